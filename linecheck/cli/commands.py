@@ -1,0 +1,68 @@
+"""`check` and `static` commands."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+from rich.table import Table
+
+from .. import service
+from ..core.errors import CaseError
+from ..io.atomic import check_target
+from ..io.jsonout import static_to_dict, write_json
+from .app import CaseArg, CasesArg, JsonOpt, app, console, err_console, handle_errors, read_case
+from .progress import progress_bar
+
+
+@app.command()
+@handle_errors
+def check(cases: CasesArg) -> None:
+    """Validate case files without running them (exit 2 on the first bad file)."""
+    failed = 0
+    for path in cases:
+        try:
+            case = read_case(path)
+        except CaseError as err:
+            err_console.print(f"[bold red]error:[/] {err}", highlight=False, soft_wrap=True)
+            failed += 1
+            continue
+        console.print(f"[green]ok[/] {path}  [dim]{case.name}: {case.description}[/]", highlight=False)
+    if failed:
+        raise typer.Exit(2)
+
+
+@app.command()
+@handle_errors
+def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
+    """Step 1: non-linear static analysis under the (running-)mean wind."""
+    case = read_case(case_file)
+    if json_out is not None:
+        check_target(json_out, what="JSON")
+    with progress_bar() as cb:
+        res = service.static_analysis(case, progress=cb)
+    doc = static_to_dict(res)
+    m = res.mean
+    toi = case.line.tower_of_interest - 1
+    table = Table(title=f"{case.name}: step-1 mean reactions (kN)", title_justify="left")
+    for col in ("tower", "support", "Rx", "Ry", "Rz", "Rx wind", "Ry wind", "Rz wind"):
+        table.add_column(col, justify="right")
+    rw = m.reactions_wind
+    for j in range(res.system.n_towers):
+        k = int(abs(rw[:, j, 1]).argmax()) if case.wind.type == "downburst" else 0
+        mark = " *" if j == toi else ""
+        table.add_row(
+            f"{j + 1}{mark}", case.line.supports[j],
+            *(f"{m.reactions[k, j, c] / 1e3:.3f}" for c in range(3)),
+            *(f"{rw[k, j, c] / 1e3:.3f}" for c in range(3)),
+        )
+    console.print(table)
+    tens = ", ".join(f"{h / 1e3:.2f}" for h in m.tension[0])
+    console.print(f"span tensions H (kN): {tens}   still air: {m.still_air.tension[0] / 1e3:.2f}   "
+                  f"nominal T0: {res.system.tension_nominal / 1e3:.2f}")
+    if case.wind.type == "downburst":
+        console.print(f"[dim]{m.time.size} mean states over t = {m.time[0]:.0f} to {m.time[-1]:.0f} s; "
+                      "rows show the instant of peak wind-induced Ry at each tower.[/]")
+    if json_out is not None:
+        write_json(json_out, doc)
+        console.print(f"wrote {json_out}")

@@ -1,0 +1,574 @@
+"""Case model: frozen dataclasses, the TOML key schema and its validation.
+
+The TOML key layout is a public contract (see ``docs/case-files.md``).  Every
+key is declared once in :data:`SCHEMA` with its type, physical range, default,
+unit and help text; the loader, the TUI editor and the Excel inputs sheet all
+read that table, so a message or a unit is written in one place only.
+
+Units are SI inside (m, s, N, kg, Pa); angles are degrees in the file and in
+the dataclasses (converted where used).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import hashlib
+import math
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .errors import CaseError
+
+SUPPORT_TYPES = ("strain", "suspension")
+WIND_TYPES = ("synoptic", "downburst")
+DOWNBURST_PRESETS = ("Db_x", "Db_y")
+DAMPING_MODELS = ("quasi-steady", "paper")
+
+
+# --------------------------------------------------------------------------- schema
+@dataclass(frozen=True)
+class FieldSpec:
+    """Declaration of one case key.
+
+    kind: ``float``, ``int``, ``str``, ``choice``, ``float_list``, ``str_list``, ``bool``.
+    ``low``/``high`` bound the value (or every list item); ``low_open`` makes the
+    lower bound exclusive.  ``default`` of ``None`` with ``required=False`` means
+    "derived elsewhere" (documented in ``help``).
+    """
+
+    name: str
+    kind: str
+    unit: str = ""
+    help: str = ""
+    default: Any = None
+    required: bool = False
+    low: float | None = None
+    high: float | None = None
+    low_open: bool = False
+    choices: tuple[str, ...] = ()
+
+    def allowed(self) -> str:
+        """Human text of the allowed values."""
+        if self.kind == "choice" or (self.kind == "str_list" and self.choices):
+            return "one of " + ", ".join(f'"{c}"' for c in self.choices)
+        if self.kind in ("float", "int", "float_list"):
+            what = {"float": "a number", "int": "an integer", "float_list": "a list of numbers"}[
+                self.kind
+            ]
+            parts = []
+            if self.low is not None:
+                parts.append(f"{'>' if self.low_open else '>='} {self.low:g}")
+            if self.high is not None:
+                parts.append(f"<= {self.high:g}")
+            rng = (" " + " and ".join(parts)) if parts else ""
+            unit = f" {self.unit}" if self.unit and self.unit != "-" else ""
+            return f"{what}{rng}{unit}"
+        if self.kind == "bool":
+            return "true or false"
+        return "a string"
+
+
+def _f(name, unit, help, default=None, required=False, low=None, high=None, low_open=False):
+    return FieldSpec(name, "float", unit, help, default, required, low, high, low_open)
+
+
+def _i(name, unit, help, default=None, required=False, low=None, high=None):
+    return FieldSpec(name, "int", unit, help, default, required, low, high)
+
+
+SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
+    "": (
+        FieldSpec("name", "str", "", "case name (default: file stem)"),
+        FieldSpec("description", "str", "", "one-line description", default=""),
+    ),
+    "line": (
+        _i("spans", "-", "number of spans in the modelled section", required=True, low=1, high=200),
+        _f("span_length", "m", "span length L_x (equal spans)", required=True, low=10.0, high=3000.0),
+        _f("sag", "m", "still-air mid-span sag S", required=True, low=0.0, high=None, low_open=True),
+        _f("weight", "N/m", "conductor weight per unit length W", required=True, low=0.0, high=1000.0, low_open=True),
+        _f("diameter", "m", "projected area per unit length D (m2/m)", required=True, low=0.0, high=1.0, low_open=True),
+        _f("drag_coefficient", "-", "drag coefficient C_d", default=1.0, low=0.0, high=3.0, low_open=True),
+        _f("area", "m2", "conductor cross-section A", required=True, low=0.0, high=0.1, low_open=True),
+        _f("elastic_modulus", "Pa", "elastic modulus E", required=True, low=1e8, high=1e12),
+        _f("height", "m", "average conductor elevation", required=True, low=1.0, high=500.0),
+        _f("insulator_length", "m", "suspension insulator length v", default=4.0, low=0.0, high=20.0, low_open=True),
+        FieldSpec("supports", "str_list", "-", 'one per tower: "strain" or "suspension"', choices=SUPPORT_TYPES),
+        _i("tower_of_interest", "-", "1-based tower whose reactions are reported", default=1, low=1),
+        _i("elements_per_span", "-", "cable finite elements per span (step 2)", default=10, low=2, high=200),
+    ),
+    "wind": (
+        FieldSpec("type", "choice", "-", "wind type", required=True, choices=WIND_TYPES),
+        _f("v_ref", "m/s", "reference mean speed V_ref at conductor height", required=True, low=0.0, high=150.0),
+        _f("turbulence_intensity", "-", "turbulence intensity I", default=0.12, low=0.0, high=0.6),
+        _f("air_density", "kg/m3", "air density rho", default=1.25, low=0.5, high=2.0),
+        _f("coherence_decay", "-", "Davenport coherence decay constant C", default=10.0, low=0.0, high=100.0, low_open=True),
+        _f("length_scale", "m", "von Karman length scale L_u (default: synoptic 52/0.3, downburst D_j)", low=0.0, high=1e5, low_open=True),
+        FieldSpec("span_speeds", "float_list", "m/s", "synoptic only: mean speed per span (default v_ref on every span)", low=0.0, high=150.0),
+    ),
+    "wind.downburst": (
+        FieldSpec("preset", "choice", "-", "critical configuration: Db_x (D_j=2L, R=1.6D_j, 30 deg) or Db_y (D_j=2L, R=1.2D_j, 0 deg)", choices=DOWNBURST_PRESETS),
+        _f("jet_diameter", "m", "downburst jet diameter D_j", low=10.0, high=1e5),
+        _f("distance", "m", "distance R from the tower of interest to the downburst centre", low=0.0, high=1e6),
+        _f("angle", "deg", "angle Theta of the centre from the perpendicular to the line (Fig. 2)", low=-180.0, high=180.0),
+        _f("r_max", "m", "radius of peak outflow (default 1.2 D_j)", low=0.0, high=1e6, low_open=True),
+        _f("radial_decay", "m", "radial decay length R_r beyond r_max (default D_j/2)", low=0.0, high=1e6, low_open=True),
+        _f("z_max", "m", "height of peak outflow (default 0.025 D_j)", low=0.0, high=1e4, low_open=True),
+        _f("t1", "s", "rise time T1 of the intensity function", low=0.0, high=1e5, low_open=True),
+        _f("t_f", "s", "end time T_f of the intensity function", low=0.0, high=1e5, low_open=True),
+        _f("translation_speed", "m/s", "storm translation speed (Holmes & Oliver vector sum)", default=0.0, low=0.0, high=100.0),
+        _f("translation_direction", "deg", "direction of storm travel, from +x toward +y", default=90.0, low=-360.0, high=360.0),
+        FieldSpec("field", "str", "", "user running-mean field file (CSV or NPZ), relative to the case file"),
+    ),
+    "analysis": (
+        _f("duration", "s", "analysed record length (downburst default: 0 to T_f)", low=0.0, high=1e5, low_open=True),
+        _f("time_step", "s", "time step", default=0.05, low=0.0, high=1.0, low_open=True),
+        _i("realizations", "-", "number of turbulence realizations", default=10, low=1, high=10000),
+        _i("seed", "-", "random seed", default=2015, low=0, high=2**63 - 1),
+        _i("mean_states", "-", "downburst: step-1 mean-state instants over the event", default=250, low=2, high=100000),
+    ),
+}
+
+
+def field_spec(section: str, key: str) -> FieldSpec:
+    """The :class:`FieldSpec` of ``section.key`` (``section`` "" for top level)."""
+    for spec in SCHEMA[section]:
+        if spec.name == key:
+            return spec
+    raise KeyError(f"{section}.{key}")
+
+
+# --------------------------------------------------------------------------- dataclasses
+@dataclass(frozen=True)
+class Line:
+    """Conductor system of one line section (paper Table 1)."""
+
+    spans: int
+    span_length: float  # [m]
+    sag: float  # [m]
+    weight: float  # [N/m]
+    diameter: float  # [m2/m]
+    drag_coefficient: float  # [-]
+    area: float  # [m2]
+    elastic_modulus: float  # [Pa]
+    height: float  # [m]
+    insulator_length: float  # [m]
+    supports: tuple[str, ...]
+    tower_of_interest: int  # 1-based
+    elements_per_span: int = 10
+
+    @property
+    def n_towers(self) -> int:
+        return self.spans + 1
+
+    @property
+    def ea(self) -> float:
+        """Axial stiffness E*A [N]."""
+        return self.elastic_modulus * self.area
+
+    @property
+    def mass_per_length(self) -> float:
+        """Mass per unit length [kg/m] (W / g, g = 9.81 m/s2 as in paper Eq. 8)."""
+        return self.weight / GRAVITY
+
+
+@dataclass(frozen=True)
+class Downburst:
+    """Downburst geometry and time history (paper Fig. 2; see docs/method.md)."""
+
+    jet_diameter: float  # [m] D_j
+    distance: float  # [m] R
+    angle: float  # [deg] Theta
+    preset: str | None = None
+    r_max: float | None = None  # [m]
+    radial_decay: float | None = None  # [m]
+    z_max: float | None = None  # [m]
+    t1: float | None = None  # [s]
+    t_f: float | None = None  # [s]
+    translation_speed: float = 0.0  # [m/s]
+    translation_direction: float = 90.0  # [deg]
+    field: str | None = None  # path as written in the file
+    field_path: Path | None = None  # resolved path
+
+
+@dataclass(frozen=True)
+class Wind:
+    type: str
+    v_ref: float  # [m/s]
+    turbulence_intensity: float = 0.12
+    air_density: float = 1.25  # [kg/m3]
+    coherence_decay: float = 10.0
+    length_scale: float | None = None  # [m]; None = default of the wind type
+    span_speeds: tuple[float, ...] | None = None  # [m/s]
+    downburst: Downburst | None = None
+
+
+@dataclass(frozen=True)
+class Analysis:
+    duration: float | None = None  # [s]; None = default of the wind type
+    time_step: float = 0.05  # [s]
+    realizations: int = 10
+    seed: int = 2015
+    mean_states: int = 250
+
+
+@dataclass(frozen=True)
+class Case:
+    """One analysis case: a line section, a wind and the analysis settings."""
+
+    name: str
+    line: Line
+    wind: Wind
+    analysis: Analysis = field(default_factory=Analysis)
+    description: str = ""
+    source: Path | None = None
+
+    @property
+    def g_yp(self) -> float:
+        """Reference transverse load intensity g*_yp = 1/2 rho C_d V_ref^2 D [N/m] (paper Eq. 17)."""
+        return 0.5 * self.wind.air_density * self.line.drag_coefficient * self.wind.v_ref**2 * self.line.diameter
+
+    @property
+    def g_yp_L(self) -> float:
+        """Normalising force g*_yp * L_x [N] (paper Eq. 17, Fig. 13)."""
+        return self.g_yp * self.line.span_length
+
+
+GRAVITY = 9.81  # [m/s2], paper Eq. 8
+
+_SUBTABLES = {"": ("line", "wind", "analysis"), "wind": ("downburst",)}
+
+
+# --------------------------------------------------------------------------- loading
+def _find_line(text: str | None, section: str, key: str | None) -> int | None:
+    """1-based line of ``key`` inside ``[section]`` (or of the header when key is None)."""
+    if text is None:
+        return None
+    current = ""
+    header = re.compile(r"^\s*\[\s*([A-Za-z0-9_.\-\" ]+?)\s*\]\s*(#.*)?$")
+    for n, raw in enumerate(text.splitlines(), start=1):
+        m = header.match(raw)
+        if m:
+            current = m.group(1).replace('"', "").replace(" ", "")
+            if key is None and current == section:
+                return n
+            continue
+        if key is not None and current == section:
+            if re.match(rf"^\s*\"?{re.escape(key)}\"?\s*=", raw):
+                return n
+    return None
+
+
+class _Ctx:
+    """Where a value came from, to build messages that name file, key and line."""
+
+    def __init__(self, file: str | None, text: str | None) -> None:
+        self.file = file
+        self.text = text
+
+    def error(self, section: str, key: str | None, message: str) -> CaseError:
+        dotted = f"{section}.{key}" if section and key else (key or section or None)
+        return CaseError(message, file=self.file, key=dotted, line=_find_line(self.text, section, key))
+
+
+def _fmt(value: Any) -> str:
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, list):
+        return "[" + ", ".join(_fmt(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "a table"
+    return repr(value)
+
+
+def _check_number(spec: FieldSpec, v: Any, ctx: _Ctx, section: str, whole: Any = None) -> float:
+    shown = _fmt(whole if whole is not None else v)
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise ctx.error(section, spec.name, f"value {shown} is not allowed: expected {spec.allowed()}")
+    if spec.kind == "int" and not isinstance(v, int):
+        raise ctx.error(section, spec.name, f"value {shown} is not allowed: expected {spec.allowed()}")
+    if not math.isfinite(float(v)):
+        raise ctx.error(section, spec.name, f"value {shown} is not allowed: expected {spec.allowed()}")
+    bad = False
+    if spec.low is not None:
+        bad |= v <= spec.low if spec.low_open else v < spec.low
+    if spec.high is not None:
+        bad |= v > spec.high
+    if bad:
+        raise ctx.error(section, spec.name, f"value {shown} is out of range: expected {spec.allowed()}")
+    return v
+
+
+def _check_value(spec: FieldSpec, v: Any, ctx: _Ctx, section: str) -> Any:
+    if spec.kind in ("float", "int"):
+        out = _check_number(spec, v, ctx, section)
+        return float(out) if spec.kind == "float" else int(out)
+    if spec.kind == "str":
+        if not isinstance(v, str):
+            raise ctx.error(section, spec.name, f"value {_fmt(v)} is not allowed: expected {spec.allowed()}")
+        return v
+    if spec.kind == "choice":
+        if not isinstance(v, str) or v not in spec.choices:
+            hint = ""
+            if isinstance(v, str):
+                close = difflib.get_close_matches(v, spec.choices, n=1)
+                hint = f' (did you mean "{close[0]}"?)' if close else ""
+            raise ctx.error(section, spec.name, f"value {_fmt(v)} is not allowed: expected {spec.allowed()}{hint}")
+        return v
+    if spec.kind == "bool":
+        if not isinstance(v, bool):
+            raise ctx.error(section, spec.name, f"value {_fmt(v)} is not allowed: expected {spec.allowed()}")
+        return v
+    if spec.kind == "float_list":
+        if not isinstance(v, list) or not v:
+            raise ctx.error(section, spec.name, f"value {_fmt(v)} is not allowed: expected {spec.allowed()}")
+        return tuple(float(_check_number(spec, item, ctx, section, whole=v)) for item in v)
+    if spec.kind == "str_list":
+        if not isinstance(v, list) or not v:
+            raise ctx.error(section, spec.name, f"value {_fmt(v)} is not allowed: expected a list, each {spec.allowed()}")
+        for item in v:
+            if not isinstance(item, str) or (spec.choices and item not in spec.choices):
+                raise ctx.error(
+                    section, spec.name, f"item {_fmt(item)} in {_fmt(v)} is not allowed: expected each {spec.allowed()}"
+                )
+        return tuple(v)
+    raise ValueError(spec.kind)  # pragma: no cover - schema bug
+
+
+def _read_section(data: dict, section: str, ctx: _Ctx) -> dict[str, Any]:
+    """Validate the keys of one table against :data:`SCHEMA`; fill defaults."""
+    specs = {s.name: s for s in SCHEMA[section]}
+    subtables = set(_SUBTABLES.get(section, ()))
+    out: dict[str, Any] = {}
+    for key, value in data.items():
+        if key in subtables:
+            if not isinstance(value, dict):
+                raise ctx.error(section, key, f"value {_fmt(value)} is not allowed: expected a table [{(section + '.') if section else ''}{key}]")
+            continue
+        if key not in specs:
+            candidates = list(specs) + sorted(subtables)
+            close = difflib.get_close_matches(key, candidates, n=1, cutoff=0.5)
+            hint = f'; did you mean "{close[0]}"?' if close else ""
+            where = f"[{section}]" if section else "the top level"
+            allowed = ", ".join(candidates)
+            raise ctx.error(section, key, f"unknown key in {where}{hint} (allowed: {allowed})")
+        out[key] = _check_value(specs[key], value, ctx, section)
+    for name, spec in specs.items():
+        if name not in out:
+            if spec.required:
+                raise ctx.error(section, name, f"missing required key: expected {spec.allowed()}")
+            out[name] = spec.default
+    return out
+
+
+def case_from_dict(
+    data: dict[str, Any],
+    *,
+    file: str | None = None,
+    text: str | None = None,
+    default_name: str = "case",
+    base_dir: Path | None = None,
+) -> Case:
+    """Validate a parsed TOML document and build a :class:`Case`.
+
+    Raises :class:`CaseError` naming file, key, line, value and what is allowed.
+    """
+    ctx = _Ctx(file, text)
+    top = _read_section(data, "", ctx)
+    for required in ("line", "wind"):
+        if required not in data:
+            raise ctx.error("", required, f"missing required table [{required}]")
+    line_d = _read_section(data["line"], "line", ctx)
+    wind_d = _read_section(data["wind"], "wind", ctx)
+    an_d = _read_section(data.get("analysis", {}), "analysis", ctx)
+
+    # ---- line cross-checks
+    n_towers = line_d["spans"] + 1
+    if line_d["supports"] is None:
+        if line_d["spans"] == 1:
+            line_d["supports"] = ("strain", "strain")
+        else:
+            raise ctx.error("line", "supports", f"missing: give {n_towers} entries, one per tower (\"strain\" or \"suspension\")")
+    sup = line_d["supports"]
+    if len(sup) != n_towers:
+        raise ctx.error("line", "supports", f"value {_fmt(list(sup))} has {len(sup)} entries: expected {n_towers} (spans + 1), one per tower")
+    if sup[0] != "strain" or sup[-1] != "strain":
+        raise ctx.error("line", "supports", f"value {_fmt(list(sup))} is not allowed: the end towers must be \"strain\" (a suspension end leaves the section unrestrained along the line)")
+    toi = line_d["tower_of_interest"]
+    if toi > n_towers:
+        raise ctx.error("line", "tower_of_interest", f"value {toi} is out of range: expected an integer from 1 to {n_towers} (number of towers)")
+    if line_d["sag"] >= 0.25 * line_d["span_length"]:
+        raise ctx.error("line", "sag", f"value {line_d['sag']!r} is out of range: expected a sag below span_length/4 = {0.25 * line_d['span_length']:g} m (shallow-cable method)")
+    line = Line(**line_d)
+
+    # ---- wind cross-checks
+    db_data = data["wind"].get("downburst")
+    if wind_d["type"] == "downburst":
+        if db_data is None:
+            raise ctx.error("wind", "downburst", "missing table [wind.downburst] for type = \"downburst\"")
+        db_d = _read_section(db_data, "wind.downburst", ctx)
+        db = _build_downburst(db_d, line, ctx, base_dir)
+        if wind_d["span_speeds"] is not None:
+            raise ctx.error("wind", "span_speeds", "is for synoptic winds only: a downburst's speeds come from its field")
+    else:
+        if db_data is not None:
+            raise ctx.error("wind", "downburst", "table [wind.downburst] given but type = \"synoptic\": remove it or set type = \"downburst\"")
+        db = None
+        if wind_d["span_speeds"] is not None and len(wind_d["span_speeds"]) != line.spans:
+            raise ctx.error("wind", "span_speeds", f"value {_fmt(list(wind_d['span_speeds']))} has {len(wind_d['span_speeds'])} entries: expected {line.spans}, one per span")
+    wind = Wind(downburst=db, **wind_d)
+
+    analysis = Analysis(**an_d)
+    if analysis.duration is not None and analysis.time_step * 4 > analysis.duration:
+        raise ctx.error("analysis", "time_step", f"value {analysis.time_step!r} is too large for duration {analysis.duration!r}: expected at most duration/4")
+    name = top["name"] or default_name
+    return Case(name=name, description=top["description"] or "", line=line, wind=wind, analysis=analysis,
+                source=Path(file) if file else None)
+
+
+def _build_downburst(d: dict[str, Any], line: Line, ctx: _Ctx, base_dir: Path | None) -> Downburst:
+    sec = "wind.downburst"
+    preset = d["preset"]
+    if preset is not None:
+        dj = 2.0 * line.span_length  # paper Table 2 note: D_j = 2.0 L_x
+        r_ratio, theta = (1.6, 30.0) if preset == "Db_x" else (1.2, 0.0)
+        for key, val in (("jet_diameter", dj), ("distance", r_ratio * dj), ("angle", theta)):
+            if d[key] is not None and not math.isclose(d[key], val, rel_tol=1e-9, abs_tol=1e-9):
+                raise ctx.error(sec, key, f"value {d[key]!r} contradicts preset \"{preset}\" (which sets {key} = {val:g}): remove one of them")
+            d[key] = val
+    for key in ("jet_diameter", "distance", "angle"):
+        if d[key] is None:
+            raise ctx.error(sec, key, f"missing: give {key} or a preset (\"Db_x\" or \"Db_y\")")
+    if d["t1"] is not None and d["t_f"] is not None and d["t_f"] <= d["t1"]:
+        raise ctx.error(sec, "t_f", f"value {d['t_f']!r} is not allowed: expected t_f > t1 = {d['t1']!r}")
+    path = None
+    if d["field"] is not None:
+        path = Path(d["field"])
+        if not path.is_absolute() and base_dir is not None:
+            path = base_dir / path
+        if not path.exists():
+            raise ctx.error(sec, "field", f"value {_fmt(d['field'])}: file {path} does not exist (expected a CSV or NPZ running-mean field, see docs/wind.md)")
+    return Downburst(field_path=path, **d)
+
+
+def load_case(path: str | Path) -> Case:
+    """Read and validate a TOML case file.
+
+    Raises :class:`CaseError` (one line: file, key, line, value, what is allowed).
+    """
+    p = Path(path)
+    try:
+        raw = p.read_bytes()
+    except FileNotFoundError:
+        raise CaseError("file not found", file=str(p)) from None
+    except IsADirectoryError:
+        raise CaseError("is a directory, expected a .toml case file", file=str(p)) from None
+    except OSError as exc:
+        raise CaseError(f"cannot read: {exc.strerror}", file=str(p)) from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        raise CaseError("not a UTF-8 text file (expected a TOML case file)", file=str(p)) from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        m = re.search(r"\(at line (\d+), column (\d+)\)", str(exc))
+        msg = re.sub(r"\s*\(at line \d+, column \d+\)", "", str(exc))
+        if m:
+            raise CaseError(f"TOML syntax error at line {m.group(1)}, column {m.group(2)}: {msg}", file=str(p)) from None
+        raise CaseError(f"TOML syntax error: {msg}", file=str(p)) from None
+    return case_from_dict(data, file=str(p), text=text, default_name=p.stem, base_dir=p.parent)
+
+
+def case_hash(path: str | Path) -> str:
+    """SHA-256 of the case file's bytes (batch --resume)."""
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+# --------------------------------------------------------------------------- editing / writing
+def case_to_dict(case: Case) -> dict[str, Any]:
+    """The TOML document of a case (only keys that are set), inverse of :func:`case_from_dict`."""
+    def pick(obj: Any, section: str) -> dict[str, Any]:
+        out = {}
+        for spec in SCHEMA[section]:
+            v = getattr(obj, spec.name)
+            if v is None:
+                continue
+            out[spec.name] = list(v) if isinstance(v, tuple) else v
+        return out
+
+    doc: dict[str, Any] = {"name": case.name}
+    if case.description:
+        doc["description"] = case.description
+    doc["line"] = pick(case.line, "line")
+    doc["wind"] = pick(case.wind, "wind")
+    if case.wind.downburst is not None:
+        db = pick(case.wind.downburst, "wind.downburst")
+        if db.get("preset"):
+            for k in ("jet_diameter", "distance", "angle"):
+                db.pop(k, None)
+        doc["wind"]["downburst"] = db
+    doc["analysis"] = pick(case.analysis, "analysis")
+    return doc
+
+
+def _toml_value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, float):
+        return repr(v)
+    if isinstance(v, list):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    return str(v)
+
+
+def case_to_toml(case: Case) -> str:
+    """Serialise a case to TOML text with units as comments."""
+    doc = case_to_dict(case)
+    lines: list[str] = []
+
+    def emit(section: str, table: dict[str, Any]) -> None:
+        for spec in SCHEMA[section]:
+            if spec.name in table:
+                unit = f"  # {spec.unit}" if spec.unit and spec.unit != "-" else ""
+                lines.append(f"{spec.name} = {_toml_value(table[spec.name])}{unit}")
+
+    emit("", doc)
+    for section in ("line", "wind", "wind.downburst", "analysis"):
+        table = doc.get(section) if "." not in section else doc["wind"].get("downburst")
+        if table is None:
+            continue
+        lines.append("")
+        lines.append(f"[{section}]")
+        emit(section, table)
+    return "\n".join(lines) + "\n"
+
+
+def with_value(case: Case, dotted_key: str, value: Any) -> Case:
+    """A validated copy of ``case`` with one key changed (e.g. ``"wind.v_ref"``).
+
+    The same validation and messages as the file loader (TUI editor, scans).
+    """
+    doc = case_to_dict(case)
+    *path, key = dotted_key.split(".")
+    table = doc
+    for p in path:
+        table = table.setdefault(p, {})
+    if value is None:
+        table.pop(key, None)
+    else:
+        table[key] = value
+    base = case.source.parent if case.source else None
+    return case_from_dict(doc, file=str(case.source) if case.source else None, default_name=case.name, base_dir=base)
+
+
+def replace(obj: Any, **changes: Any) -> Any:
+    """``dataclasses.replace`` re-exported for convenience."""
+    return dataclasses.replace(obj, **changes)

@@ -1,0 +1,439 @@
+"""Step 1: non-linear static analysis under the (running-)mean wind.
+
+Semi-analytical technique of the paper (Appendix A, Eqs 2-4, Fig. 6, after
+Aboshosha & El Damatty 2014): every span is ONE element described by the
+shallow-cable (parabolic) theory; the unknowns are the displacements
+d = (d_x, d_y, d_z) of the conductor-insulator attachment points.  The paper's
+length-tension relation (its C_n) is for an inextensible conductor; here the
+conductor is elastic and the relation and its derivative are derived in
+``docs/method.md`` ("Elastic span relation"):
+
+    G(H) = l + D^2/(2 l) + J/(2 H^2) - L_u - (H/EA) (l + D^2/l + J/H^2) = 0
+
+with l the horizontal chord, D^2 = dy^2 + dz^2 the end offsets, L_u the
+unstretched length and J = int_0^l (Q_y^2 + Q_z^2) dx the shear integral of the
+span loads (loads are per unit conductor length, J = L_u^2 l j_hat).
+
+Iteration (paper Fig. 6): given d_y, d_z, Newton on d_x with the tangent K_x of
+Eq. 3 (insulator forces R_res fixed); reactions by Eq. 2; new d_y, d_z from
+the insulator equilibrium Eq. 4; repeat until the attachment displacements
+stop changing.  Nothing here prints; failures raise :class:`ConvergenceError`.
+
+Sign conventions: reactions are the forces the conductor system exerts on the
+tower at its fixed point: R_x toward +x, R_y toward +y, R_z downward.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+from scipy.linalg import solve_banded
+
+from .errors import Cancelled, ConvergenceError
+from .system import LineSystem
+
+MAX_STRAIN = 0.05  # conductor strain above this is not an admissible elastic state
+_GAUSS_T, _GAUSS_W = np.polynomial.legendre.leggauss(3)  # exact for degree 5
+
+
+# --------------------------------------------------------------------------- span load operators
+@dataclass(frozen=True)
+class _SpanOperators:
+    """Linear maps from nodal load intensities g_k (piecewise linear on a unit span) to
+    the beam quantities of paper Appendix A (simply supported span of length 1).
+
+    a_left, a_right: (ne+1,) end reactions v_A = int g (1-s) ds, v_B = int g s ds.
+    shear_gp: (n_gp, ne+1) shear Q(s) = v_A - int_0^s g at Gauss points; w_gp (n_gp,) weights.
+    moment_nodes: (ne+1, ne+1) bending moment M(s_k) = int_0^s Q at the nodes.
+    """
+
+    a_left: np.ndarray
+    a_right: np.ndarray
+    shear_gp: np.ndarray
+    w_gp: np.ndarray
+    moment_nodes: np.ndarray
+
+
+@lru_cache(maxsize=32)
+def span_operators(ne: int) -> _SpanOperators:
+    """Exact integration operators for piecewise-linear loads on ``ne`` equal elements."""
+    h = 1.0 / ne
+    n = ne + 1
+    eye = np.eye(n)
+    # cumulative integral of g at the nodes: C_k = sum_{i<k} h (g_i + g_{i+1}) / 2 (trapezoid exact)
+    cum_nodes = np.zeros((n, n))
+    cum_nodes[1:] = np.cumsum(0.5 * h * (eye[:-1] + eye[1:]), axis=0)
+    # end reactions for piecewise-linear g (exact): int_e g (1-s) ds and int_e g s ds per element
+    t, w = _GAUSS_T, _GAUSS_W
+    tt = 0.5 * (t + 1.0)  # local coordinate in [0, 1]
+    ww = 0.5 * w * h
+    s_gp = (np.arange(ne)[:, None] + tt[None, :]) * h  # (ne, 3)
+    # g at gauss points: g_e (1-t) + g_{e+1} t  -> (ne, 3, n)
+    g_gp = (1 - tt)[None, :, None] * eye[:-1][:, None, :] + tt[None, :, None] * eye[1:][:, None, :]
+    a_left = np.einsum("eg,egk->k", ww[None, :] * (1.0 - s_gp), g_gp)
+    a_right = np.einsum("eg,egk->k", ww[None, :] * s_gp, g_gp)
+    # int_0^s g at gauss points: C_e + h (g_e t + (g_{e+1} - g_e) t^2 / 2)
+    cum_gp = (
+        cum_nodes[:-1][:, None, :]
+        + h * (eye[:-1][:, None, :] * (tt - 0.5 * tt**2)[None, :, None] + eye[1:][:, None, :] * (0.5 * tt**2)[None, :, None])
+    )
+    shear_gp = (a_left[None, None, :] - cum_gp).reshape(ne * 3, n)
+    w_gp = np.tile(ww, ne)
+    # moment at nodes M(s_k) = int_0^{s_k} Q ds; Q is quadratic per element -> Simpson is exact
+    q_nodes = a_left[None, :] - cum_nodes  # (n, n)
+    cum_mid = cum_nodes[:-1] + h * (eye[:-1] * (0.5 - 0.125) + eye[1:] * 0.125)  # int_0^{s_e + h/2} g
+    q_mid = a_left[None, :] - cum_mid
+    incr = h / 6.0 * (q_nodes[:-1] + 4.0 * q_mid + q_nodes[1:])
+    moment_nodes = np.zeros((n, n))
+    moment_nodes[1:] = np.cumsum(incr, axis=0)
+    return _SpanOperators(a_left, a_right, shear_gp, w_gp, moment_nodes)
+
+
+# --------------------------------------------------------------------------- results
+@dataclass(frozen=True)
+class StaticState:
+    """Converged step-1 equilibrium of the line section under one set of mean loads.
+
+    Attributes:
+        displacement: [m] attachment-point displacements (d_x, d_y, d_z), shape (n_towers, 3).
+        reactions: [N] (R_x, R_y, R_z) at every tower's fixed point, shape (n_towers, 3).
+        tension: [N] horizontal tension H of every span, shape (n_spans,).
+        insulator_force: [N] R_res at every tower (strain towers: resultant reaction), (n_towers,).
+        nodes: [m] deformed FE node coordinates (x, y, z), shape (n_nodes, 3).
+        element_tension: [N] axial tension of every cable element, shape (n_spans * ne,).
+        iterations: outer (Fig. 6) iterations used.
+        residual: [N] largest out-of-balance force at an attachment point.
+    """
+
+    displacement: np.ndarray
+    reactions: np.ndarray
+    tension: np.ndarray
+    insulator_force: np.ndarray
+    nodes: np.ndarray
+    element_tension: np.ndarray
+    iterations: int
+    residual: float
+
+
+def span_loads_uniform(system: LineSystem, intensity: np.ndarray | float) -> np.ndarray:
+    """Nodal transverse load intensities [N/m] for a uniform load per span, shape (n_spans, ne+1)."""
+    g = np.broadcast_to(np.asarray(intensity, dtype=float), (system.n_spans,))
+    return np.repeat(g[:, None], system.ne + 1, axis=1)
+
+
+def drag_intensity(speed: np.ndarray | float, air_density: float, drag_coefficient: float, diameter: float) -> np.ndarray:
+    """Mean-wind load per unit length g_y = 1/2 rho C_d V|V| D [N/m] (paper Eq. 1; sign follows V)."""
+    v = np.asarray(speed, dtype=float)
+    return 0.5 * air_density * drag_coefficient * diameter * v * np.abs(v)
+
+
+class _Spans:
+    """Per-span load integrals for one load case (vectorised over spans)."""
+
+    def __init__(self, system: LineSystem, gy: np.ndarray) -> None:
+        op = span_operators(system.ne)
+        line = system.line
+        self.Lu = system.unstretched_length
+        self.EA = line.ea
+        self.L = line.span_length
+        W = line.weight
+        # beam end reactions per unit L_u (loads per unit unstretched conductor length)
+        self.vAy = gy @ op.a_left
+        self.vBy = gy @ op.a_right
+        self.vAz = self.vBz = 0.5 * W
+        self.qy_gp = gy @ op.shear_gp.T  # (n_spans, n_gp) shear of the unit span
+        self.qz_gp = op.shear_gp @ np.full(system.ne + 1, W)  # (n_gp,)
+        self.w_gp = op.w_gp
+        self.my_hat = gy @ op.moment_nodes.T  # (n_spans, ne+1) moment of unit span
+        self.mz_hat = 0.5 * W * system.node_s * (1.0 - system.node_s)
+
+    def tension(
+        self, l: np.ndarray, dy: np.ndarray, dz: np.ndarray, H0: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Solve the elastic span relation F(H) = 0 for the horizontal tension H.
+
+        F(H) = int_0^l u / (1 + H u / EA) dx - L_u,  u = sqrt(1 + y'^2 + z'^2),
+        y' = dy/l + L_u Q_y(s)/H, z' = dz/l - L_u Q_z(s)/H  (docs/method.md, "Elastic
+        span relation"; shallow-cable shape, Irvine 1981 ch. 2, exact length integral).
+
+        Args: l, dy, dz [m] chord projections per span, shape (n_spans,); H0 [N] start.
+        Returns: H [N] and C = dH/dl [N/m] (the elastic form of the paper's C_n).
+        """
+        Lu, EA = self.Lu, self.EA
+        w = self.w_gp
+        ay, az = (dy / l)[:, None], (dz / l)[:, None]
+        by, bz = Lu * self.qy_gp, -Lu * self.qz_gp  # (n_spans, n_gp) and (n_gp,)
+        H = np.array(H0, dtype=float)
+        for _ in range(60):
+            Hc = H[:, None]
+            py, pz = ay + by / Hc, az + bz / Hc
+            u = np.sqrt(1.0 + py**2 + pz**2)
+            den = 1.0 + Hc * u / EA
+            f = u / den
+            F = l * (f @ w) - Lu
+            fu = 1.0 / den**2
+            dpdH_dot_p = -(py * by + pz * bz) / Hc**2
+            dF = l * ((-(u**2) / EA / den**2 + fu * dpdH_dot_p / u) @ w)
+            Hn = H - F / dF
+            Hn = np.where(Hn <= 0.1 * H, 0.1 * H, Hn)  # F decreasing: guard the first steps only
+            done = np.abs(Hn - H) <= 1e-13 * np.abs(H)
+            H = Hn
+            if np.all(done):
+                break
+        else:
+            raise ConvergenceError("span tension iteration did not converge (non-finite loads?)")
+        Hc = H[:, None]
+        py, pz = ay + by / Hc, az + bz / Hc
+        u = np.sqrt(1.0 + py**2 + pz**2)
+        den = 1.0 + Hc * u / EA
+        fu = 1.0 / den**2
+        dF_dH = l * ((-(u**2) / EA / den**2 + fu * (-(py * by + pz * bz) / Hc**2) / u) @ w)
+        dF_dl = (u / den) @ w + l * ((fu * (-(py * ay + pz * az) / l[:, None]) / u) @ w)
+        self.u_last = u
+        return H, -dF_dl / dF_dH
+
+
+def _reactions(sp: _Spans, H, l, dy, dz, n_towers) -> np.ndarray:
+    """Conductor forces on every attachment point (paper Eq. 2 incl. the P-delta term K_yz d)."""
+    R = np.zeros((n_towers, 3))
+    Ddy, Ddz = np.diff(dy), np.diff(dz)
+    # left end A of each span
+    R[:-1, 0] += H
+    R[:-1, 1] += H * Ddy / l + sp.Lu * sp.vAy
+    R[:-1, 2] += sp.Lu * sp.vAz - H * Ddz / l
+    # right end B
+    R[1:, 0] -= H
+    R[1:, 1] += -H * Ddy / l + sp.Lu * sp.vBy
+    R[1:, 2] += sp.Lu * sp.vBz + H * Ddz / l
+    return R
+
+
+def solve_static(
+    system: LineSystem,
+    gy: np.ndarray,
+    *,
+    initial: StaticState | None = None,
+    tol: float = 1e-9,
+    max_iter: int = 500,
+    label: str = "mean state",
+) -> StaticState:
+    """Non-linear static equilibrium under weight and the transverse mean-wind load.
+
+    Args:
+        system: the line section.
+        gy: [N/m] transverse load per unit conductor length at each span's FE nodes,
+            shape (n_spans, ne+1) (paper Eq. 1; use :func:`drag_intensity`).
+        initial: a previous state to start from (downburst time stepping).
+        tol: [m] convergence tolerance on the attachment displacements, relative to v.
+        max_iter: limit on outer (Fig. 6) iterations.
+        label: names the state in error messages (e.g. "mean state 37 (t = 120.0 s)").
+
+    Raises:
+        ConvergenceError: no convergence, non-finite values or an inadmissible strain.
+    """
+    line = system.line
+    nt = system.n_towers
+    sus = system.suspension
+    v = line.insulator_length
+    gy = np.asarray(gy, dtype=float)
+    if gy.shape != (system.n_spans, system.ne + 1):
+        raise ValueError(f"gy must have shape {(system.n_spans, system.ne + 1)}, got {gy.shape}")
+    if not np.all(np.isfinite(gy)):
+        raise ConvergenceError(f"{label}: non-finite mean-wind load")
+    sp = _Spans(system, gy)
+    L = line.span_length
+
+    if initial is not None:
+        d = initial.displacement.copy()
+        H = initial.tension.copy()
+    else:
+        d = np.zeros((nt, 3))
+        H = np.full(system.n_spans, system.tension_nominal)
+        # a better start for H: the resultant-load parabola
+        wres = np.hypot(line.weight, np.abs(gy).mean(axis=1))
+        H = np.maximum(H, system.tension_nominal * wres / line.weight)
+    idx = np.flatnonzero(sus)
+    Rres = np.full(nt, line.weight * L)
+    if initial is not None:
+        Rres = initial.insulator_force.copy()
+
+    tol_d = tol * max(v, 1.0)
+    change = np.inf
+    residual = np.inf
+    for it in range(1, max_iter + 1):
+        d_old = d.copy()
+        # ---- inner Newton on d_x (paper Eq. 3), R_res fixed
+        for _inner in range(50):
+            l = L + np.diff(d[:, 0])
+            H, C = sp.tension(l, np.diff(d[:, 1]), np.diff(d[:, 2]), H)
+            if idx.size == 0:
+                break
+            fx = np.zeros(nt)
+            fx[:-1] += H
+            fx[1:] -= H
+            fx = fx - d[:, 0] * Rres / v
+            f = fx[idx]
+            # tangent (paper K_x with the elastic C_n = dH/dl): tridiagonal over all towers
+            diag = -Rres / v
+            diag = diag.copy()
+            diag[:-1] -= C
+            diag[1:] -= C
+            # restrict to suspension nodes (strain nodes are fixed)
+            k = idx.size
+            ab = np.zeros((3, k))
+            ab[1] = diag[idx]
+            # neighbours that are both free are adjacent towers j, j+1
+            adj = np.flatnonzero(np.diff(idx) == 1)
+            ab[0, adj + 1] = C[idx[adj]]
+            ab[2, adj] = C[idx[adj]]
+            step = solve_banded((1, 1), ab, -f)
+            d[idx, 0] += step
+            if np.max(np.abs(step)) <= 1e-3 * tol_d:
+                break
+        l = L + np.diff(d[:, 0])
+        H, _ = sp.tension(l, np.diff(d[:, 1]), np.diff(d[:, 2]), H)
+        R = _reactions(sp, H, l, d[:, 1], d[:, 2], nt)
+        Rres = np.linalg.norm(R, axis=1)
+        if not (np.all(np.isfinite(R)) and np.all(np.isfinite(d))):
+            raise ConvergenceError(f"{label}: non-finite values after {it} iterations")
+        # ---- insulator equilibrium (paper Eq. 4)
+        if idx.size:
+            d[idx, 0] = v * R[idx, 0] / Rres[idx]
+            d[idx, 1] = v * R[idx, 1] / Rres[idx]
+            d[idx, 2] = v - v * R[idx, 2] / Rres[idx]
+        change = float(np.max(np.abs(d - d_old))) if idx.size else 0.0
+        # out-of-balance: conductor force minus insulator force along its axis
+        if idx.size:
+            axis = np.column_stack([d_old[idx, 0], d_old[idx, 1], v - d_old[idx, 2]]) / v
+            F = np.column_stack([R[idx, 0], R[idx, 1], R[idx, 2]])
+            residual = float(np.max(np.linalg.norm(F - Rres[idx, None] * axis, axis=1)))
+        else:
+            residual = 0.0
+        if change <= tol_d:
+            break
+    else:
+        raise ConvergenceError(
+            f"{label}: step-1 static solver did not converge in {max_iter} iterations "
+            f"(last displacement change {change:.3g} m, out-of-balance force {residual:.3g} N)"
+        )
+
+    strain = H.max() / line.ea
+    if strain > MAX_STRAIN or not np.isfinite(strain):
+        raise ConvergenceError(
+            f"{label}: no admissible equilibrium: conductor strain {strain:.3g} exceeds {MAX_STRAIN:g} "
+            f"(horizontal tension {H.max():.4g} N, out-of-balance force {residual:.3g} N); check the loads"
+        )
+
+    # ---- deformed shape at the FE nodes (shallow cable: y = chord + M_y/H, z = chord - M_z/H)
+    l = L + np.diff(d[:, 0])
+    s = system.node_s
+    xA = system.tower_x[:-1] + d[:-1, 0]
+    X = xA[:, None] + s[None, :] * l[:, None]
+    scale = (sp.Lu * l / H)[:, None]
+    Y = d[:-1, 1][:, None] + s * np.diff(d[:, 1])[:, None] + scale * sp.my_hat
+    Z = d[:-1, 2][:, None] + s * np.diff(d[:, 2])[:, None] - scale * sp.mz_hat[None, :]
+    ne = system.ne
+    nodes = np.empty((system.n_nodes, 3))
+    for c, A in enumerate((X, Y, Z)):
+        nodes[:-1, c] = A[:, :-1].reshape(-1)
+        nodes[-1, c] = A[-1, -1]
+    seg = np.diff(nodes, axis=0)  # (n_elements, 3)
+    seg_len = np.linalg.norm(seg, axis=1)
+    H_el = np.repeat(H, ne)
+    element_tension = H_el * seg_len / np.abs(seg[:, 0])  # T = H ds/dx (shallow cable)
+    return StaticState(
+        displacement=d,
+        reactions=R,
+        tension=H,
+        insulator_force=Rres,
+        nodes=nodes,
+        element_tension=element_tension,
+        iterations=it,
+        residual=residual,
+    )
+
+
+@dataclass(frozen=True)
+class MeanStates:
+    """Step-1 results over time (downburst) or a single instant (synoptic).
+
+    Attributes:
+        time: [s] instants of the mean states, shape (n_t,).
+        displacement: [m] (n_t, n_towers, 3); reactions: [N] (n_t, n_towers, 3);
+        tension: [N] (n_t, n_spans); insulator_force: [N] (n_t, n_towers);
+        nodes: [m] (n_t, n_nodes, 3); element_tension: [N] (n_t, n_elements);
+        gy: [N/m] the mean transverse loads used, (n_t, n_spans, ne+1).
+        still_air: the zero-wind reference state.
+    """
+
+    time: np.ndarray
+    displacement: np.ndarray
+    reactions: np.ndarray
+    tension: np.ndarray
+    insulator_force: np.ndarray
+    nodes: np.ndarray
+    element_tension: np.ndarray
+    gy: np.ndarray
+    still_air: StaticState
+
+    def state(self, k: int) -> StaticState:
+        """The k-th instant as a :class:`StaticState`."""
+        return StaticState(
+            self.displacement[k], self.reactions[k], self.tension[k], self.insulator_force[k],
+            self.nodes[k], self.element_tension[k], 0, 0.0,
+        )
+
+    @property
+    def reactions_wind(self) -> np.ndarray:
+        """Wind-induced reactions (total - still air) [N], shape (n_t, n_towers, 3)."""
+        return self.reactions - self.still_air.reactions[None]
+
+
+def still_air_state(system: LineSystem) -> StaticState:
+    """Equilibrium under self-weight only (reference for wind-induced values)."""
+    return solve_static(system, np.zeros((system.n_spans, system.ne + 1)), label="still-air state")
+
+
+def solve_mean_states(
+    system: LineSystem,
+    time: np.ndarray,
+    gy: np.ndarray,
+    *,
+    progress: Callable[[int, int], None] | None = None,
+    cancel: threading.Event | None = None,
+) -> MeanStates:
+    """Step 1 at every instant of ``time`` (warm-started from the previous instant).
+
+    Args:
+        time: [s] shape (n_t,).
+        gy: [N/m] mean transverse loads, shape (n_t, n_spans, ne+1).
+        progress: called as ``progress(done, total)``.
+        cancel: set it to stop; raises :class:`Cancelled`.
+    """
+    still = still_air_state(system)
+    n_t = len(time)
+    states = []
+    prev = still
+    for k in range(n_t):
+        if cancel is not None and cancel.is_set():
+            raise Cancelled("step 1 cancelled")
+        st = solve_static(system, gy[k], initial=prev, label=f"mean state {k + 1} of {n_t} (t = {time[k]:.1f} s)")
+        states.append(st)
+        prev = st
+        if progress is not None:
+            progress(k + 1, n_t)
+    return MeanStates(
+        time=np.asarray(time, dtype=float),
+        displacement=np.stack([s.displacement for s in states]),
+        reactions=np.stack([s.reactions for s in states]),
+        tension=np.stack([s.tension for s in states]),
+        insulator_force=np.stack([s.insulator_force for s in states]),
+        nodes=np.stack([s.nodes for s in states]),
+        element_tension=np.stack([s.element_tension for s in states]),
+        gy=np.asarray(gy, dtype=float),
+        still_air=still,
+    )

@@ -1,0 +1,1 @@
+"""Wind fields: running mean (synoptic, downburst) and turbulence synthesis."""

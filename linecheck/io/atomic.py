@@ -1,0 +1,62 @@
+"""Atomic output: write to a temporary file in the target folder, then rename.
+
+A failure (disk full, permission, cancel) never leaves a half-written file at
+the destination.  An existing destination is replaced only when ``force`` is
+true.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+from ..core.errors import CaseError
+
+
+def check_target(path: str | Path, *, force: bool = True, what: str = "output") -> Path:
+    """Validate an output path before any work is done (clear one-line errors)."""
+    p = Path(path)
+    if p.exists() and p.is_dir():
+        raise CaseError(f"{what} path is a directory, expected a file name", file=str(p))
+    if p.exists() and not force:
+        raise CaseError(f"{what} file exists; use --force to replace it", file=str(p))
+    parent = p.parent if str(p.parent) else Path(".")
+    if not parent.exists():
+        raise CaseError(f"folder {parent} does not exist", file=str(p))
+    if not os.access(parent, os.W_OK):
+        raise CaseError(f"folder {parent} is not writable", file=str(p))
+    return p
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | Path, *, force: bool = True, what: str = "output") -> Iterator[Path]:
+    """Yield a temporary path next to ``path``; rename it over ``path`` on success."""
+    p = check_target(path, force=force, what=what)
+    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent if str(p.parent) else ".")
+    os.close(fd)
+    tmp_path = Path(tmp)
+    try:
+        yield tmp_path
+        if p.exists() and not force:
+            raise CaseError(f"{what} file appeared while writing; use --force to replace it", file=str(p))
+        try:
+            os.replace(tmp_path, p)
+        except PermissionError:
+            raise CaseError(f"cannot replace {what} file (is it open in another program?)", file=str(p)) from None
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            tmp_path.unlink()
+
+
+def write_atomic(path: str | Path, writer: Callable[[Path], None], *, force: bool = True, what: str = "output") -> Path:
+    """Call ``writer(tmp_path)`` and move the result to ``path`` atomically."""
+    with atomic_path(path, force=force, what=what) as tmp:
+        writer(tmp)
+    return Path(path)
+
+
+def write_text_atomic(path: str | Path, text: str, *, force: bool = True, what: str = "output") -> Path:
+    return write_atomic(path, lambda t: t.write_text(text, encoding="utf-8"), force=force, what=what)

@@ -1,0 +1,44 @@
+"""The numerical core and the service layer never import a UI library."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+CORE_MODULES = [
+    "linecheck.core.case",
+    "linecheck.core.errors",
+    "linecheck.core.system",
+    "linecheck.core.static",
+    "linecheck.core.wind.mean",
+    "linecheck.service",
+    "linecheck.io.jsonout",
+]
+
+
+def test_core_imports_no_ui_libraries():
+    code = (
+        "import importlib, sys\n"
+        f"for m in {CORE_MODULES!r}:\n"
+        "    importlib.import_module(m)\n"
+        "bad = sorted(n for n in ('textual', 'rich', 'typer', 'openpyxl', 'pandas') if n in sys.modules)\n"
+        "print(','.join(bad))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "", f"core imported UI/front-end libraries: {out.stdout.strip()}"
+
+
+def test_every_core_module_is_listed():
+    """A new core module must be added to the boundary check above."""
+    from pathlib import Path
+
+    import linecheck
+
+    root = Path(linecheck.__file__).parent
+    found = {
+        "linecheck." + ".".join(p.relative_to(root).with_suffix("").parts)
+        for p in (root / "core").rglob("*.py")
+        if p.name != "__init__.py"
+    }
+    missing = found - set(CORE_MODULES)
+    assert not missing, f"add to CORE_MODULES: {sorted(missing)}"

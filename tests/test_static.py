@@ -1,0 +1,75 @@
+"""Step 1 against closed-form and independent solutions."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from linecheck.core.errors import ConvergenceError
+from linecheck.core.static import drag_intensity, solve_static, span_loads_uniform, still_air_state
+from linecheck.core.system import LineSystem
+
+from .conftest import paper_line
+from .reference import irvine
+
+
+@pytest.mark.parametrize("L", [300.0, 500.0])
+@pytest.mark.parametrize("V", [0.0, 20.0, 40.0])
+def test_single_span_matches_elastic_catenary(L, V):
+    system = LineSystem(paper_line(L))
+    g = float(drag_intensity(V, 1.25, 1.0, 0.022))
+    st = solve_static(system, span_loads_uniform(system, g))
+    Lu, EA = system.unstretched_length, system.line.ea
+    Rx, Ry, Rz = irvine.reactions(L, Lu, 17.92, g, EA)
+    # issue 2 acceptance: within 0.5 % of the exact elastic catenary
+    assert st.tension[0] == pytest.approx(Rx, rel=5e-3)
+    assert st.reactions[0, 0] == pytest.approx(Rx, rel=5e-3)
+    assert st.reactions[0, 1] == pytest.approx(Ry, rel=5e-3, abs=1e-6)
+    assert st.reactions[0, 2] == pytest.approx(Rz, rel=5e-3)
+    # the right tower mirrors the left one
+    assert st.reactions[1] == pytest.approx(st.reactions[0] * np.array([-1, 1, 1]), rel=1e-9, abs=1e-6)
+    # deformed mid-span sag in the plane of the resultant load (Irvine Eq. 2.6)
+    w = np.hypot(17.92, g)
+    mid = st.nodes[system.ne // 2]
+    assert np.hypot(mid[1], mid[2]) == pytest.approx(irvine.midspan_sag(L, Lu, w, EA), rel=5e-3)
+
+
+def test_still_air_state_is_the_nominal_reference():
+    """Zero wind reproduces the issue's reference: T0 = W L^2/(8S) within the parabola error."""
+    system = LineSystem(paper_line(300.0))
+    st = still_air_state(system)
+    # Table 1: T0 = 20 kN (20.16 kN exactly); the elastic catenary differs by < 0.5 %
+    assert st.tension[0] == pytest.approx(system.tension_nominal, rel=5e-3)
+    assert st.nodes[5, 2] == pytest.approx(-system.line.sag, rel=1e-2)
+
+
+def test_six_spans_uniform_wind_equilibrium_and_symmetry():
+    system = LineSystem(paper_line(300.0, spans=6))
+    g = float(drag_intensity(40.0, 1.25, 1.0, 0.022))
+    st = solve_static(system, span_loads_uniform(system, g))
+    Lu = system.unstretched_length
+    R = st.reactions
+    # global equilibrium: the towers carry all the load
+    assert R[:, 0].sum() == pytest.approx(0.0, abs=1e-6)
+    assert R[:, 1].sum() == pytest.approx(6 * g * Lu, rel=1e-12)
+    assert R[:, 2].sum() == pytest.approx(6 * 17.92 * Lu, rel=1e-12)
+    # symmetry: R_x at the middle tower vanishes to round-off; mirror towers agree
+    assert abs(R[3, 0]) < 1e-6 * abs(R[0, 0])
+    np.testing.assert_allclose(R[::-1] * [-1, 1, 1], R, rtol=1e-8, atol=1e-6)
+    # insulators swing with the load: d_y = v R_y / R_res (paper Eq. 4)
+    d = st.displacement
+    np.testing.assert_allclose(d[1:-1, 1], 4.0 * R[1:-1, 1] / st.insulator_force[1:-1], rtol=1e-6)
+    assert st.residual < 1e-3
+
+
+def test_absurd_load_raises_convergence_error_naming_the_state():
+    system = LineSystem(paper_line(300.0))
+    with pytest.raises(ConvergenceError, match=r"bad state.*strain.*out-of-balance"):
+        solve_static(system, span_loads_uniform(system, 1e6), label="bad state")
+
+
+def test_iteration_limit_raises_with_residual():
+    system = LineSystem(paper_line(300.0, spans=6))
+    gy = span_loads_uniform(system, np.array([400.0, 400, 400, 0, 0, 0]))
+    with pytest.raises(ConvergenceError, match=r"state X.*did not converge in 2 iterations.*out-of-balance force"):
+        solve_static(system, gy, max_iter=2, label="state X")

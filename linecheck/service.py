@@ -16,6 +16,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from .core.case import Case
+from .core.damping import aerodynamic_damping
+from .core.dynamics import integrate
+from .core.errors import Cancelled
+from .core.model import build_model, reaction_matrix_direct
+from .core.results import Statistics, compute_statistics
 from .core.static import MeanStates, drag_intensity, solve_mean_states
 from .core.system import LineSystem
 from .core.wind.mean import MeanWind, mean_wind
@@ -62,3 +67,185 @@ def static_analysis(
     cb = None if progress is None else (lambda d, n: progress("step 1: mean states", d, n))
     mean = solve_mean_states(system, wind.time, gy, progress=cb, cancel=cancel)
     return StaticResult(case, system, wind, mean)
+
+
+def to_global_nodes(system: LineSystem, span_local: np.ndarray) -> np.ndarray:
+    """Span-local node values (..., n_spans, ne+1) to global nodes (..., n_nodes).
+
+    A tower node shared by two spans takes the mean of both sides.
+    """
+    ne = system.ne
+    head = span_local[..., :, :-1].reshape(span_local.shape[:-2] + (-1,))
+    out = np.concatenate([head, span_local[..., -1:, -1]], axis=-1)
+    if system.n_spans > 1:
+        out[..., system.tower_nodes[1:-1]] = 0.5 * (span_local[..., :-1, -1] + span_local[..., 1:, 0])
+    return out
+
+
+def record_time(case: Case) -> np.ndarray:
+    """Time grid of steps 2-3 [s], shape (n_steps,): synoptic 0..duration, downburst the event window."""
+    dt = case.analysis.time_step
+    if case.wind.type == "synoptic":
+        t0, t1 = 0.0, case.analysis.duration if case.analysis.duration is not None else 600.0
+    else:
+        from .core.wind.mean import event_window
+
+        t0, t1 = event_window(case)
+    n = int(round((t1 - t0) / dt)) + 1
+    return t0 + dt * np.arange(n)
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """Steps 1-3 of a case and the statistics of Eqs 15-17.
+
+    Attributes:
+        case, system, static: the case and its step-1 result.
+        realizations: realization indices run (seeds spawned per index), shape (n_real,).
+        time: [s] record time grid, shape (n_steps,).
+        mean: [N] wind-induced mean reaction M(t) at every tower, shape (n_steps, n_towers, 3).
+        background, resonant: [N] B(t), R(t) at the tower of interest, shape (n_real, n_steps, 3).
+        stats: statistics per realization at every tower (:class:`Statistics`).
+    """
+
+    case: Case
+    system: LineSystem
+    static: StaticResult
+    realizations: np.ndarray
+    time: np.ndarray
+    mean: np.ndarray
+    background: np.ndarray
+    resonant: np.ndarray
+    stats: Statistics
+
+    @property
+    def tower_index(self) -> int:
+        """0-based index of the tower of interest."""
+        return self.case.line.tower_of_interest - 1
+
+    @property
+    def still_air(self) -> np.ndarray:
+        """[N] still-air reactions at every tower, shape (n_towers, 3)."""
+        return self.static.mean.still_air.reactions
+
+
+def _state_of_step(mean_times: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Nearest mean state at each step and the interpolation weight toward the next one."""
+    if mean_times.size == 1:
+        return np.zeros(t.size, dtype=int), np.zeros(t.size)
+    k = np.clip(np.searchsorted(mean_times, t, side="right") - 1, 0, mean_times.size - 2)
+    w = np.clip((t - mean_times[k]) / (mean_times[k + 1] - mean_times[k]), 0.0, 1.0)
+    nearest = np.where(w > 0.5, k + 1, k)
+    return nearest, w
+
+
+def run_case(
+    case: Case,
+    *,
+    realizations: list[int] | np.ndarray | None = None,
+    interpolate_states: bool = False,
+    progress: Progress | None = None,
+    cancel: threading.Event | None = None,
+) -> RunResult:
+    """Steps 1-3 of the method for ``case`` and the statistics of Eqs 15-17.
+
+    Args:
+        realizations: which realizations to run (default all ``analysis.realizations``);
+            realization r always gets the same turbulence, whatever else is run with it.
+        interpolate_states: interpolate K(t), C(t) between mean states at every step
+            (reference scheme) instead of holding the nearest state.
+        progress: ``progress(stage, done, total)``.
+        cancel: a :class:`threading.Event`; when set the run stops with ``Cancelled``.
+    """
+    from .core.wind.turbulence import fluctuating_velocity
+
+    real = np.arange(case.analysis.realizations) if realizations is None else np.asarray(realizations, dtype=int)
+    st = static_analysis(case, progress=progress, cancel=cancel)
+    system, mean = st.system, st.mean
+    t = record_time(case)
+    dt = case.analysis.time_step
+    line, wind = case.line, case.wind
+
+    def check_cancel() -> None:
+        if cancel is not None and cancel.is_set():
+            raise Cancelled("run cancelled")
+
+    # ---- linear models at the mean states (paper Eqs 7-9, 13)
+    models = [build_model(system, mean.state(k)) for k in range(mean.time.size)]
+    vn_states = to_global_nodes(system, st.wind.normal)  # (n_k, n_nodes)
+    damping = np.stack([aerodynamic_damping(case, models[k], vn_states[k]) for k in range(len(models))])
+    state_of_step, weights = _state_of_step(mean.time, t)
+    check_cancel()
+
+    # ---- fluctuating load F_w = rho C_d D L_e V_m v (paper Eq. 5), normal components
+    if progress is not None:
+        progress("wind", 0, 1)
+    mw = mean_wind(case, system, t) if wind.type == "downburst" else None
+    if mw is None:
+        vn = np.broadcast_to(vn_states[0], (t.size, system.n_nodes))
+        cos_n = np.ones_like(vn)
+    else:
+        vn = to_global_nodes(system, mw.normal)
+        vl = to_global_nodes(system, mw.longitudinal)
+        speed = np.hypot(vn, vl)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            cos_n = np.where(speed > 0, np.abs(vn) / np.where(speed > 0, speed, 1.0), 1.0)
+    v = fluctuating_velocity(case, system, t, list(real))  # (n_real, n_steps, n_nodes), along-wind
+    if progress is not None:
+        progress("wind", 1, 1)
+    check_cancel()
+    coef = wind.air_density * line.drag_coefficient * line.diameter
+    # normal component of the fluctuation: v cos(phi), phi the angle of the mean wind to the normal
+    f_nodes = coef * models[0].tributary[None, None, :] * (vn * cos_n)[None] * v  # (n_real, n_steps, n_nodes)
+    free = models[0].dofs.free_nodes
+    loads = np.ascontiguousarray(np.moveaxis(f_nodes[:, :, free], 0, -1))  # (n_steps, n_free, n_real)
+    D = reaction_matrix_direct(system)
+    # loads at pinned nodes go straight into their supports: (n_steps, n_towers*3, n_real)
+    direct = np.einsum("rn,snk->srk", D, np.moveaxis(f_nodes, 0, -1))
+    del f_nodes, v
+
+    cb = None if progress is None else (lambda d, n: progress("steps 2-3: dynamics", d, n))
+    resp = integrate(models, damping, state_of_step, loads, dt, direct=direct,
+                     weights=weights if interpolate_states else None, progress=cb, cancel=cancel)
+
+    # ---- mean M(t): step-1 reactions interpolated to the record grid (wind-induced)
+    rw = mean.reactions_wind  # (n_k, n_towers, 3)
+    if mean.time.size == 1:
+        M = np.broadcast_to(rw[0], (t.size,) + rw.shape[1:]).copy()
+    else:
+        flat = rw.reshape(rw.shape[0], -1)
+        M = np.stack([np.interp(t, mean.time, flat[:, i]) for i in range(flat.shape[1])], axis=1).reshape(
+            (t.size,) + rw.shape[1:])
+    stats = compute_statistics(M, resp.background, resp.resonant, mean.still_air.reactions, case.g_yp_L)
+    j = case.line.tower_of_interest - 1
+    return RunResult(
+        case=case, system=system, static=st, realizations=real, time=t, mean=M,
+        background=resp.background[:, :, j, :].copy(), resonant=resp.resonant[:, :, j, :].copy(), stats=stats,
+    )
+
+
+@dataclass(frozen=True)
+class ModesResult:
+    """Natural modes of the still-air state and of the mean state.
+
+    ``mean_time`` [s] is the instant of the mean state used: synoptic 0; downburst the
+    step-1 instant of the largest wind-induced mean reaction at the tower of interest.
+    """
+
+    case: Case
+    still_air: "Modes"
+    mean: "Modes"
+    mean_time: float
+
+
+def modes_analysis(case: Case, *, n_modes: int = 20) -> ModesResult:
+    """Natural frequencies and mode shapes of the still-air and the mean state."""
+    from .core.modes import natural_modes
+
+    st = static_analysis(case)
+    system, mean = st.system, st.mean
+    j = case.line.tower_of_interest - 1
+    k = int(np.argmax(np.abs(mean.reactions_wind[:, j, :]).max(axis=1)))
+    still = natural_modes(build_model(system, mean.still_air), n_modes)
+    at_mean = natural_modes(build_model(system, mean.state(k)), n_modes)
+    return ModesResult(case, still, at_mean, float(mean.time[k]))

@@ -1,0 +1,193 @@
+"""Linearised finite-element model about a step-1 mean state (paper section 4, Step 2).
+
+Degrees of freedom: 3 translations (x, y, z) per global FE node, node-major, with
+the nodes at strain towers removed (pinned).  Element matrices:
+
+- cable element (paper Eq. 7): in local axes diag(EA, T, T)/L_e, i.e. in global axes
+  k = (EA/L_e) e e^T + (T/L_e) (I - e e^T), e the unit chord of the deformed element;
+- insulator (issue 4): from the fixed point to the attachment node, axially stiff
+  (penalty EA_ins/v, see :data:`INSULATOR_AXIAL_FACTOR`) and with the geometric
+  stiffness R_res/v transversely;
+- lumped mass (paper Eq. 8): m = W L_u / (ne g) per element, half to each node;
+- aerodynamic damping (paper Eqs 9-13): c_i = rho C_d D L_i |V_i| on the y DOF of
+  node i (L_i its tributary conductor length, V_i the local running-mean normal speed).
+
+Reactions on tower j (force of the conductor system on its fixed point, R_z
+downward) are linear in the free displacements u and in the loads applied
+directly at pinned nodes: R = G u + D f_pinned.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from .case import GRAVITY
+from .static import StaticState
+from .system import LineSystem
+
+# Axial stiffness of an insulator relative to the axial stiffness EA/L_e of one cable
+# element.  Large enough that its stretch is negligible (< 0.1 % of the transverse
+# response), small enough to keep K well conditioned; the mode it creates is far
+# above the wind band (hundreds of Hz) and average-acceleration Newmark is
+# unconditionally stable, so it costs nothing.
+INSULATOR_AXIAL_FACTOR = 1.0e3
+
+
+@dataclass(frozen=True)
+class DofMap:
+    """Map between global FE nodes and free DOFs.
+
+    Attributes:
+        free_nodes: indices of the nodes that carry DOFs, shape (n_free_nodes,).
+        node_dof: first DOF of every node (-1 for pinned nodes), shape (n_nodes,).
+        n_dof: number of free DOFs (3 * n_free_nodes).
+    """
+
+    free_nodes: np.ndarray
+    node_dof: np.ndarray
+    n_dof: int
+
+
+def dof_map(system: LineSystem) -> DofMap:
+    pinned = np.zeros(system.n_nodes, dtype=bool)
+    pinned[system.tower_nodes[~system.suspension]] = True
+    free = np.flatnonzero(~pinned)
+    node_dof = np.full(system.n_nodes, -1)
+    node_dof[free] = 3 * np.arange(free.size)
+    return DofMap(free, node_dof, 3 * free.size)
+
+
+@dataclass(frozen=True)
+class LinearModel:
+    """Stiffness (banded), mass and damping of the linearised system at one mean state.
+
+    Attributes:
+        system: the line section.
+        dofs: the DOF map.
+        K_band: [N/m] symmetric stiffness in LAPACK upper banded storage, shape (6, n_dof)
+            (half-bandwidth 5, node-major ordering).
+        mass: [kg] lumped mass per DOF, shape (n_dof,).
+        tributary: [m] tributary unstretched conductor length of every global node, (n_nodes,).
+        G: [N/m] reactions from free displacements, shape (n_towers * 3, n_dof); row 3j+c is
+            component c (x, y, z-down) of tower j.
+    """
+
+    system: LineSystem
+    dofs: DofMap
+    K_band: np.ndarray
+    mass: np.ndarray
+    tributary: np.ndarray
+    G: np.ndarray
+
+    @cached_property
+    def K_dense(self) -> np.ndarray:
+        """Dense stiffness [N/m], shape (n_dof, n_dof) (modes, tests, baselines)."""
+        return band_to_dense(self.K_band)
+
+
+BANDWIDTH = 5  # half-bandwidth with node-major DOFs and two-node elements
+
+
+def band_to_dense(ab: np.ndarray) -> np.ndarray:
+    """Upper banded storage (LAPACK 'U', ab[u + i - j, j] = A[i, j]) to a dense symmetric matrix."""
+    u, n = ab.shape[0] - 1, ab.shape[1]
+    A = np.zeros((n, n))
+    for k in range(u + 1):
+        d = ab[u - k, k:]
+        idx = np.arange(n - k)
+        A[idx, idx + k] = d
+        A[idx + k, idx] = d
+    return A
+
+
+def _cable_blocks(nodes: np.ndarray, tension: np.ndarray, ea: float) -> np.ndarray:
+    """3x3 element stiffness blocks k = EA/L e e^T + T/L (I - e e^T) (paper Eq. 7), shape (n_el, 3, 3)."""
+    seg = np.diff(nodes, axis=0)
+    Le = np.linalg.norm(seg, axis=1)
+    e = seg / Le[:, None]
+    eet = e[:, :, None] * e[:, None, :]
+    eye = np.eye(3)[None]
+    return (ea / Le)[:, None, None] * eet + (tension / Le)[:, None, None] * (eye - eet)
+
+
+def build_model(system: LineSystem, state: StaticState) -> LinearModel:
+    """Assemble K, M and the reaction map about the mean state ``state`` (paper Eqs 7-8)."""
+    line = system.line
+    dm = dof_map(system)
+    n_dof = dm.n_dof
+    kb = _cable_blocks(state.nodes, state.element_tension, line.ea)  # (n_el, 3, 3)
+    n_el = kb.shape[0]
+    ab = np.zeros((BANDWIDTH + 1, n_dof))
+    u = BANDWIDTH
+
+    def add_block(r0: int, c0: int, blk: np.ndarray) -> None:
+        # add a 3x3 block at (r0, c0) (r0 <= c0 for the upper triangle; diagonal blocks symmetric)
+        for a in range(3):
+            for b in range(3):
+                i, j = r0 + a, c0 + b
+                if i <= j:
+                    ab[u + i - j, j] += blk[a, b]
+
+    nd = dm.node_dof
+    for e in range(n_el):
+        i, j = nd[e], nd[e + 1]
+        if i >= 0:
+            add_block(i, i, kb[e])
+        if j >= 0:
+            add_block(j, j, kb[e])
+        if i >= 0 and j >= 0:
+            add_block(i, j, -kb[e])
+
+    # insulators (issue 4): axially stiff, geometric stiffness R_res/v transversely
+    v = line.insulator_length
+    ea_cable_el = line.ea / (system.unstretched_length / system.ne)
+    k_ax = INSULATOR_AXIAL_FACTOR * ea_cable_el
+    ins_blocks = {}
+    for j in np.flatnonzero(system.suspension):
+        d = state.displacement[j]
+        axis = np.array([d[0], d[1], d[2] - v]) / v  # from fixed point to attachment (points down)
+        axis /= np.linalg.norm(axis)
+        P = np.outer(axis, axis)
+        blk = k_ax * P + (state.insulator_force[j] / v) * (np.eye(3) - P)
+        ins_blocks[j] = blk
+        r = nd[system.tower_nodes[j]]
+        add_block(r, r, blk)
+
+    # lumped mass (paper Eq. 8) by tributary unstretched length
+    Le_u = system.unstretched_length / system.ne
+    trib = np.zeros(system.n_nodes)
+    trib[:-1] += 0.5 * Le_u
+    trib[1:] += 0.5 * Le_u
+    m_node = line.weight * trib / GRAVITY
+    mass = np.repeat(m_node[dm.free_nodes], 3)
+
+    # reaction map: force of the system on tower j's fixed point
+    G = np.zeros((3 * system.n_towers, n_dof))
+    flip = np.array([1.0, 1.0, -1.0])  # R_z is positive downward
+    for j in range(system.n_towers):
+        node = system.tower_nodes[j]
+        if system.suspension[j]:
+            # insulator: force on the fixed point = k_ins u_node
+            r = nd[node]
+            G[3 * j:3 * j + 3, r:r + 3] = flip[:, None] * ins_blocks[j]
+        else:
+            # pinned node: force on the support = -(K_rf u) from the adjacent cable elements
+            for e, other in ((node - 1, node - 1), (node, node + 1)):
+                if 0 <= e < n_el and nd[other] >= 0:
+                    c = nd[other]
+                    G[3 * j:3 * j + 3, c:c + 3] += flip[:, None] * kb[e]
+    return LinearModel(system, dm, ab, mass, trib, G)
+
+
+def reaction_matrix_direct(system: LineSystem) -> np.ndarray:
+    """D: reactions from nodal y-loads applied at pinned nodes, shape (n_towers*3, n_nodes).
+
+    A load applied directly at a pinned node goes straight into its support.
+    """
+    D = np.zeros((3 * system.n_towers, system.n_nodes))
+    for j in np.flatnonzero(~system.suspension):
+        D[3 * j + 1, system.tower_nodes[j]] = 1.0
+    return D

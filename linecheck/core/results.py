@@ -1,0 +1,154 @@
+"""Response statistics, gust factors and contributions (paper Eqs 15-17).
+
+Every statistic is computed per realization on the wind-induced response
+(total minus still air) and kept as an array of shape (n_real, n_towers, 3),
+last axis (R_x, R_y, R_z); :meth:`Statistics.mean` / :meth:`Statistics.std`
+summarise over realizations.  Definitions (issue 4):
+
+- mean_max = max_t |M(t)|  (M: step-1 mean reaction, wind-induced)
+- rms_background = sqrt(mean_t B^2), rms_resonant = sqrt(mean_t R^2),
+  rms_fluctuating = sqrt(mean_t (B + R)^2)
+- peak_quasi_static = max_t |M + B|, peak_dynamic = max_t |M + B + R|
+  (``*_total``: the same with the still-air reaction added)
+- GF_Dy = peak_dynamic / mean_max, GF_QS = peak_quasi_static / mean_max (Eq. 15)
+- Cont_M = 1/GF_Dy, Cont_BG = (GF_QS - 1)/GF_Dy, Cont_R = (GF_Dy - GF_QS)/GF_Dy (Eq. 16),
+  written as mean_max/peak, (peak_QS - mean_max)/peak, (peak - peak_QS)/peak so that
+  they stay defined when the mean vanishes by symmetry (the paper's "**" rows of
+  Table 5 still report Cont_R);
+- peak_normalised = peak_dynamic / (g*_yp L_x), g*_yp = 1/2 rho C_d V_ref^2 D (Eq. 17).
+
+A reaction whose mean is zero by symmetry, or negligible (mean_max below
+:data:`ZERO_MEAN_RTOL` = 1 % of the largest wind-induced mean reaction component
+of the case), has GF_Dy = GF_QS = NaN (JSON null): a peak divided by a vanishing
+mean carries no design meaning (the paper's "**" entries of Table 5).  Its peaks
+and Cont_* are still reported.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+REACTIONS = ("Rx", "Ry", "Rz")
+STATISTICS = (
+    "mean_max",
+    "rms_background",
+    "rms_resonant",
+    "rms_fluctuating",
+    "peak_quasi_static",
+    "peak_dynamic",
+    "peak_quasi_static_total",
+    "peak_dynamic_total",
+    "GF_Dy",
+    "GF_QS",
+    "Cont_M",
+    "Cont_BG",
+    "Cont_R",
+    "peak_normalised",
+    "peak_normalised_total",
+)
+ZERO_MEAN_RTOL = 0.01
+
+
+@dataclass(frozen=True)
+class Statistics:
+    """Per-realization statistics; every field has shape (n_real, n_towers, 3).
+
+    Forces in [N]; GF and Cont are ratios (Cont as fractions, 0.042 = 4.2 %).
+    """
+
+    mean_max: np.ndarray
+    rms_background: np.ndarray
+    rms_resonant: np.ndarray
+    rms_fluctuating: np.ndarray
+    peak_quasi_static: np.ndarray
+    peak_dynamic: np.ndarray
+    peak_quasi_static_total: np.ndarray
+    peak_dynamic_total: np.ndarray
+    GF_Dy: np.ndarray
+    GF_QS: np.ndarray
+    Cont_M: np.ndarray
+    Cont_BG: np.ndarray
+    Cont_R: np.ndarray
+    peak_normalised: np.ndarray
+    peak_normalised_total: np.ndarray
+
+    def values(self, name: str) -> np.ndarray:
+        """The per-realization array of statistic ``name`` (one of :data:`STATISTICS`)."""
+        if name not in STATISTICS:
+            raise KeyError(name)
+        return getattr(self, name)
+
+    def mean(self, name: str) -> np.ndarray:
+        """Mean over realizations, shape (n_towers, 3); NaN where undefined."""
+        return self.values(name).mean(axis=0)
+
+    def std(self, name: str) -> np.ndarray:
+        """Sample standard deviation over realizations (ddof=1; 0 for one realization)."""
+        v = self.values(name)
+        if v.shape[0] < 2:
+            return np.zeros(v.shape[1:])
+        return v.std(axis=0, ddof=1)
+
+    @staticmethod
+    def concatenate(parts: list[Statistics]) -> Statistics:
+        """Join statistics of disjoint realization sets (batch/distributed runs)."""
+        return Statistics(**{f.name: np.concatenate([getattr(p, f.name) for p in parts]) for f in fields(Statistics)})
+
+
+def compute_statistics(
+    mean: np.ndarray,
+    background: np.ndarray,
+    resonant: np.ndarray,
+    still_air: np.ndarray,
+    g_yp_L: float,
+) -> Statistics:
+    """Statistics of Eqs 15-17 from response histories.
+
+    Args:
+        mean: [N] wind-induced mean reaction M(t), shape (n_t, n_towers, 3).
+        background: [N] B(t), shape (n_real, n_t, n_towers, 3).
+        resonant: [N] R(t) = F - B, same shape.
+        still_air: [N] still-air reactions, shape (n_towers, 3).
+        g_yp_L: [N] normalising force g*_yp L_x (Eq. 17).
+    """
+    M = mean[None]
+    qs = M + background
+    dyn = qs + resonant
+    mean_max = np.broadcast_to(np.abs(mean).max(axis=0), background.shape[:1] + mean.shape[1:]).copy()
+    rms_b = np.sqrt(np.mean(background**2, axis=1))
+    rms_r = np.sqrt(np.mean(resonant**2, axis=1))
+    rms_f = np.sqrt(np.mean((background + resonant) ** 2, axis=1))
+    pk_qs = np.abs(qs).max(axis=1)
+    pk_dy = np.abs(dyn).max(axis=1)
+    sa = still_air[None, None]
+    pk_qs_t = np.abs(qs + sa).max(axis=1)
+    pk_dy_t = np.abs(dyn + sa).max(axis=1)
+    scale = max(float(np.abs(mean).max()), 1e-300)
+    defined = mean_max > ZERO_MEAN_RTOL * scale
+    with np.errstate(divide="ignore", invalid="ignore"):
+        gf_dy = np.where(defined, pk_dy / mean_max, np.nan)
+        gf_qs = np.where(defined, pk_qs / mean_max, np.nan)
+        cont_m = np.where(pk_dy > 0, mean_max / pk_dy, np.nan)
+        cont_bg = np.where(pk_dy > 0, (pk_qs - mean_max) / pk_dy, np.nan)
+        cont_r = np.where(pk_dy > 0, (pk_dy - pk_qs) / pk_dy, np.nan)
+        norm = pk_dy / g_yp_L if g_yp_L > 0 else np.full_like(pk_dy, np.nan)
+        norm_t = pk_dy_t / g_yp_L if g_yp_L > 0 else np.full_like(pk_dy, np.nan)
+    return Statistics(
+        mean_max=mean_max,
+        rms_background=rms_b,
+        rms_resonant=rms_r,
+        rms_fluctuating=rms_f,
+        peak_quasi_static=pk_qs,
+        peak_dynamic=pk_dy,
+        peak_quasi_static_total=pk_qs_t,
+        peak_dynamic_total=pk_dy_t,
+        GF_Dy=gf_dy,
+        GF_QS=gf_qs,
+        Cont_M=cont_m,
+        Cont_BG=cont_bg,
+        Cont_R=cont_r,
+        peak_normalised=norm,
+        peak_normalised_total=norm_t,
+    )

@@ -87,3 +87,99 @@ def static_to_dict(res: StaticResult) -> dict[str, Any]:
 def write_json(path: str | Path, doc: dict[str, Any], *, force: bool = True) -> Path:
     """Write a JSON document atomically."""
     return write_text_atomic(path, json.dumps(doc, indent=2, allow_nan=False) + "\n", force=force, what="JSON")
+
+
+# --------------------------------------------------------------------------- run results
+def decimate_keep_peaks(series: np.ndarray, max_points: int) -> np.ndarray:
+    """Indices of the min and max of each of ``max_points/2`` blocks of ``series`` (n, k)."""
+    n = series.shape[0]
+    if n <= max_points:
+        return np.arange(n)
+    nb = max(1, max_points // 2)
+    edges = np.linspace(0, n, nb + 1).astype(int)
+    keep = [0, n - 1]
+    for a, b in zip(edges[:-1], edges[1:]):
+        if b <= a:
+            continue
+        blk = series[a:b]
+        keep.extend((a + blk.argmin(axis=0)).tolist())
+        keep.extend((a + blk.argmax(axis=0)).tolist())
+    return np.unique(np.array(keep))
+
+
+def case_parameters(case: Any) -> dict[str, Any]:
+    """The case's inputs as a TOML-like document (for sheets and re-runs)."""
+    from ..core.case import case_to_dict
+
+    return case_to_dict(case)
+
+
+def run_to_dict(res: Any, *, full_histories: bool = False, max_points: int = 2000) -> dict[str, Any]:
+    """JSON document of a run (issue 4 contract).
+
+    ``{"case", "wind", "units": "SI", "tower_of_interest", "g_yp_L",
+    "reactions": {"Rx": {stat: {"mean", "std"}}, "Ry": .., "Rz": ..},
+    "towers": [...all towers...], "still_air": {...}, "static": {...},
+    "time_histories": {...}}``.  Forces in N, Cont_* as fractions, GF null where the
+    mean vanishes.  Time histories are those of realization 1 at the tower of
+    interest, thinned to about ``max_points`` samples keeping every block's extremes
+    unless ``full_histories``.
+    """
+    from ..core.results import REACTIONS, STATISTICS
+
+    case, stats = res.case, res.stats
+    j = res.tower_index
+
+    def reaction_block(tower: int) -> dict[str, Any]:
+        out = {}
+        for c, rname in enumerate(REACTIONS):
+            out[rname] = {
+                s: {"mean": _num(stats.mean(s)[tower, c]), "std": _num(stats.std(s)[tower, c])} for s in STATISTICS
+            }
+        return out
+
+    still = res.static.mean.still_air
+    m = res.static.mean
+    doc: dict[str, Any] = {
+        "case": case.name,
+        "description": case.description,
+        "wind": case.wind.type,
+        "units": "SI",
+        "tower_of_interest": case.line.tower_of_interest,
+        "g_yp_L": _num(case.g_yp_L),
+        "v_ref": case.wind.v_ref,
+        "span_length": case.line.span_length,
+        "spans": case.line.spans,
+        "realizations": int(res.realizations.size),
+        "seed": case.analysis.seed,
+        "duration": _num(res.time[-1] - res.time[0]),
+        "time_step": case.analysis.time_step,
+        "reactions": reaction_block(j),
+        "towers": [{"index": k + 1, "support": case.line.supports[k], "reactions": reaction_block(k)}
+                   for k in range(res.system.n_towers)],
+        "still_air": {
+            "reactions": {r: _num(still.reactions[j, c]) for c, r in enumerate(REACTIONS)},
+            "tension": _num(still.tension),
+            "tension_nominal": _num(res.system.tension_nominal),
+            "sag": case.line.sag,
+        },
+        "static": {
+            "time": _num(m.time),
+            "reactions_wind": {r: _num(m.reactions_wind[:, j, c]) for c, r in enumerate(REACTIONS)},
+            "tension": _num(m.tension),
+            "displacement": {k: _num(m.displacement[:, j, c]) for c, k in enumerate(("dx", "dy", "dz"))},
+        },
+        "parameters": case_parameters(case),
+    }
+    M = res.mean[:, j, :]
+    B = res.background[0]
+    R = res.resonant[0]
+    total = M + B + R
+    idx = np.arange(res.time.size) if full_histories else decimate_keep_peaks(np.concatenate([total, M + B], axis=1), max_points)
+    doc["time_histories"] = {
+        "realization": int(res.realizations[0]) + 1,
+        "decimated": bool(idx.size < res.time.size),
+        "time": _num(res.time[idx]),
+        **{r: {"M": _num(M[idx, c]), "B": _num(B[idx, c]), "R": _num(R[idx, c])} for c, r in enumerate(REACTIONS)},
+    }
+    return doc

@@ -1,0 +1,129 @@
+"""`run` and `modes` commands."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from .. import service
+from ..core.case import Case
+from ..core.errors import CaseError
+from ..core.results import REACTIONS
+from ..io.atomic import check_target
+from ..io.jsonout import _num, run_to_dict, write_json
+from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
+from .progress import progress_bar
+
+RealOpt = Annotated[int | None, typer.Option("--realizations", "-n", help="Number of realizations (overrides the case).", min=1)]
+SeedOpt = Annotated[int | None, typer.Option("--seed", help="Random seed (overrides the case).", min=0)]
+
+
+def override(case: Case, realizations: int | None, seed: int | None) -> Case:
+    """The case with CLI overrides of [analysis] applied."""
+    changes = {}
+    if realizations is not None:
+        changes["realizations"] = realizations
+    if seed is not None:
+        changes["seed"] = seed
+    if not changes:
+        return case
+    return dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, **changes))
+
+
+def _pm(stat: dict, scale: float = 1.0, fmt: str = "{:.3f}", n: int = 1) -> str:
+    m, s = stat["mean"], stat["std"]
+    if m is None:
+        return "**"
+    text = fmt.format(m * scale)
+    if n > 1 and s is not None:
+        text += " ± " + fmt.format(s * scale)
+    return text
+
+
+def results_table(doc: dict) -> Table:
+    """Rich table of the statistics at the tower of interest (kN, %)."""
+    n = doc["realizations"]
+    t = Table(title=f"{doc['case']}: reactions at tower {doc['tower_of_interest']} "
+                    f"({doc['wind']}, V_ref = {doc['v_ref']:g} m/s, {n} realization{'s' if n > 1 else ''})",
+              title_justify="left")
+    cols = [("reaction", None, None), ("mean max kN", "mean_max", 1e-3), ("rms B kN", "rms_background", 1e-3),
+            ("rms R kN", "rms_resonant", 1e-3), ("peak QS kN", "peak_quasi_static", 1e-3),
+            ("peak Dy kN", "peak_dynamic", 1e-3), ("GF_Dy", "GF_Dy", 1.0), ("GF_QS", "GF_QS", 1.0),
+            ("Cont_M %", "Cont_M", 100.0), ("Cont_BG %", "Cont_BG", 100.0), ("Cont_R %", "Cont_R", 100.0),
+            ("peak/g*L", "peak_normalised", 1.0)]
+    for name, _, _ in cols:
+        t.add_column(name, justify="right")
+    for r in REACTIONS:
+        block = doc["reactions"][r]
+        row = [r]
+        for _, key, scale in cols[1:]:
+            fmt = "{:.1f}" if key.startswith("Cont") else "{:.3f}"
+            row.append(_pm(block[key], scale, fmt, n))
+        t.add_row(*row)
+    return t
+
+
+@app.command()
+@handle_errors
+def run(
+    case_file: CaseArg,
+    json_out: JsonOpt = None,
+    realizations: RealOpt = None,
+    seed: SeedOpt = None,
+    full_histories: Annotated[bool, typer.Option("--full-histories", help="Keep full-resolution time histories in the outputs.")] = False,
+) -> None:
+    """Steps 1-3: mean, background and resonant reactions, gust factors and contributions."""
+    case = override(read_case(case_file), realizations, seed)
+    if json_out is not None:
+        check_target(json_out, what="JSON")
+    with progress_bar() as cb:
+        res = service.run_case(case, progress=cb)
+    doc = run_to_dict(res, full_histories=full_histories)
+    console.print(results_table(doc))
+    console.print("[dim]GF ** : mean reaction zero by symmetry (or < 1 % of the largest mean); "
+                  "Cont_R = share of the peak that a quasi-static analysis misses.[/]")
+    if json_out is not None:
+        write_json(json_out, doc)
+        console.print(f"wrote {json_out}")
+
+
+@app.command()
+@handle_errors
+def modes(
+    case_file: CaseArg,
+    json_out: JsonOpt = None,
+    count: Annotated[int, typer.Option("--count", help="Number of modes.", min=1, max=500)] = 20,
+    shapes: Annotated[bool, typer.Option("--shapes", help="Include mode shapes in the JSON.")] = False,
+) -> None:
+    """Natural frequencies (and mode shapes) of the still-air and mean states."""
+    case = read_case(case_file)
+    if json_out is not None:
+        check_target(json_out, what="JSON")
+    res = service.modes_analysis(case, n_modes=count)
+    t = Table(title=f"{case.name}: natural frequencies (Hz)", title_justify="left")
+    for c in ("mode", "still air", "direction", "mean state", "direction"):
+        t.add_column(c, justify="right")
+    dirs = "xyz"
+    ds, dm = res.still_air.dominant_direction(), res.mean.dominant_direction()
+    for i in range(res.still_air.frequencies_hz.size):
+        t.add_row(str(i + 1), f"{res.still_air.frequencies_hz[i]:.4f}", dirs[ds[i]],
+                  f"{res.mean.frequencies_hz[i]:.4f}", dirs[dm[i]])
+    console.print(t)
+    if case.wind.type == "downburst":
+        console.print(f"[dim]mean state at t = {res.mean_time:.1f} s (largest mean reaction at the tower of interest)[/]")
+    if json_out is not None:
+        doc = {"case": case.name, "units": "SI",
+               "still_air": {"frequencies_hz": _num(res.still_air.frequencies_hz),
+                             "direction": [dirs[i] for i in ds]},
+               "mean": {"frequencies_hz": _num(res.mean.frequencies_hz), "direction": [dirs[i] for i in dm],
+                        "time": res.mean_time}}
+        if shapes:
+            doc["still_air"]["shapes"] = _num(res.still_air.shapes)
+            doc["mean"]["shapes"] = _num(res.mean.shapes)
+        write_json(json_out, doc)
+        console.print(f"wrote {json_out}")

@@ -106,6 +106,7 @@ class RunResult:
         mean: [N] wind-induced mean reaction M(t) at every tower, shape (n_steps, n_towers, 3).
         background, resonant: [N] B(t), R(t) at the tower of interest, shape (n_real, n_steps, 3).
         stats: statistics per realization at every tower (:class:`Statistics`).
+        spectral: frequency-domain check (synoptic cases; None for downbursts).
     """
 
     case: Case
@@ -117,6 +118,7 @@ class RunResult:
     background: np.ndarray
     resonant: np.ndarray
     stats: Statistics
+    spectral: "SpectralResult | None" = None
 
     @property
     def tower_index(self) -> int:
@@ -218,9 +220,11 @@ def run_case(
             (t.size,) + rw.shape[1:])
     stats = compute_statistics(M, resp.background, resp.resonant, mean.still_air.reactions, case.g_yp_L)
     j = case.line.tower_of_interest - 1
+    spectral = spectral_analysis(case, static=st) if wind.type == "synoptic" else None
     return RunResult(
         case=case, system=system, static=st, realizations=real, time=t, mean=M,
         background=resp.background[:, :, j, :].copy(), resonant=resp.resonant[:, :, j, :].copy(), stats=stats,
+        spectral=spectral,
     )
 
 
@@ -249,3 +253,150 @@ def modes_analysis(case: Case, *, n_modes: int = 20) -> ModesResult:
     still = natural_modes(build_model(system, mean.still_air), n_modes)
     at_mean = natural_modes(build_model(system, mean.state(k)), n_modes)
     return ModesResult(case, still, at_mean, float(mean.time[k]))
+
+
+@dataclass(frozen=True)
+class WindAtP:
+    """Wind at the FE node nearest point p (paper Fig. 3).
+
+    Attributes:
+        time: [s] shape (n_steps,); mean: [m/s] running-mean speed (magnitude);
+        total: [m/s] mean + turbulence of ``realization``; x: [m] abscissa of the node used.
+    """
+
+    case: Case
+    time: np.ndarray
+    mean: np.ndarray
+    total: np.ndarray
+    x: float
+    realization: int
+
+
+def wind_at_p(case: Case, *, realization: int = 0) -> WindAtP:
+    """Running-mean and total wind speed at point p over the record (paper Fig. 3)."""
+    from .core.wind.turbulence import fluctuating_velocity
+
+    system = LineSystem(case.line)
+    t = record_time(case)
+    mw = mean_wind(case, system, t if case.wind.type == "downburst" else None)
+    node = int(np.argmin(np.abs(system.node_x0 - mw.point_p)))
+    vn = to_global_nodes(system, mw.normal)
+    vl = to_global_nodes(system, mw.longitudinal)
+    speed = np.hypot(vn, vl)[:, node]
+    speed = np.broadcast_to(speed, t.shape).copy()
+    v = fluctuating_velocity(case, system, t, [realization])[0, :, node]
+    return WindAtP(case, t, speed, speed + v, float(system.node_x0[node]), realization)
+
+
+@dataclass(frozen=True)
+class SpectralResult:
+    """Frequency-domain check of a synoptic case (issue 5).
+
+    ``exact``: estimate 1 (linear random vibration of the step-1 model), reactions
+    (R_x, R_y, R_z) at the tower of interest; ``davenport``: estimate 2 for the
+    transverse reaction (closed form) and whether it is within 15 % of estimate 1.
+    """
+
+    case: Case
+    exact: "SpectralEstimate"
+    davenport: "DavenportEstimate"
+    davenport_applicable: bool
+    davenport_note: str
+
+
+DAVENPORT_TOLERANCE = 0.15  # issue 5: estimate 2 shown only where within 15 % of estimate 1
+
+
+def spectral_analysis(case: Case, *, static: StaticResult | None = None) -> SpectralResult:
+    """Frequency-domain estimates for a synoptic case (same model and damping as the time domain)."""
+    from .core.errors import CaseError
+    from .core.spectral import davenport_gust_factor, random_vibration
+    from .core.wind.turbulence import length_scale
+
+    if case.wind.type != "synoptic":
+        raise CaseError("the frequency-domain check is for synoptic cases only (a downburst is non-stationary)",
+                        file=str(case.source) if case.source else None, key="wind.type")
+    st = static if static is not None else static_analysis(case)
+    system, mean = st.system, st.mean
+    model = build_model(system, mean.state(0))
+    vn = to_global_nodes(system, st.wind.normal)[0]
+    damping = aerodynamic_damping(case, model, vn)
+    line, wind = case.line, case.wind
+    a = wind.air_density * line.drag_coefficient * line.diameter * model.tributary * vn  # Eq. 5 per unit v
+    t = record_time(case)
+    j = case.line.tower_of_interest - 1
+    mean_r = mean.reactions_wind[0, j]
+    from .core.results import ZERO_MEAN_RTOL
+
+    tol = ZERO_MEAN_RTOL * float(np.abs(mean.reactions_wind[0]).max())
+    L_u = length_scale(case)
+    exact = random_vibration(
+        model, damping, a, mean_r, j, sigma=wind.turbulence_intensity * wind.v_ref, length_scale=L_u,
+        v_mean=wind.v_ref, coherence_decay=wind.coherence_decay, duration=float(t[-1] - t[0]),
+        band=(1e-5, 0.5 / case.analysis.time_step), zero_mean_tol=tol,
+    )
+    H = float(mean.tension[0].mean())
+    mu = line.mass_per_length
+    f1 = np.sqrt(H / mu) / (2 * line.span_length)  # taut-string fundamental (Irvine 1981 Eq. 3.21)
+    dav = davenport_gust_factor(
+        span=line.span_length, v_mean=wind.v_ref, intensity=wind.turbulence_intensity, length_scale=L_u,
+        coherence_decay=wind.coherence_decay, f1=f1, mass_per_length=mu, air_density=wind.air_density,
+        drag_coefficient=line.drag_coefficient, diameter=line.diameter, duration=float(t[-1] - t[0]),
+        height=line.height,
+    )
+    ref = exact.GF_Dy[1]
+    if not np.isfinite(ref):
+        ok, note = False, "transverse mean is zero: no gust factor to compare"
+    else:
+        diff = abs(dav.GF_Dy - ref) / ref
+        ok = diff <= DAVENPORT_TOLERANCE
+        note = (f"within {100 * diff:.0f} % of the exact estimate" if ok else
+                f"differs by {100 * diff:.0f} % from the exact estimate (> 15 %): the closed form's uniform "
+                "influence line and single mode do not represent this system; use estimate 1")
+    return SpectralResult(case, exact, dav, ok, note)
+
+
+@dataclass(frozen=True)
+class SanityItem:
+    """One time- vs frequency-domain comparison (issue 5 "sanity check")."""
+
+    reaction: str
+    quantity: str
+    time_domain: float
+    time_domain_std: float
+    frequency_domain: float
+    allowed: float
+    ok: bool
+
+
+SANITY_QUANTITIES = ("rms_background", "rms_fluctuating")
+NUMERICAL_TOLERANCE = 0.03  # frequency-grid and estimator bias allowance, relative
+
+
+def sanity_check(res: RunResult) -> list[SanityItem]:
+    """Compare the time-domain r.m.s. with estimate 1 at the tower of interest.
+
+    A difference is flagged when it exceeds what sampling explains: three standard
+    errors of the realization mean (std / sqrt(N)) plus a 3 % numerical allowance.
+    Components whose r.m.s. is below 1 % of the largest are skipped.
+    """
+    if res.spectral is None:
+        return []
+    from .core.results import REACTIONS
+
+    j = res.tower_index
+    n = res.realizations.size
+    ex = res.spectral.exact
+    items = []
+    scale = float(np.max(ex.rms_fluctuating))
+    for q in SANITY_QUANTITIES:
+        td = res.stats.mean(q)[j]
+        sd = res.stats.std(q)[j]
+        fd = getattr(ex, q)
+        for c, r in enumerate(REACTIONS):
+            if fd[c] < 0.01 * scale:
+                continue
+            allowed = 3.0 * sd[c] / np.sqrt(max(n, 1)) + NUMERICAL_TOLERANCE * fd[c]
+            items.append(SanityItem(r, q, float(td[c]), float(sd[c]), float(fd[c]), float(allowed),
+                                    bool(abs(td[c] - fd[c]) <= allowed)))
+    return items

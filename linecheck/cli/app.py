@@ -27,8 +27,9 @@ app = typer.Typer(
     add_completion=False,
 )
 
-console = Console()
-err_console = Console(stderr=True)
+# Piped output (CI, files) gets a wide console so result tables are not truncated.
+console = Console(width=None if sys.stdout.isatty() else 160)
+err_console = Console(stderr=True, width=None if sys.stderr.isatty() else 160)
 
 CaseArg = Annotated[Path, typer.Argument(help="Case file (TOML).", show_default=False)]
 CasesArg = Annotated[list[Path], typer.Argument(help="Case files (TOML).", show_default=False)]

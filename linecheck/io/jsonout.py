@@ -171,6 +171,16 @@ def run_to_dict(res: Any, *, full_histories: bool = False, max_points: int = 200
         },
         "parameters": case_parameters(case),
     }
+    if res.spectral is not None:
+        from ..service import sanity_check
+
+        doc["spectral"] = spectral_to_dict(res.spectral)
+        doc["spectral"]["sanity_check"] = [
+            {"reaction": it.reaction, "quantity": it.quantity, "time_domain": _num(it.time_domain),
+             "time_domain_std": _num(it.time_domain_std), "frequency_domain": _num(it.frequency_domain),
+             "allowed_difference": _num(it.allowed), "ok": it.ok}
+            for it in sanity_check(res)
+        ]
     M = res.mean[:, j, :]
     B = res.background[0]
     R = res.resonant[0]
@@ -183,3 +193,32 @@ def run_to_dict(res: Any, *, full_histories: bool = False, max_points: int = 200
         **{r: {"M": _num(M[idx, c]), "B": _num(B[idx, c]), "R": _num(R[idx, c])} for c, r in enumerate(REACTIONS)},
     }
     return doc
+
+
+def spectral_to_dict(sp: Any) -> dict[str, Any]:
+    """JSON block of a :class:`~linecheck.service.SpectralResult` (reactions at the tower of interest)."""
+    from ..core.results import REACTIONS
+
+    ex = sp.exact
+    keys = ("mean", "rms_background", "rms_resonant", "rms_fluctuating", "peak_quasi_static", "peak_dynamic",
+            "GF_Dy", "GF_QS", "Cont_R", "nu_background", "nu_fluctuating")
+    exact = {r: {k: _num(getattr(ex, k)[c]) for k in keys} for c, r in enumerate(REACTIONS)}
+    d = sp.davenport
+    dav = {
+        "reaction": "Ry",
+        "applicable": bool(sp.davenport_applicable),
+        "note": sp.davenport_note,
+        "background_factor": _num(d.background),
+        "resonant_factor": _num(d.resonant),
+        "peak_factor": _num(d.peak_factor),
+        "f1_hz": _num(d.f1),
+        "zeta_a": _num(d.zeta_a),
+        "GF_Dy": _num(d.GF_Dy) if sp.davenport_applicable else None,
+        "GF_QS": _num(d.GF_QS) if sp.davenport_applicable else None,
+        "Cont_R": _num(d.Cont_R) if sp.davenport_applicable else None,
+        "GF_ASCE74": _num(d.GF_ASCE),
+    }
+    return {"duration": _num(ex.duration), "band_hz": _num(list(ex.band)), "n_frequencies": ex.n_frequencies,
+            "exact": exact, "davenport": dav,
+            "not_applicable": {"Rx": "closed form ignores the longitudinal influence line",
+                               "Rz": "closed form ignores the vertical influence line"}}

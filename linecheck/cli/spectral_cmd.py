@@ -1,0 +1,72 @@
+"""`spectral` command: the frequency-domain check of a synoptic case (issue 5)."""
+
+from __future__ import annotations
+
+from rich.table import Table
+
+from .. import service
+from ..io.atomic import check_target
+from ..io.jsonout import spectral_to_dict, write_json
+from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
+
+
+def spectral_table(doc: dict, title: str) -> Table:
+    t = Table(title=title, title_justify="left")
+    for c in ("reaction", "mean kN", "rms B kN", "rms R kN", "rms F kN", "peak QS kN", "peak Dy kN",
+              "GF_Dy", "GF_QS", "Cont_R %"):
+        t.add_column(c, justify="right")
+    for r, v in doc["exact"].items():
+        def f(x, s=1e-3, fmt="{:.3f}"):
+            return "**" if x is None else fmt.format(x * s)
+        t.add_row(r, f(v["mean"]), f(v["rms_background"]), f(v["rms_resonant"]), f(v["rms_fluctuating"]),
+                  f(v["peak_quasi_static"]), f(v["peak_dynamic"]), f(v["GF_Dy"], 1), f(v["GF_QS"], 1),
+                  f(v["Cont_R"], 100, "{:.1f}"))
+    return t
+
+
+def davenport_line(doc: dict) -> str:
+    d = doc["davenport"]
+    if d["applicable"]:
+        return (f"closed form (Davenport/Castanheta), Ry: GF_Dy {d['GF_Dy']:.3f}, GF_QS {d['GF_QS']:.3f}, "
+                f"Cont_R {100 * d['Cont_R']:.1f} % (B {d['background_factor']:.3f}, R {d['resonant_factor']:.3f}, "
+                f"g {d['peak_factor']:.2f}, zeta_a {d['zeta_a']:.3f}); {d['note']}; "
+                f"ASCE 74 wire GRF {d['GF_ASCE74']:.3f}. Rx, Rz: not applicable (closed form ignores their influence lines).")
+    return f"closed form (Davenport/Castanheta): not shown: {d['note']}. ASCE 74 wire GRF {d['GF_ASCE74']:.3f}."
+
+
+@app.command()
+@handle_errors
+def spectral(case_file: CaseArg, json_out: JsonOpt = None) -> None:
+    """Frequency-domain estimates (exact random vibration and closed form) for a synoptic case."""
+    case = read_case(case_file)
+    if json_out is not None:
+        check_target(json_out, what="JSON")
+    res = service.spectral_analysis(case)
+    doc = {"case": case.name, "units": "SI", "tower_of_interest": case.line.tower_of_interest,
+           **spectral_to_dict(res)}
+    console.print(spectral_table(doc, f"{case.name}: frequency-domain estimate 1 (exact linear random vibration), "
+                                      f"tower {case.line.tower_of_interest}"))
+    console.print(davenport_line(doc), highlight=False)
+    if json_out is not None:
+        write_json(json_out, doc)
+        console.print(f"wrote {json_out}")
+
+
+def print_sanity(doc: dict) -> None:
+    """The run's "sanity check" line(s): time vs frequency domain."""
+    sp = doc.get("spectral")
+    if not sp:
+        return
+    items = sp.get("sanity_check", [])
+    bad = [i for i in items if not i["ok"]]
+    parts = []
+    for i in items:
+        tag = "" if i["ok"] else " [bold red]FLAG[/]"
+        parts.append(f"{i['reaction']} {i['quantity'].replace('rms_', 'rms ')}: time {i['time_domain'] / 1e3:.3f} "
+                     f"vs freq {i['frequency_domain'] / 1e3:.3f} kN{tag}")
+    head = "[green]sanity check ok[/]" if not bad else (
+        f"[bold red]sanity check: {len(bad)} difference(s) larger than sampling error explains[/]")
+    console.print(head + ": " + "; ".join(parts), highlight=False)
+    if bad:
+        console.print("[dim]A flagged resonant component usually means a lightly damped mode that the record "
+                      "does not reach stationarity for (see docs/validation.md, damping).[/]")

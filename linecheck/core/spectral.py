@@ -1,0 +1,337 @@
+"""Frequency-domain check of synoptic cases (issue 5).
+
+Estimate 1 -- exact linear random vibration of the same linearised model as the time
+domain (step-1 mean state K, lumped M, the case's damping C):
+
+    S_r(n) = S_v(n) * w(n)^H Coh(n) w(n),   w_i = t_i(n) a_i,
+
+with a_i = rho C_d D L_i V_i the load per unit turbulence at node i (paper Eq. 5),
+S_v the von Karman spectrum, Coh_ij = exp(-C n |x_i - x_j| / V) (Davenport 1961) and
+t_i(n) the reaction per unit load at node i:
+
+    t_F(n) = G H(w) P + D,  H(w) = (K - w^2 M + i w C)^-1   (total fluctuating)
+    t_B    = G K^-1 P + D                                   (quasi-static background)
+    t_R    = t_F - t_B                                       (resonant, R = F - B)
+
+(G, D: reaction maps of :mod:`linecheck.core.model`; P: y-DOF loading).  The
+variances integrate S_r over the band that the time-domain synthesis contains
+(1/T_record .. 1/(2 dt)), on a logarithmic grid refined around every lightly damped
+complex pole (tan-spaced points, exact for Lorentzian peaks).  Expected peaks use
+Davenport's (1964) peak factor g = sqrt(2 ln nu T) + 0.5772 / sqrt(2 ln nu T),
+nu = sqrt(m2/m0) from the spectral moments of the response.
+
+Estimate 2 -- closed-form Davenport / Castanheta gust response factor for the
+transverse reaction (Davenport 1979; Castanheta 1971 via Matheson & Holmes 1981):
+
+    GF = 1 + 2 g I sqrt(B + R),
+    B = int S_v(n)/sigma^2 |J(n)|^2 dn,  |J|^2 = 2/eta - 2 (1 - e^-eta)/eta^2,  eta = C n L / V,
+    R = pi f1 S_v(f1) / (4 zeta_a sigma^2) |J(f1)|^2,  zeta_a = rho C_d D V / (4 pi f1 m),
+
+and the ASCE Manual 74 (2010) wire gust response factor for comparison.
+Formulas and sources are collected in docs/method.md.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.linalg import eig, lapack, solve_banded
+
+from .errors import NumericalError
+from .model import BANDWIDTH, LinearModel, reaction_matrix_direct
+from .wind.turbulence import von_karman_cumulative, von_karman_psd
+
+EULER_GAMMA = 0.5772156649
+
+
+# --------------------------------------------------------------------------- wind spectrum
+def von_karman(n: np.ndarray, sigma: float, length_scale: float, v_mean: float) -> np.ndarray:
+    """One-sided von Karman spectrum S_v(n) [m^2/s^2/Hz] (von Karman 1948; the same
+    function the time-domain synthesis uses, :func:`~linecheck.core.wind.turbulence.von_karman_psd`)."""
+    return sigma**2 * von_karman_psd(n, length_scale, v_mean)
+
+
+def peak_factor(nu: np.ndarray | float, duration: float) -> np.ndarray:
+    """Davenport (1964) expected peak factor g = sqrt(2 ln nu T) + 0.5772/sqrt(2 ln nu T)."""
+    a = np.sqrt(2.0 * np.log(np.maximum(np.asarray(nu, dtype=float) * duration, 1.0 + 1e-12)))
+    return a + EULER_GAMMA / a
+
+
+# --------------------------------------------------------------------------- complex modes
+@dataclass(frozen=True)
+class ComplexModes:
+    """Damped modes of M u'' + C u' + K u = 0 (state-space eigenproblem).
+
+    Attributes:
+        frequencies_hz: [Hz] undamped-equivalent natural frequency |lambda|/(2 pi), (n,).
+        damping_ratio: [-] zeta = -Re(lambda)/|lambda|, (n,).
+        poles: complex eigenvalues lambda with Im > 0, (n,).
+    """
+
+    frequencies_hz: np.ndarray
+    damping_ratio: np.ndarray
+    poles: np.ndarray
+
+
+def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None = None) -> ComplexModes:
+    """Eigenvalues of the first-order form [[0, I], [-M^-1 K, -M^-1 C]] (sorted by frequency).
+
+    Args:
+        damping: [N s/m] viscous damping per DOF (diagonal C), shape (n_dof,), or a full
+            (n_dof, n_dof) matrix.
+        max_hz: keep only modes below this frequency.
+    """
+    K = model.K_dense
+    n = K.shape[0]
+    minv = 1.0 / model.mass
+    C = np.diag(damping) if damping.ndim == 1 else damping
+    A = np.zeros((2 * n, 2 * n))
+    A[:n, n:] = np.eye(n)
+    A[n:, :n] = -minv[:, None] * K
+    A[n:, n:] = -minv[:, None] * C
+    lam = eig(A, right=False)
+    lam = lam[lam.imag > 1e-12]
+    w = np.abs(lam)
+    order = np.argsort(w)
+    lam, w = lam[order], w[order]
+    f = w / (2 * np.pi)
+    zeta = -lam.real / w
+    if max_hz is not None:
+        keep = f <= max_hz
+        lam, f, zeta = lam[keep], f[keep], zeta[keep]
+    return ComplexModes(f, zeta, lam)
+
+
+def frequency_grid(f_lo: float, f_hi: float, modes: ComplexModes, *, n_log: int = 400, n_peak: int = 33,
+                   zeta_resolved: float = 0.05) -> np.ndarray:
+    """Integration grid [Hz]: log-spaced plus tan-spaced points around lightly damped poles.
+
+    Around a pole of half-power half-width b = zeta f the points f + b tan(theta),
+    theta uniform in (-pi/2, pi/2) minus 1e-3, integrate a Lorentzian peak to ~0.1 %.
+    """
+    parts = [np.geomspace(f_lo, f_hi, n_log)]
+    theta = np.linspace(-np.pi / 2 + 1e-3, np.pi / 2 - 1e-3, n_peak)
+    for f, z in zip(modes.frequencies_hz, modes.damping_ratio):
+        if f_lo < f < f_hi and z < zeta_resolved:
+            b = max(z * f, 1e-12 * f)
+            parts.append(f + b * np.tan(theta))
+    grid = np.unique(np.concatenate(parts))
+    return grid[(grid >= f_lo) & (grid <= f_hi)]
+
+
+def _general_band(ab_upper: np.ndarray) -> np.ndarray:
+    """Symmetric upper band storage (u+1, n) -> general band storage (2u+1, n) for solve_banded."""
+    u, n = ab_upper.shape[0] - 1, ab_upper.shape[1]
+    out = np.zeros((2 * u + 1, n), dtype=ab_upper.dtype)
+    out[: u + 1] = ab_upper
+    for k in range(1, u + 1):
+        # lower diagonal k: A[j+k, j] = A[j, j+k] = ab_upper[u - k, j + k]
+        out[u + k, : n - k] = ab_upper[u - k, k:]
+    return out
+
+
+def _quad_kms(w: np.ndarray, rho: np.ndarray) -> np.ndarray:
+    """w^H Coh w for Coh_ij = rho^|i-j| (equally spaced nodes), O(N) per frequency.
+
+    Args: w (n_f, ..., N) complex; rho (n_f,) in [0, 1).  Returns (n_f, ...) real.
+    """
+    r = rho.reshape((-1,) + (1,) * (w.ndim - 2))
+    h = np.zeros(w.shape[:-1], dtype=complex)
+    total = np.sum(np.abs(w) ** 2, axis=-1)
+    cross = np.zeros(w.shape[:-1])
+    for j in range(1, w.shape[-1]):
+        h = r * (h + w[..., j - 1])  # h_j = sum_{i<j} rho^(j-i) w_i
+        cross += np.real(np.conj(w[..., j]) * h)
+    return total + 2.0 * cross
+
+
+@dataclass(frozen=True)
+class SpectralEstimate:
+    """Frequency-domain statistics of the reactions at the tower of interest.
+
+    Every array has shape (3,) for (R_x, R_y, R_z); forces [N], frequencies [Hz].
+    GF_* are NaN where the mean vanishes (as in the time domain).
+    """
+
+    mean: np.ndarray
+    rms_background: np.ndarray
+    rms_resonant: np.ndarray
+    rms_fluctuating: np.ndarray
+    nu_background: np.ndarray
+    nu_fluctuating: np.ndarray
+    peak_quasi_static: np.ndarray
+    peak_dynamic: np.ndarray
+    GF_Dy: np.ndarray
+    GF_QS: np.ndarray
+    Cont_R: np.ndarray
+    duration: float
+    band: tuple[float, float]
+    n_frequencies: int
+
+
+def random_vibration(
+    model: LinearModel,
+    damping: np.ndarray,
+    load_per_v: np.ndarray,
+    mean_reaction: np.ndarray,
+    tower: int,
+    *,
+    sigma: float,
+    length_scale: float,
+    v_mean: float,
+    coherence_decay: float,
+    duration: float,
+    band: tuple[float, float],
+    zero_mean_tol: float,
+) -> SpectralEstimate:
+    """Estimate 1: exact linear random vibration of ``model`` (see module docstring).
+
+    Args:
+        model: linear model of the (synoptic) mean state.
+        damping: [N s/m] damping per DOF, shape (n_dof,).
+        load_per_v: [N s/m] a_i = rho C_d D L_i V_i at every global node, shape (n_nodes,).
+        mean_reaction: [N] wind-induced mean reactions at ``tower``, shape (3,).
+        tower: 0-based tower index.
+        sigma, length_scale, v_mean, coherence_decay: turbulence (sigma = I V) [m/s], L_u [m],
+            V [m/s], C [-].
+        duration: [s] record length T for the peak factor.
+        band: [Hz] integration band (f_lo, f_hi).
+        zero_mean_tol: [N] a mean below this has no gust factor.
+    """
+    system = model.system
+    n_dof = model.mass.size
+    free = model.dofs.free_nodes
+    rows = slice(3 * tower, 3 * tower + 3)
+    Gt = model.G[rows]  # (3, n_dof)
+    Dt = reaction_matrix_direct(system)[rows]  # (3, n_nodes)
+    ydof = model.dofs.node_dof[free] + 1
+
+    # background transfer t_B = G K^-1 P + D (K symmetric: solve with G^T)
+    K_gen = _general_band(model.K_band)
+    xB = solve_banded((BANDWIDTH, BANDWIDTH), K_gen, Gt.T)  # (n_dof, 3)
+    tB = Dt.astype(complex).copy()
+    tB[:, free] += xB[ydof].T
+
+    modes = complex_modes(model, damping, max_hz=band[1] * 1.5)
+    f = frequency_grid(band[0], band[1], modes)
+    # LAPACK zgbsv storage: kl extra rows on top of the general band (rows kl .. 2kl+ku)
+    kl = BANDWIDTH
+    base = np.zeros((kl + K_gen.shape[0], n_dof), dtype=complex)
+    base[kl:] = K_gen
+    mrow = kl + BANDWIDTH  # main diagonal row
+    rhs0 = np.asfortranarray(Gt.T.astype(complex))
+    tF = np.empty((f.size, 3, system.n_nodes), dtype=complex)
+    tF[:] = Dt[None]
+    zgbsv = lapack.zgbsv
+    for k, fk in enumerate(f):
+        w = 2 * np.pi * fk
+        ab = base.copy()
+        ab[mrow] += -(w**2) * model.mass + 1j * w * damping  # K - w^2 M + i w C (M, C diagonal)
+        _, _, x, info = zgbsv(kl, kl, ab, rhs0, overwrite_ab=1)
+        if info != 0:
+            raise NumericalError(f"dynamic stiffness singular at {fk:.6g} Hz (LAPACK zgbsv info {info})")
+        tF[k][:, free] += x[ydof].T
+    a = load_per_v[None, None, :]
+    # the synthesis scales the spectrum to unit variance below its top frequency
+    # (linecheck.core.wind.turbulence.spectral_grid); do the same here
+    Sv = von_karman(f, sigma, length_scale, v_mean) / float(von_karman_cumulative(band[1], length_scale, v_mean))
+    dx = system.line.span_length / system.ne
+    rho = np.exp(-coherence_decay * f * dx / v_mean)  # Davenport coherence between neighbours
+    SB = Sv[:, None] * _quad_kms(np.broadcast_to(tB[None] * a, tF.shape), rho)
+    SF = Sv[:, None] * _quad_kms(tF * a, rho)
+    SR = Sv[:, None] * _quad_kms((tF - tB[None]) * a, rho)
+
+    def integ(y: np.ndarray) -> np.ndarray:
+        return np.trapezoid(y, f, axis=0)
+
+    m0B, m0F, m0R = integ(SB), integ(SF), integ(SR)
+    nuB = np.sqrt(integ(SB * f[:, None] ** 2) / np.maximum(m0B, 1e-300))
+    nuF = np.sqrt(integ(SF * f[:, None] ** 2) / np.maximum(m0F, 1e-300))
+    sB, sF, sR = np.sqrt(m0B), np.sqrt(m0F), np.sqrt(m0R)
+    mabs = np.abs(mean_reaction)
+    pk_qs = mabs + peak_factor(nuB, duration) * sB
+    pk_dy = mabs + peak_factor(nuF, duration) * sF
+    defined = mabs > zero_mean_tol
+    with np.errstate(divide="ignore", invalid="ignore"):
+        gf_dy = np.where(defined, pk_dy / mabs, np.nan)
+        gf_qs = np.where(defined, pk_qs / mabs, np.nan)
+    cont_r = (pk_dy - pk_qs) / pk_dy
+    return SpectralEstimate(
+        mean=np.asarray(mean_reaction, dtype=float), rms_background=sB, rms_resonant=sR, rms_fluctuating=sF,
+        nu_background=nuB, nu_fluctuating=nuF, peak_quasi_static=pk_qs, peak_dynamic=pk_dy,
+        GF_Dy=gf_dy, GF_QS=gf_qs, Cont_R=cont_r, duration=duration, band=band, n_frequencies=int(f.size),
+    )
+
+
+# --------------------------------------------------------------------------- estimate 2
+def joint_acceptance_uniform(eta: np.ndarray) -> np.ndarray:
+    """|J|^2 = 2/eta - 2 (1 - e^-eta)/eta^2 for exponential coherence over a uniform span
+    (Davenport 1962; eta = C n L / V); limit 1 as eta -> 0."""
+    eta = np.asarray(eta, dtype=float)
+    small = eta < 1e-6
+    e = np.where(small, 1.0, eta)
+    out = 2.0 / e - 2.0 * (1.0 - np.exp(-e)) / e**2
+    return np.where(small, 1.0 - eta / 3.0, out)
+
+
+@dataclass(frozen=True)
+class DavenportEstimate:
+    """Estimate 2 for the transverse reaction: closed-form gust response factors.
+
+    Attributes:
+        background: B [-]; resonant: R [-]; peak_factor: g [-]; f1 [Hz]; zeta_a [-];
+        GF_Dy = 1 + 2 g I sqrt(B + R); GF_QS = 1 + 2 g I sqrt(B); Cont_R [-];
+        GF_ASCE: ASCE Manual 74 (2010) wire gust response factor G_w = 1 + 2.7 E_w sqrt(B_w).
+    """
+
+    background: float
+    resonant: float
+    peak_factor: float
+    f1: float
+    zeta_a: float
+    GF_Dy: float
+    GF_QS: float
+    Cont_R: float
+    GF_ASCE: float
+
+
+def davenport_gust_factor(
+    *,
+    span: float,
+    v_mean: float,
+    intensity: float,
+    length_scale: float,
+    coherence_decay: float,
+    f1: float,
+    mass_per_length: float,
+    air_density: float,
+    drag_coefficient: float,
+    diameter: float,
+    duration: float,
+    height: float,
+) -> DavenportEstimate:
+    """Estimate 2 (see module docstring); all inputs SI ([m], [m/s], [Hz], [kg/m], [s])."""
+    n = np.geomspace(1e-5, 10.0, 4000)
+    Sn = von_karman(n, 1.0, length_scale, v_mean)  # S/sigma^2
+    J2 = joint_acceptance_uniform(coherence_decay * n * span / v_mean)
+    B = float(np.trapezoid(Sn * J2, n))
+    zeta = air_density * drag_coefficient * diameter * v_mean / (4 * np.pi * f1 * mass_per_length)  # Davenport 1962
+    R = float(np.pi * f1 * von_karman(f1, 1.0, length_scale, v_mean) / (4 * zeta)
+              * joint_acceptance_uniform(coherence_decay * f1 * span / v_mean))
+    # cycling rate of the response (Davenport 1964): nu^2 = (f1^2 R + nu_B^2 B) / (B + R)
+    nuB2 = float(np.trapezoid(n**2 * Sn * J2, n) / max(B, 1e-300))
+    nu = np.sqrt((f1**2 * R + nuB2 * B) / (B + R))
+    g = float(peak_factor(nu, duration))
+    gB = float(peak_factor(np.sqrt(nuB2), duration))
+    gf_dy = 1 + 2 * g * intensity * np.sqrt(B + R)
+    gf_qs = 1 + 2 * gB * intensity * np.sqrt(B)
+    # ASCE 74 (2010) section 2.1.5, exposure C: E_w = 4.9 sqrt(kappa) (33/z)^(1/alpha),
+    # B_w = 1 / (1 + 0.8 L / L_s), L_s = 220 (z/33)^(1/eps) [ft]; kappa = 0.005, alpha = 9.5, eps = 5.
+    z_ft = height / 0.3048
+    Ew = 4.9 * np.sqrt(0.005) * (33.0 / z_ft) ** (1 / 9.5)
+    Ls = 220.0 * (z_ft / 33.0) ** (1 / 5.0) * 0.3048
+    Bw = 1.0 / (1.0 + 0.8 * span / Ls)
+    gf_asce = 1 + 2.7 * Ew * np.sqrt(Bw)
+    return DavenportEstimate(B, R, g, f1, float(zeta), float(gf_dy), float(gf_qs),
+                             float((gf_dy - gf_qs) / gf_dy), float(gf_asce))

@@ -36,6 +36,7 @@ duration = 600.0
 time_step = 0.05
 realizations = 10
 seed = {seed}
+damping = "paper"        # Eq. 13 exactly (transverse only), as in the paper
 """
 
 
@@ -99,6 +100,7 @@ duration = 600.0
 time_step = 0.05
 realizations = 10
 seed = {1000 + V}
+damping = "paper"        # Eq. 13 exactly (transverse only), as in the paper
 '''
         (val / f"matheson-holmes-v{V}.toml").write_text(text)
 

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .core.case import Case
-from .core.damping import aerodynamic_damping
+from .core.damping import aerodynamic_damping, stiffness_proportional
 from .core.dynamics import integrate
 from .core.errors import Cancelled
 from .core.model import build_model, reaction_matrix_direct
@@ -107,6 +107,7 @@ class RunResult:
         background, resonant: [N] B(t), R(t) at the tower of interest, shape (n_real, n_steps, 3).
         stats: statistics per realization at every tower (:class:`Statistics`).
         spectral: frequency-domain check (synoptic cases; None for downbursts).
+        burn_in: the discarded start of the record and whether it suffices (issue 10).
     """
 
     case: Case
@@ -119,6 +120,7 @@ class RunResult:
     resonant: np.ndarray
     stats: Statistics
     spectral: "SpectralResult | None" = None
+    burn_in: "BurnIn | None" = None
 
     @property
     def tower_index(self) -> int:
@@ -129,6 +131,110 @@ class RunResult:
     def still_air(self) -> np.ndarray:
         """[N] still-air reactions at every tower, shape (n_towers, 3)."""
         return self.static.mean.still_air.reactions
+
+
+def reference_state_index(case: Case, mean: MeanStates) -> int:
+    """Mean state used for single-state quantities (modes, structural damping calibration):
+    synoptic 0; downburst the instant of the largest wind-induced mean reaction at the tower."""
+    j = case.line.tower_of_interest - 1
+    return int(np.argmax(np.abs(mean.reactions_wind[:, j, :]).max(axis=1)))
+
+
+def damping_matrices(case: Case, st: StaticResult, models: list) -> np.ndarray:
+    """Damping of every mean state [N s/m], upper band storage, shape (n_k, 6, n_dof).
+
+    Aerodynamic (``analysis.damping``) plus stiffness-proportional structural damping
+    calibrated at the lowest mode of the reference mean state (docs/method.md, damping).
+    """
+    from .core.modes import natural_modes
+
+    system, mean = st.system, st.mean
+    vn = to_global_nodes(system, st.wind.normal)  # (n_k, n_nodes)
+    C = np.stack([aerodynamic_damping(case, models[k], vn[k], mean.nodes[k]) for k in range(len(models))])
+    zs = case.analysis.structural_ratio
+    if zs > 0:
+        k_ref = reference_state_index(case, mean)
+        w1 = 2 * np.pi * float(natural_modes(models[k_ref], 1).frequencies_hz[0])
+        beta = 2.0 * zs / w1
+        C = C + np.stack([beta * m.K_band for m in models])
+    return C
+
+
+BURN_IN_DECAY = np.log(100.0)  # transient amplitude down to 1 %: t = ln(100) / (zeta omega)
+BURN_IN_MAX_FACTOR = 10.0  # derived burn-in capped at this multiple of the analysed duration
+SIGNIFICANT_FRACTION = 0.01  # a mode matters if it adds > 1 % of the largest background r.m.s.
+
+
+@dataclass(frozen=True)
+class BurnIn:
+    """Discarded start of a synoptic record (issue 10).
+
+    Attributes:
+        seconds: [s] burn-in used; required: [s] time for the transient of the least-damped
+        significant mode to decay to 1 % (inf if undamped); mode_hz [Hz], zeta [-]: that mode;
+        sufficient: whether the analysed record is stationary for every significant mode;
+        source: where ``seconds`` comes from.
+    """
+
+    seconds: float
+    required: float
+    mode_hz: float
+    zeta: float
+    sufficient: bool
+    source: str
+
+
+@dataclass(frozen=True)
+class SynopticModel:
+    """The linearised synoptic mean state shared by the time and frequency domains."""
+
+    model: object
+    damping: np.ndarray
+    load_per_v: np.ndarray
+    modes: object
+
+
+def synoptic_model(case: Case, st: StaticResult) -> SynopticModel:
+    """Model, damping, load per unit turbulence (Eq. 5) and complex modes of the synoptic state."""
+    from .core.spectral import complex_modes
+
+    system = st.system
+    model = build_model(system, st.mean.state(0))
+    damping = damping_matrices(case, st, [model])[0]
+    vn = to_global_nodes(system, st.wind.normal)[0]
+    line, wind = case.line, case.wind
+    a = wind.air_density * line.drag_coefficient * line.diameter * model.tributary * vn  # Eq. 5 per unit v
+    f_top = 0.75 / case.analysis.time_step
+    modes = complex_modes(model, damping, max_hz=f_top, vectors=True)
+    return SynopticModel(model, damping, a, modes)
+
+
+def burn_in(case: Case, sm: SynopticModel) -> BurnIn:
+    """Burn-in of a synoptic run from the least-damped significant complex mode (issue 10)."""
+    from .core.spectral import modal_contributions
+    from .core.wind.turbulence import length_scale
+
+    duration = case.analysis.duration if case.analysis.duration is not None else 600.0
+    mc = modal_contributions(
+        sm.model, sm.modes, sm.load_per_v, case.line.tower_of_interest - 1,
+        sigma=case.wind.turbulence_intensity * case.wind.v_ref, length_scale=length_scale(case),
+        v_mean=case.wind.v_ref, coherence_decay=case.wind.coherence_decay, max_hz=0.5 / case.analysis.time_step,
+    )
+    sig = np.flatnonzero(mc.significant(SIGNIFICANT_FRACTION))
+    if sig.size == 0:
+        required, f1, z1 = 0.0, float("nan"), float("nan")
+    else:
+        i = sig[np.argmin(mc.decay_rate[sig])]
+        rate = mc.decay_rate[i]
+        required = float(BURN_IN_DECAY / rate) if rate > 0 else float("inf")
+        f1, z1 = float(mc.frequencies_hz[i]), float(mc.damping_ratio[i])
+    if case.analysis.burn_in is not None:
+        used, src = float(case.analysis.burn_in), "analysis.burn_in"
+    elif case.analysis.damping == "paper":
+        used, src = 0.0, "none with damping = \"paper\" (the paper's method)"
+    else:
+        used, src = min(required, BURN_IN_MAX_FACTOR * duration), "derived from the least-damped significant mode"
+    return BurnIn(float(used), required, f1, z1, bool(used >= required), src)
 
 
 def _state_of_step(mean_times: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -175,7 +281,13 @@ def run_case(
     # ---- linear models at the mean states (paper Eqs 7-9, 13)
     models = [build_model(system, mean.state(k)) for k in range(mean.time.size)]
     vn_states = to_global_nodes(system, st.wind.normal)  # (n_k, n_nodes)
-    damping = np.stack([aerodynamic_damping(case, models[k], vn_states[k]) for k in range(len(models))])
+    damping = damping_matrices(case, st, models)
+    sm = synoptic_model(case, st) if wind.type == "synoptic" else None
+    burn = burn_in(case, sm) if sm is not None else BurnIn(
+        0.0, 0.0, float("nan"), float("nan"), True, "none: a downburst starts from a weak running mean")
+    if burn.seconds > 0:
+        t = t[0] - dt * np.round(burn.seconds / dt) + dt * np.arange(t.size + int(np.round(burn.seconds / dt)))
+    keep = t >= t[0] + burn.seconds - 1e-9  # the analysed record (after the burn-in)
     state_of_step, weights = _state_of_step(mean.time, t)
     check_cancel()
 
@@ -218,13 +330,14 @@ def run_case(
         flat = rw.reshape(rw.shape[0], -1)
         M = np.stack([np.interp(t, mean.time, flat[:, i]) for i in range(flat.shape[1])], axis=1).reshape(
             (t.size,) + rw.shape[1:])
-    stats = compute_statistics(M, resp.background, resp.resonant, mean.still_air.reactions, case.g_yp_L)
+    Bk, Rk = resp.background[:, keep], resp.resonant[:, keep]
+    stats = compute_statistics(M[keep], Bk, Rk, mean.still_air.reactions, case.g_yp_L)
     j = case.line.tower_of_interest - 1
-    spectral = spectral_analysis(case, static=st) if wind.type == "synoptic" else None
+    spectral = spectral_analysis(case, static=st, synoptic=sm) if sm is not None else None
     return RunResult(
-        case=case, system=system, static=st, realizations=real, time=t, mean=M,
-        background=resp.background[:, :, j, :].copy(), resonant=resp.resonant[:, :, j, :].copy(), stats=stats,
-        spectral=spectral,
+        case=case, system=system, static=st, realizations=real, time=t[keep], mean=M[keep],
+        background=Bk[:, :, j, :].copy(), resonant=Rk[:, :, j, :].copy(), stats=stats,
+        spectral=spectral, burn_in=burn,
     )
 
 
@@ -307,7 +420,8 @@ class SpectralResult:
 DAVENPORT_TOLERANCE = 0.15  # issue 5: estimate 2 shown only where within 15 % of estimate 1
 
 
-def spectral_analysis(case: Case, *, static: StaticResult | None = None) -> SpectralResult:
+def spectral_analysis(case: Case, *, static: StaticResult | None = None,
+                      synoptic: SynopticModel | None = None) -> SpectralResult:
     """Frequency-domain estimates for a synoptic case (same model and damping as the time domain)."""
     from .core.errors import CaseError
     from .core.spectral import davenport_gust_factor, random_vibration
@@ -317,12 +431,9 @@ def spectral_analysis(case: Case, *, static: StaticResult | None = None) -> Spec
         raise CaseError("the frequency-domain check is for synoptic cases only (a downburst is non-stationary)",
                         file=str(case.source) if case.source else None, key="wind.type")
     st = static if static is not None else static_analysis(case)
-    system, mean = st.system, st.mean
-    model = build_model(system, mean.state(0))
-    vn = to_global_nodes(system, st.wind.normal)[0]
-    damping = aerodynamic_damping(case, model, vn)
+    mean = st.mean
+    sm = synoptic if synoptic is not None else synoptic_model(case, st)  # same model as the time domain
     line, wind = case.line, case.wind
-    a = wind.air_density * line.drag_coefficient * line.diameter * model.tributary * vn  # Eq. 5 per unit v
     t = record_time(case)
     j = case.line.tower_of_interest - 1
     mean_r = mean.reactions_wind[0, j]
@@ -331,7 +442,7 @@ def spectral_analysis(case: Case, *, static: StaticResult | None = None) -> Spec
     tol = ZERO_MEAN_RTOL * float(np.abs(mean.reactions_wind[0]).max())
     L_u = length_scale(case)
     exact = random_vibration(
-        model, damping, a, mean_r, j, sigma=wind.turbulence_intensity * wind.v_ref, length_scale=L_u,
+        sm.model, sm.damping, sm.load_per_v, mean_r, j, modes=sm.modes, sigma=wind.turbulence_intensity * wind.v_ref, length_scale=L_u,
         v_mean=wind.v_ref, coherence_decay=wind.coherence_decay, duration=float(t[-1] - t[0]),
         band=(1e-5, 0.5 / case.analysis.time_step), zero_mean_tol=tol,
     )

@@ -38,7 +38,8 @@ def test_newmark_sdof_harmonic_matches_exact_solution():
     t = dt * np.arange(n)
     F = F0 * np.sin(W * t)
     model = sdof_model(k, m)
-    damping = np.array([[0.0, c, 0.0]])
+    damping = np.zeros((1, 6, 3))
+    damping[0, -1, 1] = c  # diagonal band row: c on the y DOF
     resp = integrate([model], damping, np.zeros(n, dtype=int), F[:, None, None], dt)
     u = resp.fluctuating[0, :, 1, 1]
     # exact: steady state + transient (Chopra, "Dynamics of Structures", section 3.2)
@@ -64,8 +65,8 @@ def test_newmark_mdof_matches_modal_superposition():
     model = build_model(system, still_air_state(system))
     V = 20.0
     alpha = 1.25 * 1.0 * 0.022 * V * 9.81 / 17.92  # c/m on every y DOF [1/s]
-    damping = np.zeros((1, model.dofs.n_dof))
-    damping[0, 1::3] = alpha * model.mass[1::3]
+    damping = np.zeros((1, 6, model.dofs.n_dof))
+    damping[0, -1, 1::3] = alpha * model.mass[1::3]
     y = np.arange(1, model.dofs.n_dof, 3)
     Kyy = model.K_dense[np.ix_(y, y)]
     assert np.allclose(model.K_dense[np.ix_(y, np.arange(0, model.dofs.n_dof, 3))], 0.0)

@@ -15,7 +15,10 @@ CORE_MODULES = [
     "linecheck.core.damping",
     "linecheck.core.results",
     "linecheck.core.modes",
+    "linecheck.core.spectral",
     "linecheck.core.wind.mean",
+    "linecheck.core.wind.turbulence",
+    "linecheck.core.wind.point",
     "linecheck.service",
     "linecheck.io.jsonout",
 ]

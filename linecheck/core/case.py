@@ -27,6 +27,9 @@ SUPPORT_TYPES = ("strain", "suspension")
 WIND_TYPES = ("synoptic", "downburst")
 DOWNBURST_PRESETS = ("Db_x", "Db_y")
 DAMPING_MODELS = ("quasi-steady", "paper")
+# Conductor self-damping assumed with the quasi-steady model (ratio at the lowest mean-state
+# mode, stiffness-proportional): it damps the axial modes that no aerodynamic model damps.
+DEFAULT_STRUCTURAL_DAMPING = 0.002
 
 
 # --------------------------------------------------------------------------- schema
@@ -129,6 +132,9 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         _i("realizations", "-", "number of turbulence realizations", default=10, low=1, high=10000),
         _i("seed", "-", "random seed", default=2015, low=0, high=2**63 - 1),
         _i("mean_states", "-", "downburst: step-1 mean-state instants over the event", default=250, low=2, high=100000),
+        FieldSpec("damping", "choice", "-", 'aerodynamic damping: "quasi-steady" (every direction of relative motion) or "paper" (Eq. 13, transverse only)', default="quasi-steady", choices=DAMPING_MODELS),
+        _f("structural_damping", "-", 'structural (self-)damping ratio at the lowest mean-state mode (default: 0 with "paper", 0.002 with "quasi-steady")', low=0.0, high=0.2),
+        _f("burn_in", "s", "synoptic: discarded start of the record (default: from the least-damped significant mode)", low=0.0, high=1e5),
     ),
 }
 
@@ -213,6 +219,17 @@ class Analysis:
     realizations: int = 10
     seed: int = 2015
     mean_states: int = 250
+    damping: str = "quasi-steady"
+    structural_damping: float | None = None  # [-]; None = default of the damping model
+    burn_in: float | None = None  # [s]; None = derived (synoptic)
+
+    @property
+    def structural_ratio(self) -> float:
+        """Structural damping ratio in force [-]: the key, else 0 with ``"paper"`` (the paper has
+        none) and :data:`DEFAULT_STRUCTURAL_DAMPING` with ``"quasi-steady"`` (docs/method.md)."""
+        if self.structural_damping is not None:
+            return self.structural_damping
+        return 0.0 if self.damping == "paper" else DEFAULT_STRUCTURAL_DAMPING
 
 
 @dataclass(frozen=True)

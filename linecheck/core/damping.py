@@ -1,9 +1,32 @@
-"""Aerodynamic damping of the linearised conductor (paper Eqs 9-13).
+"""Damping of the linearised conductor (paper Eqs 9-13; issue 10).
 
-``paper`` model (Eq. 13): c_a,i(t) = rho C_d D L_i V_i(t) on the transverse (y) DOF
-of node i only, L_i the tributary conductor length and V_i the local running-mean
-speed normal to the line (the linearisation of 1/2 rho C_d D (V - u')^2 about u' = 0,
-Eqs 10-12).
+Two aerodynamic models, selected by ``[analysis] damping``:
+
+- ``"paper"`` (Eq. 13): c_a,i(t) = rho C_d D L_i V_i(t) on the transverse (y) DOF of node i
+  only, L_i the tributary conductor length and V_i the local running-mean speed normal to
+  the line -- the linearisation of 1/2 rho C_d D (V - u')^2 about u' = 0 (Eqs 10-12).
+- ``"quasi-steady"``: the drag 1/2 rho C_d D |V_rel| V_rel acts on the velocity of the wind
+  relative to the conductor in the plane normal to the conductor axis (cross-flow
+  principle).  Linearised about the mean wind V w (w the unit wind direction in that
+  plane): dF = -rho C_d D L V [w w^T + 1/2 (P - w w^T)] u', P = I - e e^T the projector
+  normal to the conductor axis e.  Along-wind c = rho C_d D V L (= Eq. 13), cross-wind
+  (in the plane, normal to the wind, mostly vertical) c = 1/2 rho C_d D V L (Davenport
+  1962; Matheson & Holmes 1981, whose full analysis has the relative velocity in every
+  direction).
+
+Structural damping (``structural_damping`` = zeta_s): stiffness-proportional,
+C_s = beta K with beta = 2 zeta_s / omega_1 (omega_1 the lowest undamped mode of the mean
+state), so the ratio is zeta_s at that mode and grows with frequency (Chopra 2012,
+section 11.4).  Conductor self-damping (inter-strand friction) is small, of the order of
+0.1-1 % of critical and dependent on tension and amplitude (IEEE Guide on conductor
+self-damping measurements, 1978).  With "paper" the default is 0 (the paper's method);
+with "quasi-steady" it is 0.2 % (:data:`~linecheck.core.case.DEFAULT_STRUCTURAL_DAMPING`):
+the cross-flow principle gives no aerodynamic damping for motion along the conductor
+axis, so without it the axial modes of a span (2.3 Hz and up for 300 m) keep damping
+ratios of 1e-5..1e-8 (docs/method.md, "Damping").
+
+Every function returns the damping matrix in the upper band storage of
+:mod:`linecheck.core.model` (shape (BANDWIDTH + 1, n_dof)).
 """
 
 from __future__ import annotations
@@ -11,20 +34,61 @@ from __future__ import annotations
 import numpy as np
 
 from .case import Case
-from .model import LinearModel
+from .model import BANDWIDTH, LinearModel
 
 
-def aerodynamic_damping(case: Case, model: LinearModel, vn_nodes: np.ndarray) -> np.ndarray:
-    """Viscous damping per DOF [N s/m], shape (n_dof,).
+def _add_node_blocks(ab: np.ndarray, first_dof: np.ndarray, blocks: np.ndarray) -> None:
+    """Add symmetric 3x3 blocks on the diagonal of an upper band matrix."""
+    u = ab.shape[0] - 1
+    for a in range(3):
+        for b in range(a, 3):
+            ab[u - (b - a), first_dof + b] += blocks[:, a, b]
+
+
+def node_tangents(model: LinearModel, nodes: np.ndarray) -> np.ndarray:
+    """Unit conductor tangent at every global node (mean of the adjacent chords), (n_nodes, 3)."""
+    seg = np.diff(nodes, axis=0)
+    seg /= np.linalg.norm(seg, axis=1)[:, None]
+    t = np.zeros_like(nodes)
+    t[:-1] += seg
+    t[1:] += seg
+    return t / np.linalg.norm(t, axis=1)[:, None]
+
+
+def aerodynamic_damping(case: Case, model: LinearModel, vn_nodes: np.ndarray, nodes: np.ndarray | None = None) -> np.ndarray:
+    """Aerodynamic damping matrix [N s/m] in upper band storage, shape (BANDWIDTH + 1, n_dof).
 
     Args:
-        case: the case (air density, C_d, D).
+        case: the case (air density, C_d, D, ``analysis.damping``).
         model: linear model of the mean state (DOF map, tributary lengths).
         vn_nodes: [m/s] running-mean normal speed at every global node, shape (n_nodes,).
+        nodes: [m] deformed node coordinates of the mean state, (n_nodes, 3); needed for
+            ``"quasi-steady"``.
     """
     line = case.line
     coef = case.wind.air_density * line.drag_coefficient * line.diameter  # rho C_d D (Eq. 13)
     free = model.dofs.free_nodes
-    c = np.zeros(model.dofs.n_dof)
-    c[1::3] = coef * model.tributary[free] * np.abs(vn_nodes[free])
-    return c
+    n_dof = model.dofs.n_dof
+    ab = np.zeros((BANDWIDTH + 1, n_dof))
+    c = coef * model.tributary[free] * np.abs(vn_nodes[free])  # (n_free,)
+    first = model.dofs.node_dof[free]
+    if case.analysis.damping == "paper":
+        ab[BANDWIDTH, first + 1] = c  # Eq. 9: transverse DOF only
+        return ab
+    if nodes is None:
+        raise ValueError("quasi-steady damping needs the mean-state node coordinates")
+    e = node_tangents(model, nodes)[free]  # (n_free, 3)
+    P = np.eye(3)[None] - e[:, :, None] * e[:, None, :]
+    w = P[:, :, 1]  # the wind (+y) projected normal to the axis
+    w = w / np.linalg.norm(w, axis=1)[:, None]
+    ww = w[:, :, None] * w[:, None, :]
+    blocks = c[:, None, None] * (ww + 0.5 * (P - ww))
+    _add_node_blocks(ab, first, blocks)
+    return ab
+
+
+def stiffness_proportional(model: LinearModel, ratio: float, omega1: float) -> np.ndarray:
+    """Structural damping C_s = (2 zeta_s / omega_1) K [N s/m], upper band storage."""
+    if ratio <= 0.0:
+        return np.zeros_like(model.K_band)
+    return (2.0 * ratio / omega1) * model.K_band

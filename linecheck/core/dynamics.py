@@ -50,9 +50,9 @@ class Newmark:
         return 4.0 / self.dt  # 1/(beta dt)
 
 
-def _factor(K_band: np.ndarray, diag_add: np.ndarray, what: str) -> np.ndarray:
-    """Banded Cholesky of K + diag(diag_add); NumericalError if not positive definite."""
-    ab = K_band.copy()
+def _factor(K_band: np.ndarray, diag_add: np.ndarray, what: str, band_add: np.ndarray | None = None) -> np.ndarray:
+    """Banded Cholesky of K + band_add + diag(diag_add); NumericalError if not positive definite."""
+    ab = K_band.copy() if band_add is None else K_band + band_add
     ab[-1] += diag_add
     c, info = _dpbtrf(ab, lower=0, overwrite_ab=1)
     if info != 0:
@@ -101,8 +101,9 @@ def integrate(
 
     Args:
         models: linear models of the mean states, length n_k (all with the same DOF map).
-        damping: [N s/m] viscous damping per DOF for every mean state, shape (n_k, n_dof)
-            (paper Eq. 9 puts c_a,i on the transverse DOF; see :mod:`linecheck.core.damping`).
+        damping: [N s/m] damping matrix of every mean state in upper band storage, shape
+            (n_k, BANDWIDTH + 1, n_dof) (see :mod:`linecheck.core.damping`); when it is
+            diagonal (paper Eq. 9) the product C u' is a vector multiply.
         state_of_step: index into ``models`` in force at every step, shape (n_steps,).
         loads: [N] fluctuating transverse (y) loads on the free nodes, shape
             (n_steps, n_free_nodes, n_real) (paper Eq. 5).
@@ -180,11 +181,11 @@ def integrate(
         key = int(state_of_step[n]) if weights is None else n
         if key != current:
             Kb, cd, G = mats(n)
-            chat = _factor(Kb, a1 * cd + a0 * mass, f"effective stiffness at step {n}")
-            cvec = cd[:, None]
+            chat = _factor(Kb, a0 * mass, f"effective stiffness at step {n}", band_add=a1 * cd)
+            cmul = _band_multiplier(cd)
             current = key
         # K_hat u_{n+1} = F_{n+1} + M (a0 u + a2 v + a) + C (a1 u + v)   (Bathe Table 9.3)
-        rhs = mcol * (a0 * U + a2 * V + A) + cvec * (a1 * U + V)
+        rhs = mcol * (a0 * U + a2 * V + A) + cmul(a1 * U + V)
         rhs[ydof] += loads[n]
         U_new = _solve(chat, rhs)
         A_new = a0 * (U_new - U) - a2 * V - A
@@ -208,3 +209,16 @@ def integrate(
         background=np.moveaxis(R_B.reshape(shape), -1, 0),
     )
 
+
+
+def _band_multiplier(c_band: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+    """x -> C x for a symmetric upper-band matrix C (vector multiply when C is diagonal)."""
+    if not np.any(c_band[:-1]):
+        d = c_band[-1][:, None]
+        return lambda x: d * x
+    from scipy.sparse import csr_matrix
+
+    from .model import band_to_dense
+
+    C = csr_matrix(band_to_dense(c_band))
+    return lambda x: C @ x

@@ -39,7 +39,7 @@ import numpy as np
 from scipy.linalg import eig, lapack, solve_banded
 
 from .errors import NumericalError
-from .model import BANDWIDTH, LinearModel, reaction_matrix_direct
+from .model import BANDWIDTH, LinearModel, band_to_dense, reaction_matrix_direct
 from .wind.turbulence import von_karman_cumulative, von_karman_psd
 
 EULER_GAMMA = 0.5772156649
@@ -61,46 +61,52 @@ def peak_factor(nu: np.ndarray | float, duration: float) -> np.ndarray:
 # --------------------------------------------------------------------------- complex modes
 @dataclass(frozen=True)
 class ComplexModes:
-    """Damped modes of M u'' + C u' + K u = 0 (state-space eigenproblem).
+    """Damped modes of M u'' + C u' + K u = 0 (state-space eigenproblem), Im(lambda) > 0.
 
     Attributes:
         frequencies_hz: [Hz] undamped-equivalent natural frequency |lambda|/(2 pi), (n,).
         damping_ratio: [-] zeta = -Re(lambda)/|lambda|, (n,).
-        poles: complex eigenvalues lambda with Im > 0, (n,).
+        poles: complex eigenvalues lambda, (n,).
+        right, left: state eigenvectors psi_k, chi_k as columns, (2 n_dof, n), or None.
     """
 
     frequencies_hz: np.ndarray
     damping_ratio: np.ndarray
     poles: np.ndarray
+    right: np.ndarray | None = None
+    left: np.ndarray | None = None
 
 
-def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None = None) -> ComplexModes:
-    """Eigenvalues of the first-order form [[0, I], [-M^-1 K, -M^-1 C]] (sorted by frequency).
+def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None = None,
+                  vectors: bool = False) -> ComplexModes:
+    """Eigenvalues (and eigenvectors) of [[0, I], [-M^-1 K, -M^-1 C]], sorted by frequency.
 
     Args:
-        damping: [N s/m] viscous damping per DOF (diagonal C), shape (n_dof,), or a full
-            (n_dof, n_dof) matrix.
-        max_hz: keep only modes below this frequency.
+        damping: [N s/m] damping matrix in upper band storage (BANDWIDTH + 1, n_dof).
+        max_hz: keep only modes below this frequency [Hz].
+        vectors: also return right and left eigenvectors.
     """
     K = model.K_dense
     n = K.shape[0]
     minv = 1.0 / model.mass
-    C = np.diag(damping) if damping.ndim == 1 else damping
+    C = band_to_dense(damping)
     A = np.zeros((2 * n, 2 * n))
     A[:n, n:] = np.eye(n)
     A[n:, :n] = -minv[:, None] * K
     A[n:, n:] = -minv[:, None] * C
-    lam = eig(A, right=False)
-    lam = lam[lam.imag > 1e-12]
-    w = np.abs(lam)
-    order = np.argsort(w)
-    lam, w = lam[order], w[order]
-    f = w / (2 * np.pi)
-    zeta = -lam.real / w
+    if vectors:
+        lam, vl, vr = eig(A, left=True, right=True)
+    else:
+        lam, vl, vr = eig(A, right=False), None, None
+    keep = lam.imag > 1e-12
     if max_hz is not None:
-        keep = f <= max_hz
-        lam, f, zeta = lam[keep], f[keep], zeta[keep]
-    return ComplexModes(f, zeta, lam)
+        keep &= np.abs(lam) / (2 * np.pi) <= max_hz
+    idx = np.flatnonzero(keep)
+    idx = idx[np.argsort(np.abs(lam[idx]))]
+    lam = lam[idx]
+    w = np.abs(lam)
+    return ComplexModes(w / (2 * np.pi), -lam.real / w, lam,
+                        None if vr is None else vr[:, idx], None if vl is None else vl[:, idx])
 
 
 def frequency_grid(f_lo: float, f_hi: float, modes: ComplexModes, *, n_log: int = 400, n_peak: int = 33,
@@ -184,12 +190,13 @@ def random_vibration(
     duration: float,
     band: tuple[float, float],
     zero_mean_tol: float,
+    modes: ComplexModes | None = None,
 ) -> SpectralEstimate:
     """Estimate 1: exact linear random vibration of ``model`` (see module docstring).
 
     Args:
         model: linear model of the (synoptic) mean state.
-        damping: [N s/m] damping per DOF, shape (n_dof,).
+        damping: [N s/m] damping matrix in upper band storage, shape (BANDWIDTH + 1, n_dof).
         load_per_v: [N s/m] a_i = rho C_d D L_i V_i at every global node, shape (n_nodes,).
         mean_reaction: [N] wind-induced mean reactions at ``tower``, shape (3,).
         tower: 0-based tower index.
@@ -198,6 +205,8 @@ def random_vibration(
         duration: [s] record length T for the peak factor.
         band: [Hz] integration band (f_lo, f_hi).
         zero_mean_tol: [N] a mean below this has no gust factor.
+        modes: complex modes of the same model and damping (computed if not given); they
+            place the refined frequency points.
     """
     system = model.system
     n_dof = model.mass.size
@@ -213,12 +222,15 @@ def random_vibration(
     tB = Dt.astype(complex).copy()
     tB[:, free] += xB[ydof].T
 
-    modes = complex_modes(model, damping, max_hz=band[1] * 1.5)
+    if modes is None:
+        modes = complex_modes(model, damping, max_hz=band[1] * 1.5)
     f = frequency_grid(band[0], band[1], modes)
     # LAPACK zgbsv storage: kl extra rows on top of the general band (rows kl .. 2kl+ku)
     kl = BANDWIDTH
     base = np.zeros((kl + K_gen.shape[0], n_dof), dtype=complex)
     base[kl:] = K_gen
+    cbase = np.zeros_like(base)
+    cbase[kl:] = _general_band(damping)
     mrow = kl + BANDWIDTH  # main diagonal row
     rhs0 = np.asfortranarray(Gt.T.astype(complex))
     tF = np.empty((f.size, 3, system.n_nodes), dtype=complex)
@@ -226,8 +238,8 @@ def random_vibration(
     zgbsv = lapack.zgbsv
     for k, fk in enumerate(f):
         w = 2 * np.pi * fk
-        ab = base.copy()
-        ab[mrow] += -(w**2) * model.mass + 1j * w * damping  # K - w^2 M + i w C (M, C diagonal)
+        ab = base + (1j * w) * cbase  # K - w^2 M + i w C
+        ab[mrow] -= w**2 * model.mass
         _, _, x, info = zgbsv(kl, kl, ab, rhs0, overwrite_ab=1)
         if info != 0:
             raise NumericalError(f"dynamic stiffness singular at {fk:.6g} Hz (LAPACK zgbsv info {info})")
@@ -335,3 +347,91 @@ def davenport_gust_factor(
     gf_asce = 1 + 2.7 * Ew * np.sqrt(Bw)
     return DavenportEstimate(B, R, g, f1, float(zeta), float(gf_dy), float(gf_qs),
                              float((gf_dy - gf_qs) / gf_dy), float(gf_asce))
+
+
+# --------------------------------------------------------------------------- modal significance
+@dataclass(frozen=True)
+class ModalContribution:
+    """Resonant contribution of every damped (complex) mode to the reactions at one tower.
+
+    Attributes:
+        frequencies_hz: [Hz] |lambda_k| / 2 pi, (n_modes,); damping_ratio: [-] -Re(lambda)/|lambda|;
+        decay_rate: [1/s] -Re(lambda_k) (a transient decays as exp(-rate t));
+        rms: [N] single-mode resonant r.m.s. contribution to (R_x, R_y, R_z), shape (n_modes, 3);
+        rms_background: [N] background r.m.s. of (R_x, R_y, R_z), shape (3,).
+    """
+
+    frequencies_hz: np.ndarray
+    damping_ratio: np.ndarray
+    decay_rate: np.ndarray
+    rms: np.ndarray
+    rms_background: np.ndarray
+
+    def significant(self, fraction: float = 0.01) -> np.ndarray:
+        """Modes whose contribution exceeds ``fraction`` of the largest background r.m.s., (n_modes,) bool."""
+        scale = float(np.max(self.rms_background))
+        return self.rms.max(axis=1) > fraction * scale
+
+
+def modal_contributions(
+    model: LinearModel,
+    modes: ComplexModes,
+    load_per_v: np.ndarray,
+    tower: int,
+    *,
+    sigma: float,
+    length_scale: float,
+    v_mean: float,
+    coherence_decay: float,
+    max_hz: float = 2.0,
+) -> ModalContribution:
+    """Single-mode estimate of every complex mode's stationary resonant contribution.
+
+    State form x' = A x + b, x = (u, u'), A = [[0, I], [-M^-1 K, -M^-1 C]], b = (0, M^-1 f).
+    With right/left eigenvectors psi_k, chi_k the response is
+    x(w) = sum_k psi_k chi_k^H b / ((chi_k^H psi_k)(i w - lambda_k)); treating the load
+    spectrum as locally white, int_0^inf df / |i 2 pi f - lambda|^2 = 1/(2 |Re lambda|), so
+
+        sigma_r,k^2 = |G psi_k^u|^2 S_v(f_k) (c_k^H Coh c_k) / (|chi_k^H psi_k|^2 2 |Re lambda_k|),
+        c_k,i = conj(chi_k^(M^-1 f_y,i)) a_i.
+
+    A mode that neither moves transversely nor is damped transversely is still finite
+    (its excitation and its damping vanish together), which is why near-degenerate,
+    almost undamped modes can matter however small their damping (issue 10).
+
+    Args:
+        modes: complex modes of ``model`` with its damping, computed with ``vectors=True``.
+    """
+    if modes.right is None or modes.left is None:
+        raise ValueError("modal_contributions needs complex modes computed with vectors=True")
+    system = model.system
+    n = model.mass.size
+    minv = 1.0 / model.mass
+    sel = modes.frequencies_hz <= max_hz
+    lam, vl, vr = modes.poles[sel], modes.left[:, sel], modes.right[:, sel]
+    f = modes.frequencies_hz[sel]
+    free = model.dofs.free_nodes
+    ydof = model.dofs.node_dof[free] + 1
+    rows = slice(3 * tower, 3 * tower + 3)
+    norm = np.abs(np.einsum("ik,ik->k", vl.conj(), vr))  # |chi^H psi|
+    r = model.G[rows] @ vr[:n]  # (3, n_modes)
+    cvec = np.zeros((lam.size, system.n_nodes), dtype=complex)
+    cvec[:, free] = (vl[n + ydof].conj() * minv[ydof][:, None]).T * load_per_v[free][None, :]
+    dx = system.line.span_length / system.ne
+    rho = np.exp(-coherence_decay * f * dx / v_mean)
+    SQ = von_karman(f, sigma, length_scale, v_mean) * _quad_kms(cvec, rho)
+    rate = -lam.real
+    with np.errstate(divide="ignore", invalid="ignore"):
+        var = np.where(rate > 0, SQ / (norm**2 * 2 * rate), np.inf)
+    rms = np.abs(r.T) * np.sqrt(var)[:, None]
+    # background r.m.s. by the quasi-static transfer, integrated over the spectrum
+    K_gen = _general_band(model.K_band)
+    xB = solve_banded((BANDWIDTH, BANDWIDTH), K_gen, model.G[rows].T)
+    tB = reaction_matrix_direct(system)[rows].astype(float).copy()
+    tB[:, free] += xB[ydof].T
+    fb = np.geomspace(1e-5, 10.0, 600)
+    rhob = np.exp(-coherence_decay * fb * dx / v_mean)
+    wb = np.broadcast_to((tB * load_per_v[None, :])[None], (fb.size, 3, system.n_nodes)).astype(complex)
+    SB = von_karman(fb, sigma, length_scale, v_mean)[:, None] * _quad_kms(wb, rhob)
+    rms_b = np.sqrt(np.trapezoid(SB, fb, axis=0))
+    return ModalContribution(f, rate / np.abs(lam), rate, rms, rms_b)

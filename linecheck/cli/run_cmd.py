@@ -87,6 +87,9 @@ def run(
     console.print(results_table(doc))
     console.print("[dim]GF ** : mean reaction zero by symmetry (or < 1 % of the largest mean); "
                   "Cont_R = share of the peak that a quasi-static analysis misses.[/]")
+    from .spectral_cmd import print_sanity
+
+    print_sanity(doc)
     if json_out is not None:
         write_json(json_out, doc)
         console.print(f"wrote {json_out}")

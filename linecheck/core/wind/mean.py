@@ -5,19 +5,82 @@ Contract used by the solver steps:
 ``mean_wind(case, system, times)`` returns a :class:`MeanWind` with the
 running-mean velocity components at the still-air FE node positions of every span
 (normal to the line, +y, and along it, +x) at the requested instants.
+``event_window(case)`` gives the analysed time window [s].
+
+Synoptic wind: V_ref (or ``span_speeds``) uniform along each span, constant in time.
+
+Downburst wind (issue 3; the paper used the CFD field of Hangan & Kim 2007, which is
+not public, so linecheck ships an analytic stationary impinging-jet model and lets
+users load their own table).  The horizontal outflow is radial from the centre:
+
+    V(r, z, t) = V_max * f_r(r) * f_z(z) * Pi(t)                      (issue 3)
+
+    f_r(r) = r / r_max                          r <= r_max     (Holmes & Oliver 2000)
+           = exp(-((r - r_max) / R_r)^2)        r >  r_max
+    f_z(z) = 1.55 (z/delta)^(1/6) [1 - erf(0.70 z/delta)]         (Wood et al. 2001)
+    Pi(t)  = t / T1                              t <= T1   (Chay, Albermani & Wilson 2006)
+           = exp(-(t - T1) / c),  c = (T_f - T1) / ln 10   t > T1
+
+with an optional storm translation added as a vector (Holmes & Oliver 2000).
+Geometry (paper Fig. 2): x along the line, the tower of interest at x_T, y = 0
+along the line, the centre at (x_T + R sin(Theta), -R cos(Theta)) at the reference
+instant, so the outflow at Theta = 0 blows toward +y.  Point p is the point of
+the (unbounded) line nearest that centre; V_max is scaled so that the maximum over
+the analysed window of the running-mean speed at p, at the conductor height,
+equals V_ref (paper section 2.1).  See ``docs/wind.md`` for the defaults and why.
+
+A user table (``[wind.downburst] field = "file.csv"`` or ``.npz``) replaces
+f_r(r) f_z(z) Pi(t) by a radial velocity on an (r/D_j, z/D_j, t) grid,
+interpolated linearly and scaled the same way.  Nothing here prints.
 """
 
 from __future__ import annotations
 
+import csv
+import math
 from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
+from scipy.interpolate import RegularGridInterpolator
+from scipy.optimize import brentq, minimize_scalar
+from scipy.special import erf
 
-from ..case import Case
+from ..case import Case, Downburst
 from ..errors import CaseError
 from ..system import LineSystem
 
+# ------------------------------------------------------------------------- constants
+R_MAX_OVER_DJ = 1.2  # r_max = 1.2 D_j: radius of peak outflow of Kim & Hangan (2007), = paper's Db_y R
+RADIAL_DECAY_OVER_DJ = 0.5  # R_r = D_j / 2 (issue 3 default; Holmes & Oliver 2000 decay length)
+Z_MAX_OVER_DJ = 0.025  # z_max = 0.025 D_j (Wood et al. 2001 / Hangan & Kim 2007 jet scale)
+# Lubbock-Reese rear-flank downdraft of 4 June 2002 (Holmes et al. 2008): running mean rose to its
+# peak in about two minutes and the event was analysed as a ten-minute record.  See docs/wind.md.
+T1_DEFAULT = 120.0  # [s]
+T_F_DEFAULT = 600.0  # [s]
+SYNOPTIC_DURATION_DEFAULT = 600.0  # [s] ten-minute record (standard averaging period)
 
+# Wood et al. (2001): f_z peaks at z/delta = ETA_PEAK (root of d f_z / d z = 0, computed below)
+_WOOD_A, _WOOD_B = 1.55, 0.70
+
+
+def _wood(eta: np.ndarray | float) -> np.ndarray:
+    eta = np.maximum(np.asarray(eta, dtype=float), 0.0)
+    # Wood, Kwok, Motteram & Fletcher (2001), J. Wind Eng. Ind. Aerodyn. 89: V/V_max
+    return _WOOD_A * eta ** (1.0 / 6.0) * (1.0 - erf(_WOOD_B * eta))
+
+
+def _wood_peak() -> float:
+    res = minimize_scalar(lambda e: -float(_wood(e)), bounds=(1e-6, 2.0), method="bounded",
+                          options={"xatol": 1e-13})
+    return float(res.x)
+
+
+ETA_PEAK = _wood_peak()  # ~0.1836: z_max = ETA_PEAK * delta
+
+
+# ------------------------------------------------------------------------- MeanWind
 @dataclass(frozen=True)
 class MeanWind:
     """Running-mean wind at the FE nodes.
@@ -44,12 +107,633 @@ def synoptic_span_speeds(case: Case) -> np.ndarray:
     return np.asarray(case.wind.span_speeds, dtype=float)
 
 
+# ------------------------------------------------------------------------- profiles
+def radial_profile(r: np.ndarray | float, r_max: float, radial_decay: float) -> np.ndarray:
+    """f_r(r) [-] of Holmes & Oliver (2000): r/r_max inside r_max, Gaussian decay beyond.
+
+    r [m] any shape; r_max, radial_decay [m].  Peak 1 at r = r_max.
+    """
+    r = np.abs(np.asarray(r, dtype=float))
+    # Holmes & Oliver (2000) Eq. 1-2: linear growth, then exp(-((r - r_max)/R_r)^2)
+    return np.where(r <= r_max, r / r_max, np.exp(-(((r - r_max) / radial_decay) ** 2)))
+
+
+def wood_delta(z_max: float) -> float:
+    """delta [m] of the Wood et al. (2001) profile from the height z_max [m] of peak outflow.
+
+    Wood et al. write f_z in terms of delta, the height (above the peak) where the speed is
+    half its maximum; f_z peaks at z/delta = ETA_PEAK ~ 0.1836, so delta = z_max / ETA_PEAK.
+    """
+    return z_max / ETA_PEAK
+
+
+def vertical_profile(z: np.ndarray | float, delta: float) -> np.ndarray:
+    """f_z(z) [-] = 1.55 (z/delta)^(1/6) [1 - erf(0.70 z/delta)] (Wood et al. 2001); z, delta [m].
+
+    Its maximum is 1.00001 at z = ETA_PEAK delta; f_z(delta) = 0.4994 (half the peak).
+    """
+    return _wood(np.asarray(z, dtype=float) / delta)
+
+
+def intensity(t: np.ndarray | float, t1: float, t_f: float) -> np.ndarray:
+    """Pi(t) [-] of Chay, Albermani & Wilson (2006): linear rise to 1 at T1, exponential decay.
+
+    t, t1, t_f [s]; Pi(T_f) = 0.1; Pi = 0 for t < 0.
+    """
+    t = np.asarray(t, dtype=float)
+    c = (t_f - t1) / math.log(10.0)  # Chay et al. (2006): decay constant, Pi(T_f) = 0.1
+    rise = np.clip(t / t1, 0.0, None)
+    # Chay et al. (2006): t/T1 for t <= T1, exp(-(t - T1)/c) after
+    return np.where(t <= t1, rise, np.exp(-np.maximum(t - t1, 0.0) / c))
+
+
+# ------------------------------------------------------------------------- user field tables
+FIELD_COLUMNS = ("r_over_dj", "z_over_dj", "t", "v_radial", "v_vertical")
+_REQUIRED_COLUMNS = FIELD_COLUMNS[:4]
+_ALLOWED_TEXT = "r_over_dj, z_over_dj, t, v_radial and optionally v_vertical"
+
+
+@dataclass(frozen=True, eq=False)
+class FieldTable:
+    """A user running-mean field on a rectilinear (r/D_j, z/D_j, t) grid (see docs/wind.md).
+
+    Attributes:
+        path: the file read.
+        r: [-] r/D_j axis, strictly increasing, shape (n_r,), n_r >= 2.
+        z: [-] z/D_j axis, strictly increasing, shape (n_z,), n_z >= 1 (1: no height variation).
+        t: [s] time axis, strictly increasing, shape (n_t,), n_t >= 2.
+        radial: [any unit, rescaled] radial (outward) velocity, shape (n_r, n_z, n_t).
+        vertical: [same unit] vertical velocity (upward) or None, shape (n_r, n_z, n_t).
+    """
+
+    path: Path
+    r: np.ndarray
+    z: np.ndarray
+    t: np.ndarray
+    radial: np.ndarray
+    vertical: np.ndarray | None
+
+
+def _field_error(path: Path, message: str, line: int | None = None) -> CaseError:
+    return CaseError(message, file=str(path), line=line)
+
+
+def _grid_from_rows(path: Path, cols: dict[str, np.ndarray], lines: np.ndarray) -> FieldTable:
+    """Assemble the grid from CSV rows; every (r, z, t) combination exactly once."""
+    axes = {}
+    idx = {}
+    for name in ("r_over_dj", "z_over_dj", "t"):
+        values, inverse = np.unique(cols[name], return_inverse=True)
+        axes[name], idx[name] = values, inverse
+    n_r, n_z, n_t = (axes[k].size for k in ("r_over_dj", "z_over_dj", "t"))
+    _check_axes(path, axes["r_over_dj"], axes["z_over_dj"], axes["t"])
+    flat = (idx["r_over_dj"] * n_z + idx["z_over_dj"]) * n_t + idx["t"]
+    seen = np.full(n_r * n_z * n_t, -1, dtype=np.int64)
+    order = np.argsort(flat, kind="stable")
+    sorted_flat = flat[order]
+    dup = np.nonzero(sorted_flat[1:] == sorted_flat[:-1])[0]
+    if dup.size:
+        first, again = order[dup[0]], order[dup[0] + 1]
+        raise _field_error(
+            path, f"row repeats the grid point (r_over_dj, z_over_dj, t) = ({cols['r_over_dj'][again]:g}, "
+            f"{cols['z_over_dj'][again]:g}, {cols['t'][again]:g}) of line {int(lines[first])}: "
+            "each grid point must appear exactly once", line=int(lines[again]))
+    seen[flat] = np.arange(flat.size)
+    missing = np.nonzero(seen < 0)[0]
+    if missing.size:
+        m = int(missing[0])
+        ir, rest = divmod(m, n_z * n_t)
+        iz, it = divmod(rest, n_t)
+        raise _field_error(
+            path, f"grid point (r_over_dj, z_over_dj, t) = ({axes['r_over_dj'][ir]:g}, {axes['z_over_dj'][iz]:g}, "
+            f"{axes['t'][it]:g}) is missing: the rows must fill the full rectilinear grid "
+            f"({n_r} r x {n_z} z x {n_t} t = {n_r * n_z * n_t} rows, found {flat.size})")
+    shape = (n_r, n_z, n_t)
+    radial = np.empty(n_r * n_z * n_t)
+    radial[flat] = cols["v_radial"]
+    vertical = None
+    if "v_vertical" in cols:
+        vertical = np.empty(n_r * n_z * n_t)
+        vertical[flat] = cols["v_vertical"]
+        vertical = vertical.reshape(shape)
+    return FieldTable(path, axes["r_over_dj"], axes["z_over_dj"], axes["t"], radial.reshape(shape), vertical)
+
+
+def _check_axes(path: Path, r: np.ndarray, z: np.ndarray, t: np.ndarray) -> None:
+    if r.size < 2:
+        raise _field_error(path, f"column r_over_dj has {r.size} distinct value(s): expected at least 2")
+    if t.size < 2:
+        raise _field_error(path, f"column t has {t.size} distinct value(s): expected at least 2")
+    if z.size < 1:
+        raise _field_error(path, "column z_over_dj has no values: expected at least 1")
+    if r[0] < 0:
+        raise _field_error(path, f"column r_over_dj has value {r[0]:g}: expected r_over_dj >= 0")
+    if z[0] < 0:
+        raise _field_error(path, f"column z_over_dj has value {z[0]:g}: expected z_over_dj >= 0")
+
+
+def _read_csv(path: Path) -> FieldTable:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise _field_error(path, "not a UTF-8 text file: expected a CSV running-mean field (see docs/wind.md)") from None
+    except OSError as exc:
+        raise _field_error(path, f"cannot read field file: {exc.strerror}") from None
+    header: list[str] | None = None
+    header_line = 0
+    rows: list[list[float]] = []
+    lines: list[int] = []
+    for lineno, raw in enumerate(text.splitlines(), start=1):
+        s = raw.strip()
+        if not s or s.startswith("#"):
+            continue
+        fields = [f.strip() for f in next(csv.reader([s]))]
+        if header is None:
+            header, header_line = fields, lineno
+            for k, name in enumerate(fields, start=1):
+                if name not in FIELD_COLUMNS:
+                    raise _field_error(path, f'header column {k} "{name}" is not allowed: expected {_ALLOWED_TEXT}',
+                                       line=lineno)
+                if fields.count(name) > 1:
+                    raise _field_error(path, f'header column "{name}" appears twice: expected each of {_ALLOWED_TEXT} once',
+                                       line=lineno)
+            for name in _REQUIRED_COLUMNS:
+                if name not in fields:
+                    raise _field_error(path, f'header has no column "{name}": expected {_ALLOWED_TEXT}', line=lineno)
+            continue
+        if len(fields) != len(header):
+            raise _field_error(path, f"row has {len(fields)} values: expected {len(header)} ({', '.join(header)})",
+                               line=lineno)
+        row = []
+        for name, value in zip(header, fields):
+            try:
+                v = float(value)
+            except ValueError:
+                raise _field_error(path, f'column "{name}": value "{value}" is not a number: expected a finite number',
+                                   line=lineno) from None
+            if not math.isfinite(v):
+                raise _field_error(path, f'column "{name}": value "{value}" is not allowed: expected a finite number',
+                                   line=lineno)
+            if name in ("r_over_dj", "z_over_dj") and v < 0:
+                raise _field_error(path, f'column "{name}": value {value} is out of range: expected {name} >= 0',
+                                   line=lineno)
+            row.append(v)
+        rows.append(row)
+        lines.append(lineno)
+    if header is None:
+        raise _field_error(path, f"no header line: expected a header with {_ALLOWED_TEXT}")
+    if not rows:
+        raise _field_error(path, "header but no data rows: expected one row per (r_over_dj, z_over_dj, t) grid point",
+                           line=header_line)
+    data = np.asarray(rows, dtype=float)
+    cols = {name: data[:, k] for k, name in enumerate(header)}
+    return _grid_from_rows(path, cols, np.asarray(lines))
+
+
+def _read_npz(path: Path) -> FieldTable:
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            arrays = {k: np.asarray(npz[k]) for k in npz.files}
+    except (OSError, ValueError) as exc:
+        raise _field_error(path, f"not a readable NPZ file ({exc}): expected arrays {_ALLOWED_TEXT}") from None
+    for name in arrays:
+        if name not in FIELD_COLUMNS:
+            raise _field_error(path, f'array "{name}" is not allowed: expected {_ALLOWED_TEXT}')
+    for name in _REQUIRED_COLUMNS:
+        if name not in arrays:
+            raise _field_error(path, f'array "{name}" is missing: expected {_ALLOWED_TEXT}')
+    axes = []
+    for name in ("r_over_dj", "z_over_dj", "t"):
+        a = arrays[name]
+        if a.ndim != 1 or not np.issubdtype(a.dtype, np.number):
+            raise _field_error(path, f'array "{name}" has shape {a.shape}: expected a 1-D array of numbers')
+        a = a.astype(float)
+        if not np.all(np.isfinite(a)):
+            raise _field_error(path, f'array "{name}" has a non-finite value: expected finite numbers')
+        if a.size > 1 and not np.all(np.diff(a) > 0):
+            k = int(np.nonzero(np.diff(a) <= 0)[0][0]) + 1
+            raise _field_error(path, f'array "{name}" entry {k} ({a[k]:g}) is not above the previous one: '
+                               "expected strictly increasing values")
+        axes.append(a)
+    r, z, t = axes
+    _check_axes(path, r, z, t)
+    shape = (r.size, z.size, t.size)
+    out = {}
+    for name in ("v_radial", "v_vertical"):
+        if name not in arrays:
+            continue
+        a = arrays[name]
+        if a.shape != shape or not np.issubdtype(a.dtype, np.number):
+            raise _field_error(path, f'array "{name}" has shape {a.shape}: expected numbers of shape '
+                               f"(len(r_over_dj), len(z_over_dj), len(t)) = {shape}")
+        a = a.astype(float)
+        if not np.all(np.isfinite(a)):
+            i = tuple(int(v) for v in np.argwhere(~np.isfinite(a))[0])
+            raise _field_error(path, f'array "{name}" entry {i} is not finite: expected finite numbers')
+        out[name] = a
+    return FieldTable(path, r, z, t, out["v_radial"], out.get("v_vertical"))
+
+
+@lru_cache(maxsize=16)
+def _load_cached(path: str, mtime_ns: int, size: int) -> FieldTable:
+    p = Path(path)
+    suffix = p.suffix.lower()
+    if suffix == ".csv":
+        return _read_csv(p)
+    if suffix == ".npz":
+        return _read_npz(p)
+    raise _field_error(p, f'file type "{p.suffix}" is not allowed: expected a .csv or .npz running-mean field '
+                       "(see docs/wind.md)")
+
+
+def load_field_table(path: str | Path) -> FieldTable:
+    """Read and validate a user running-mean field (CSV or NPZ; format in ``docs/wind.md``).
+
+    Raises :class:`CaseError` with one line naming the file, the line/column or array and
+    what is allowed.  Results are cached per (path, modification time, size).
+    """
+    p = Path(path)
+    try:
+        st = p.stat()
+    except FileNotFoundError:
+        raise _field_error(p, "field file not found (expected a CSV or NPZ running-mean field, see docs/wind.md)") from None
+    except OSError as exc:
+        raise _field_error(p, f"cannot read field file: {exc.strerror}") from None
+    if not p.is_file():
+        raise _field_error(p, "is not a file: expected a CSV or NPZ running-mean field")
+    return _load_cached(str(p.resolve()), st.st_mtime_ns, st.st_size)
+
+
+# ------------------------------------------------------------------------- downburst field
+@dataclass(frozen=True, eq=False)
+class DownburstField:
+    """A scaled downburst running-mean field along the line (paper Fig. 2 geometry).
+
+    All positions in the line frame of :class:`LineSystem` (x along the line from tower 1,
+    y transverse, wind toward +y at Theta = 0).
+
+    Attributes:
+        jet_diameter: [m] D_j.
+        height: [m] conductor height z where the field is evaluated.
+        centre: [m] (x, y) of the downburst centre at ``t_ref``.
+        t_ref: [s] instant at which the centre is at (R, Theta) (analytic: T1; table: its peak).
+        translation: [m/s] (v_x, v_y) storm translation velocity (Holmes & Oliver 2000).
+        v_max: [m/s per unit of shape] scale factor V_max found from V_ref at p.
+        point_p: [m] x of point p, the line point nearest ``centre``.
+        window: [s] (t_start, t_end) analysed window.
+        r_max, radial_decay, z_max, delta: [m] analytic profile parameters (NaN for a table).
+        t1, t_f: [s] intensity-function times (NaN for a table).
+        table: the user :class:`FieldTable`, or None for the analytic model.
+    """
+
+    jet_diameter: float
+    height: float
+    centre: tuple[float, float]
+    t_ref: float
+    translation: tuple[float, float]
+    v_max: float
+    point_p: float
+    window: tuple[float, float]
+    r_max: float = math.nan
+    radial_decay: float = math.nan
+    z_max: float = math.nan
+    delta: float = math.nan
+    t1: float = math.nan
+    t_f: float = math.nan
+    table: FieldTable | None = None
+
+    # -- model pieces
+    def centre_at(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Centre position [m] at times t [s] (any shape): c(t_ref) + v_T (t - t_ref)."""
+        t = np.asarray(t, dtype=float)
+        dt = t - self.t_ref
+        return self.centre[0] + self.translation[0] * dt, self.centre[1] + self.translation[1] * dt
+
+    def shape(self, r: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Radial speed per unit V_max [-] at radius r [m] and time t [s] (broadcast shapes)."""
+        r, t = np.broadcast_arrays(np.asarray(r, dtype=float), np.asarray(t, dtype=float))
+        if self.table is None:
+            # issue 3: V = V_max f_r(r) f_z(z) Pi(t)
+            return (radial_profile(r, self.r_max, self.radial_decay)
+                    * float(vertical_profile(self.height, self.delta)) * intensity(t, self.t1, self.t_f))
+        return _table_slice(self.table, self.height / self.jet_diameter)(r / self.jet_diameter, t, self.table.path)
+
+    def velocity(self, x: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Running-mean velocity (v_x, v_y) [m/s] at line points x [m] (y = 0, z = height).
+
+        x shape (n_x,), t shape (n_t,) -> two arrays of shape (n_t, n_x).  Radial outflow
+        plus the translation velocity (vector sum, Holmes & Oliver 2000).
+        """
+        x = np.asarray(x, dtype=float)[None, :]
+        t = np.asarray(t, dtype=float)[:, None]
+        cx, cy = self.centre_at(t)
+        dx, dy = x - cx, 0.0 - cy
+        r = np.hypot(dx, dy)
+        speed = self.v_max * self.shape(r, t)
+        safe = np.where(r > 0.0, r, 1.0)
+        # Holmes & Oliver (2000): vector sum of the radial outflow and the translation velocity
+        vx = np.where(r > 0.0, speed * dx / safe, 0.0) + self.translation[0]
+        vy = np.where(r > 0.0, speed * dy / safe, 0.0) + self.translation[1]
+        return vx, vy
+
+    def vertical_velocity(self, x: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Table vertical velocity [m/s] (same scaling as the radial one), shape (n_t, n_x);
+        zeros for the analytic model or a table without ``v_vertical``.  Not used by the
+        loads (paper section 3, Step 1: the vertical component is neglected)."""
+        x = np.asarray(x, dtype=float)[None, :]
+        t = np.asarray(t, dtype=float)[:, None]
+        if self.table is None or self.table.vertical is None:
+            return np.zeros(np.broadcast_shapes(x.shape, t.shape))
+        cx, cy = self.centre_at(t)
+        r = np.hypot(x - cx, cy)
+        interp = _table_slice(self.table, self.height / self.jet_diameter, vertical=True)
+        return self.v_max * interp(r / self.jet_diameter, np.broadcast_to(t, r.shape), self.table.path)
+
+
+class _SliceInterpolator:
+    """Bilinear (r/D_j, t) interpolation of a table at one height (trilinear overall)."""
+
+    def __init__(self, r: np.ndarray, t: np.ndarray, values: np.ndarray) -> None:
+        self.r, self.t = r, t
+        self.rgi = RegularGridInterpolator((r, t), values, method="linear", bounds_error=False, fill_value=None)
+
+    def __call__(self, rr: np.ndarray, tt: np.ndarray, path: Path) -> np.ndarray:
+        rr, tt = np.broadcast_arrays(rr, tt)
+        tol_r = 1e-9 * max(1.0, abs(self.r[-1]))
+        tol_t = 1e-9 * max(1.0, abs(self.t[-1]))
+        if rr.size:
+            lo, hi = float(rr.min()), float(rr.max())
+            if lo < self.r[0] - tol_r or hi > self.r[-1] + tol_r:
+                raise _field_error(path, f"the line reaches r/D_j from {lo:.4g} to {hi:.4g} but the table covers "
+                                   f"r_over_dj {self.r[0]:g} to {self.r[-1]:g}: extend the table")
+            lo, hi = float(tt.min()), float(tt.max())
+            if lo < self.t[0] - tol_t or hi > self.t[-1] + tol_t:
+                raise _field_error(path, f"times {lo:.6g} to {hi:.6g} s are needed but the table covers t "
+                                   f"{self.t[0]:g} to {self.t[-1]:g} s: extend the table or shorten analysis.duration")
+        pts = np.stack([np.clip(rr, self.r[0], self.r[-1]).ravel(), np.clip(tt, self.t[0], self.t[-1]).ravel()], axis=-1)
+        return self.rgi(pts).reshape(rr.shape)
+
+
+@lru_cache(maxsize=32)
+def _table_slice_cached(table: FieldTable, z: float, vertical: bool) -> _SliceInterpolator:
+    values = table.vertical if vertical else table.radial
+    if table.z.size == 1:
+        sl = values[:, 0, :]
+    else:
+        if z < table.z[0] - 1e-12 or z > table.z[-1] + 1e-12:
+            raise _field_error(table.path, f"the conductor height is z/D_j = {z:.4g} but the table covers z_over_dj "
+                               f"{table.z[0]:g} to {table.z[-1]:g}: extend the table")
+        rgi = RegularGridInterpolator((table.r, table.z, table.t), values, method="linear")
+        rr, tt = np.meshgrid(table.r, table.t, indexing="ij")
+        zz = np.full_like(rr, min(max(z, table.z[0]), table.z[-1]))
+        sl = rgi(np.stack([rr, zz, tt], axis=-1))
+    return _SliceInterpolator(table.r, table.t, sl)
+
+
+def _table_slice(table: FieldTable, z: float, vertical: bool = False) -> _SliceInterpolator:
+    return _table_slice_cached(table, float(z), vertical)
+
+
+def _downburst(case: Case) -> Downburst:
+    if case.wind.type != "downburst" or case.wind.downburst is None:
+        raise CaseError("is not a downburst case (no [wind.downburst] table)", key="wind.type")
+    return case.wind.downburst
+
+
+def _table_of(case: Case) -> FieldTable | None:
+    db = _downburst(case)
+    if db.field is None:
+        return None
+    path = db.field_path if db.field_path is not None else Path(db.field)
+    if db.t1 is not None or db.t_f is not None:
+        raise CaseError("t1/t_f shape the analytic model only: with a field file the table's t axis is the event "
+                        "time history; remove t1 and t_f", file=str(case.source) if case.source else None,
+                        key="wind.downburst.field")
+    return load_field_table(path)
+
+
+def event_window(case: Case) -> tuple[float, float]:
+    """Analysed time window (t_start, t_end) [s].
+
+    Downburst, analytic model: (0, T_f) by default, (0, analysis.duration) when set.
+    Downburst with a field table: the table's t range by default, (t_0, t_0 + duration) when set.
+    Synoptic: (0, analysis.duration), default 600 s.
+    """
+    dur = case.analysis.duration
+    if case.wind.type == "synoptic":
+        return 0.0, float(dur if dur is not None else SYNOPTIC_DURATION_DEFAULT)
+    table = _table_of(case)
+    if table is None:
+        t_f = _downburst(case).t_f if _downburst(case).t_f is not None else T_F_DEFAULT
+        return 0.0, float(dur if dur is not None else t_f)
+    t0, t_last = float(table.t[0]), float(table.t[-1])
+    if dur is None:
+        return t0, t_last
+    if t0 + dur > t_last * (1 + 1e-12) + 1e-12:
+        raise CaseError(f"value {dur!r} is too long for field file {table.path}: its t axis covers {t0:g} to "
+                        f"{t_last:g} s (expected duration <= {t_last - t0:g})",
+                        file=str(case.source) if case.source else None, key="analysis.duration")
+    return t0, t0 + float(dur)
+
+
+def _max_speed_at_p(field: DownburstField, v_max: float, times: np.ndarray) -> tuple[float, float]:
+    """max over t of |V(p, t)| for a trial V_max: grid search then bounded refinement."""
+    f = DownburstField(**{**field.__dict__, "v_max": v_max})
+    xp = np.array([field.point_p])
+
+    def speed(t: np.ndarray) -> np.ndarray:
+        vx, vy = f.velocity(xp, np.atleast_1d(t))
+        return np.hypot(vx, vy)[:, 0]
+
+    s = speed(times)
+    k = int(np.argmax(s))
+    best_t, best = float(times[k]), float(s[k])
+    lo, hi = times[max(k - 1, 0)], times[min(k + 1, times.size - 1)]
+    if hi > lo:
+        res = minimize_scalar(lambda tt: -float(speed(np.array([tt]))[0]), bounds=(lo, hi), method="bounded",
+                              options={"xatol": 1e-9 * max(1.0, abs(hi))})
+        if -res.fun > best:
+            best_t, best = float(res.x), float(-res.fun)
+    return best, best_t
+
+
+def downburst_field(case: Case) -> DownburstField:
+    """Build the scaled downburst running-mean field of a case (analytic or user table).
+
+    Cached per case (and per field-file modification time).  Raises :class:`CaseError`
+    when V_ref cannot be matched at p (centre on the line, translation faster than
+    V_ref, or a table with no outflow at p).
+    """
+    db = _downburst(case)
+    stamp = None
+    if db.field is not None:
+        path = db.field_path if db.field_path is not None else Path(db.field)
+        try:
+            st = path.stat()
+            stamp = (st.st_mtime_ns, st.st_size)
+        except OSError:
+            stamp = None  # load_field_table reports it
+    return _downburst_field_cached(case, stamp)
+
+
+@lru_cache(maxsize=64)
+def _downburst_field_cached(case: Case, stamp: tuple[int, int] | None) -> DownburstField:
+    db = _downburst(case)
+    line = case.line
+    src = str(case.source) if case.source else None
+    dj = db.jet_diameter
+    h = line.height
+    x_toi = (case.line.tower_of_interest - 1) * line.span_length
+    theta = math.radians(db.angle)
+    # paper Fig. 2: centre at distance R, angle Theta from the perpendicular through the tower, upwind (-y)
+    sin_t, cos_t = math.sin(theta), math.cos(theta)
+    # snap round-off of sin/cos at multiples of 90 degrees (e.g. cos(pi/2) = 6e-17)
+    sin_t, cos_t = (0.0 if abs(sin_t) < 1e-12 else sin_t), (0.0 if abs(cos_t) < 1e-12 else cos_t)
+    # (rounded to 1 nm so that, e.g., R sin 30 deg lands on its FE node: 480.0, not 479.99999999999994)
+    centre = (round(x_toi + db.distance * sin_t, 9), round(-db.distance * cos_t, 9) + 0.0)
+    point_p = centre[0]  # foot of the perpendicular from the centre to the line y = 0
+    beta = math.radians(db.translation_direction)
+    translation = (db.translation_speed * math.cos(beta), db.translation_speed * math.sin(beta))
+    if abs(translation[0]) < 1e-15:
+        translation = (0.0, translation[1])
+    if abs(translation[1]) < 1e-15:
+        translation = (translation[0], 0.0)
+    window = event_window(case)
+    table = _table_of(case)
+    if table is None:
+        r_max = db.r_max if db.r_max is not None else R_MAX_OVER_DJ * dj
+        r_dec = db.radial_decay if db.radial_decay is not None else RADIAL_DECAY_OVER_DJ * dj
+        z_max = db.z_max if db.z_max is not None else Z_MAX_OVER_DJ * dj
+        t1 = db.t1 if db.t1 is not None else T1_DEFAULT
+        t_f = db.t_f if db.t_f is not None else T_F_DEFAULT
+        if t_f <= t1:
+            raise CaseError(f"value {t_f!r} is not allowed: expected t_f > t1 = {t1!r} (t1 default {T1_DEFAULT:g} s)",
+                            file=src, key="wind.downburst.t_f")
+        field = DownburstField(dj, h, centre, t1, translation, 1.0, point_p, window, r_max, r_dec, z_max,
+                               wood_delta(z_max), t1, t_f, None)
+        # candidate instants where the stationary speed at p peaks: T1 and the window ends
+        special = np.array([t1, *window])
+    else:
+        z = h / dj
+        sl = _table_slice(table, z)
+        # reference instant: the table's peak radial speed at the conductor height
+        t_ref = float(table.t[int(np.argmax(np.max(np.abs(sl.rgi.values), axis=0)))])
+        field = DownburstField(dj, h, centre, t_ref, translation, 1.0, point_p, window, table=table)
+        special = np.concatenate([table.t, np.array(window)])
+    special = special[(special >= window[0]) & (special <= window[1])]
+    r_p = abs(centre[1])
+    v_ref = case.wind.v_ref
+    if translation == (0.0, 0.0):
+        # stationary centre: |V(p,t)| = V_max |shape(r_p, t)|; its maximum is at T1 or a table instant
+        # (linear interpolation in t) or a window end, so the scaling is exact (issue 3).
+        peak = float(np.max(np.abs(field.shape(np.full(special.size, r_p), special))))
+        if not peak > 0.0:
+            raise CaseError(
+                f"the outflow at point p (x = {point_p:g} m, r = {r_p:g} m from the centre) is zero over the window, "
+                "so V_ref cannot be matched: the centre lies on the line (R cos(Theta) = 0) or the field has no "
+                "outflow there; change distance/angle", file=src, key="wind.downburst")
+        v_max = v_ref / peak  # paper section 2.1: peak running mean at p (conductor height) = V_ref
+    else:
+        if math.hypot(*translation) >= v_ref:
+            raise CaseError(f"value {db.translation_speed!r} is not allowed: the translation speed alone reaches "
+                            f"V_ref = {v_ref:g} m/s at p (expected translation_speed < v_ref)",
+                            file=src, key="wind.downburst.translation_speed")
+        times = np.union1d(np.linspace(window[0], window[1], 4001), special)
+
+        def excess(v: float) -> float:
+            return _max_speed_at_p(field, v, times)[0] - v_ref
+
+        hi = v_ref
+        while excess(hi) < 0.0:
+            hi *= 2.0
+            if hi > 1e6 * v_ref:
+                raise CaseError(f"the outflow at point p (x = {point_p:g} m) is too weak to reach V_ref; change "
+                                "distance/angle", file=src, key="wind.downburst")
+        # the max over t of |affine in V_max| is convex in V_max with value < V_ref at 0: one root
+        v_max = brentq(excess, 0.0, hi, xtol=1e-13 * v_ref, rtol=1e-15, maxiter=200)
+    return DownburstField(**{**field.__dict__, "v_max": float(v_max)})
+
+
+# ------------------------------------------------------------------------- public evaluators
+def span_node_x(system: LineSystem) -> np.ndarray:
+    """Still-air x [m] of each span's FE nodes, shape (n_spans, ne+1)."""
+    L = system.line.span_length
+    return system.tower_x[:-1, None] + system.node_s[None, :] * L
+
+
+def mean_velocity_at(case: Case, x: np.ndarray, time: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Running-mean (longitudinal v_x, normal v_y) [m/s] at line points x [m], times [s].
+
+    x shape (n_x,), time shape (n_t,) -> two arrays (n_t, n_x).  Synoptic: (0, V_ref)
+    everywhere (``span_speeds`` apply only through :func:`mean_wind` and the node helpers).
+    """
+    x = np.atleast_1d(np.asarray(x, dtype=float))
+    time = np.atleast_1d(np.asarray(time, dtype=float))
+    if case.wind.type == "synoptic":
+        shape = (time.size, x.size)
+        return np.zeros(shape), np.full(shape, case.wind.v_ref)
+    return downburst_field(case).velocity(x, time)
+
+
+def point_p(case: Case) -> float:
+    """x [m] of point p: the line point nearest the downburst centre (synoptic: tower of interest)."""
+    if case.wind.type == "synoptic":
+        return (case.line.tower_of_interest - 1) * case.line.span_length
+    return downburst_field(case).point_p
+
+
 def mean_wind(case: Case, system: LineSystem, times: np.ndarray | None = None) -> MeanWind:
-    """Running-mean wind at the FE nodes at ``times`` [s] (synoptic: constant)."""
+    """Running-mean wind at the FE nodes at ``times`` [s].
+
+    Synoptic: constant (``times`` default one instant t = 0).  Downburst: ``times``
+    default ``analysis.mean_states`` instants over :func:`event_window`.
+    """
     if case.wind.type == "synoptic":
         t = np.zeros(1) if times is None else np.asarray(times, dtype=float)
         v = synoptic_span_speeds(case)
         normal = np.broadcast_to(v[:, None], (t.size, system.n_spans, system.ne + 1)).copy()
         p = float(system.tower_x[case.line.tower_of_interest - 1])
         return MeanWind(t, normal, np.zeros_like(normal), p)
-    raise CaseError("downburst running-mean field is not available yet", key="wind.type")
+    if times is None:
+        t0, t1 = event_window(case)
+        t = np.linspace(t0, t1, case.analysis.mean_states)
+    else:
+        t = np.atleast_1d(np.asarray(times, dtype=float))
+    field = downburst_field(case)
+    xs = span_node_x(system)
+    vx, vy = field.velocity(xs.ravel(), t)
+    shape = (t.size, system.n_spans, system.ne + 1)
+    return MeanWind(t, vy.reshape(shape), vx.reshape(shape), field.point_p)
+
+
+def _synoptic_node_speeds(case: Case, system: LineSystem) -> np.ndarray:
+    """Synoptic speed at the global nodes [m/s], shape (n_nodes,); a shared tower node
+    takes the average of its two spans."""
+    v = synoptic_span_speeds(case)
+    ne = system.ne
+    node = np.repeat(v, ne)
+    node = np.append(node, v[-1])
+    inner = system.tower_nodes[1:-1]
+    node[inner] = 0.5 * (v[:-1] + v[1:])
+    return node
+
+
+def mean_normal_at_nodes(case: Case, system: LineSystem, time: np.ndarray) -> np.ndarray:
+    """Running-mean normal speed (toward +y) [m/s] at the global FE nodes, shape (n_steps, n_nodes).
+
+    Nodes at their still-air x (``system.node_x0``).  Synoptic with ``span_speeds``: a
+    tower node shared by two spans takes their average.
+    """
+    time = np.atleast_1d(np.asarray(time, dtype=float))
+    if case.wind.type == "synoptic":
+        return np.broadcast_to(_synoptic_node_speeds(case, system), (time.size, system.n_nodes)).copy()
+    return downburst_field(case).velocity(system.node_x0, time)[1]
+
+
+def mean_speed_at_nodes(case: Case, system: LineSystem, time: np.ndarray) -> np.ndarray:
+    """Running-mean horizontal speed magnitude [m/s] at the global FE nodes, shape (n_steps, n_nodes)."""
+    time = np.atleast_1d(np.asarray(time, dtype=float))
+    if case.wind.type == "synoptic":
+        return np.abs(mean_normal_at_nodes(case, system, time))
+    vx, vy = downburst_field(case).velocity(system.node_x0, time)
+    return np.hypot(vx, vy)

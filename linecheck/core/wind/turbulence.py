@@ -1,0 +1,338 @@
+"""Turbulence synthesis along the line (paper section 2.2; Chen & Letchford 2004; Chay et al. 2006).
+
+A zero-mean, unit-variance, stationary Gaussian field u(x, t) is synthesised at every
+global FE node (still-air x = ``system.node_x0``) by the spectral representation
+method (Shinozuka & Deodatis 1991; Deodatis 1996) evaluated with the FFT, then
+modulated by a(x, t) = I V_m(x, t) (downburst) or I V_ref (synoptic) (Chay et al. 2006).
+
+Conventions: one-sided spectra in [1/Hz] normalised by the variance; frequencies f in
+[Hz]; a field array has shape (n_steps, n_nodes).
+
+- Spectrum: von Karman (1948), n S(n) / sigma^2 = 4 x / (1 + 70.8 x^2)^(5/6), x = n L_u / V.
+- Coherence: Davenport (1961/1986), gamma(n, dx) = exp(-C n dx / V), C = ``coherence_decay``.
+- V = V_ref (one mean speed for the whole field); L_u from :func:`length_scale`.
+
+Discretisation: the record of n_steps samples at dt is one period of an FFT of
+length M = n_steps; bin k (f_k = k / (M dt), k = 1 .. ceil(M/2) - 1) carries the
+spectrum integrated over [f_k - df/2, f_k + df/2] (closed form, incomplete beta
+function); the variance below df/2 is added to bin 1 and the bins are scaled so that
+they sum to exactly 1 (unit variance: the variance above the highest bin, about 1 %
+at dt = 0.05 s, is redistributed proportionally; see ``docs/wind.md``).
+
+Cross-correlation: at each frequency the coherence matrix of the nodes is factored
+C = L L^T and the node coefficients are B_j = A_k sum_m L_jm exp(i phi_mk) with
+independent uniform phases phi (Deodatis 1996).  For equally spaced nodes
+C_jm = rho^|j-m| with rho = exp(-C f dx / V) (Kac-Murdock-Szego matrix), whose
+Cholesky factor is closed form (L_j0 = rho^j, L_jm = rho^(j-m) sqrt(1 - rho^2)): applying
+it is the AR(1) recursion y_j = rho y_(j-1) + sqrt(1 - rho^2) xi_j, O(N) per frequency
+and vectorised over frequencies.  Non-uniform spacing uses a general dense Cholesky
+per frequency with an eigen-decomposition fallback.
+
+Randomness: realization r uses ``numpy.random.Generator(PCG64(SeedSequence(seed).spawn(r + 1)[r]))``
+only, so its field is bit-identical whatever else is generated and in any process.
+Nothing here prints.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+from scipy import fft as sfft
+from scipy.linalg import LinAlgError, cholesky, eigh
+from scipy.special import beta as beta_fn
+from scipy.special import betainc
+
+from ..case import Case
+from ..errors import CaseError
+from ..system import LineSystem
+from .mean import mean_normal_at_nodes, mean_speed_at_nodes
+
+__all__ = [
+    "SpectralGrid",
+    "VON_KARMAN_A",
+    "davenport_coherence",
+    "fluctuating_velocity",
+    "general_apply",
+    "kms_apply",
+    "length_scale",
+    "mean_normal_at_nodes",
+    "mean_speed_at_nodes",
+    "modulation",
+    "random_phases",
+    "realization_rng",
+    "spectral_grid",
+    "synthesize",
+    "unit_field",
+    "von_karman_cumulative",
+    "von_karman_psd",
+]
+
+VON_KARMAN_A = 70.8  # von Karman (1948) longitudinal spectrum constant
+SYNOPTIC_L_UV = 52.0  # [m] ASCE 74 (2010), open terrain (paper section 2.2)
+L_UV_OVER_L_U = 0.3  # paper section 2.2: L_u = L_uv / 0.3
+
+
+# ------------------------------------------------------------------------- model functions
+def length_scale(case: Case) -> float:
+    """von Karman length scale L_u [m]: ``wind.length_scale``, else synoptic L_uv/0.3 = 52/0.3 m
+    (ASCE 74 open terrain, paper section 2.2), downburst D_j (Chay et al. 2006, paper section 2.2)."""
+    if case.wind.length_scale is not None:
+        return float(case.wind.length_scale)
+    if case.wind.type == "downburst":
+        if case.wind.downburst is None:  # pragma: no cover - guarded by the case loader
+            raise CaseError("missing table [wind.downburst]", key="wind.downburst")
+        return float(case.wind.downburst.jet_diameter)  # Chay et al. (2006): L_u = D_j
+    return SYNOPTIC_L_UV / L_UV_OVER_L_U  # paper section 2.2: L_u = L_uv / 0.3, L_uv = 52 m (ASCE 74)
+
+
+def von_karman_psd(f: np.ndarray | float, length_scale: float, v_mean: float) -> np.ndarray:
+    """One-sided von Karman spectrum S(f)/sigma^2 [1/Hz] at f [Hz]; L_u [m], V [m/s]."""
+    x = np.asarray(f, dtype=float) * length_scale / v_mean
+    # von Karman (1948): n S(n)/sigma^2 = 4 x / (1 + 70.8 x^2)^(5/6), x = n L_u / V
+    return 4.0 * (length_scale / v_mean) / (1.0 + VON_KARMAN_A * x * x) ** (5.0 / 6.0)
+
+
+def von_karman_cumulative(f: np.ndarray | float, length_scale: float, v_mean: float) -> np.ndarray:
+    """Variance fraction below f [Hz]: int_0^f S(f')/sigma^2 df' [-] (closed form).
+
+    int_0^x 4 (1 + a s^2)^(-5/6) ds = (2/sqrt(a)) B(1/2, 1/3) I_w(1/2, 1/3), w = a x^2 / (1 + a x^2)
+    (substitution w = a s^2/(1 + a s^2); I the regularised incomplete beta function).
+    The limit f -> inf is 0.99986 (the 70.8 constant rounds the exact von Karman value).
+    """
+    x = np.asarray(f, dtype=float) * length_scale / v_mean
+    a = VON_KARMAN_A
+    ax2 = a * x * x
+    w = np.where(np.isinf(ax2), 1.0, ax2 / (1.0 + np.where(np.isinf(ax2), 0.0, ax2)))
+    return (2.0 / math.sqrt(a)) * beta_fn(0.5, 1.0 / 3.0) * betainc(0.5, 1.0 / 3.0, w)
+
+
+def davenport_coherence(f: np.ndarray | float, dx: np.ndarray | float, decay: float, v_mean: float) -> np.ndarray:
+    """Davenport coherence [-] at f [Hz] and separation dx [m] (broadcast); C [-], V [m/s]."""
+    # Davenport (1961; 1986): gamma = exp(-C n |dx| / V)
+    return np.exp(-decay * np.asarray(f, dtype=float) * np.abs(np.asarray(dx, dtype=float)) / v_mean)
+
+
+# ------------------------------------------------------------------------- discretisation
+@dataclass(frozen=True, eq=False)
+class SpectralGrid:
+    """Frequency discretisation of one record.
+
+    Attributes:
+        n_steps: samples in the record; dt: [s] time step; n_fft: FFT length (= n_steps).
+        df: [Hz] frequency step 1/(n_fft dt).
+        freq: [Hz] simulated frequencies f_k = k df, k = 1 .. n_freq, shape (n_freq,).
+        amplitude: [-] cosine amplitude sqrt(2 P_k) of each bin (sum P_k = 1), shape (n_freq,).
+        low_fraction: [-] von Karman variance below df/2, carried by the first bin.
+        high_fraction: [-] von Karman variance above the last bin edge (n_freq + 1/2) df,
+            removed by scaling all bins up by 1/(1 - high_fraction).
+    """
+
+    n_steps: int
+    dt: float
+    n_fft: int
+    df: float
+    freq: np.ndarray
+    amplitude: np.ndarray
+    low_fraction: float
+    high_fraction: float
+
+    @property
+    def n_freq(self) -> int:
+        return int(self.freq.size)
+
+
+@lru_cache(maxsize=32)
+def spectral_grid(n_steps: int, dt: float, length_scale: float, v_mean: float) -> SpectralGrid:
+    """Bins and amplitudes for ``n_steps`` samples at ``dt`` [s] (cached; arrays read-only).
+
+    Bin k carries P_k = int over [f_k - df/2, f_k + df/2] of S(f)/sigma^2 df (exact, closed
+    form); bin 1 also carries the variance below df/2 (a record of length T cannot hold it
+    otherwise); all bins are divided by the variance below the last edge so sum P_k = 1.
+    """
+    if n_steps < 4:
+        raise CaseError(f"record of {n_steps} samples is too short: expected at least 4 time steps",
+                        key="analysis.duration")
+    if not (dt > 0 and math.isfinite(dt)):
+        raise CaseError(f"time step {dt!r} is not allowed: expected a positive number", key="analysis.time_step")
+    n_fft = int(n_steps)
+    df = 1.0 / (n_fft * dt)
+    n_freq = (n_fft - 1) // 2  # k = 1 .. ceil(M/2) - 1: no DC, no Nyquist term
+    edges = (np.arange(n_freq + 1, dtype=float) + 0.5) * df
+    cum = von_karman_cumulative(edges, length_scale, v_mean)
+    total = float(von_karman_cumulative(np.inf, length_scale, v_mean))
+    power = np.diff(cum)  # exact band integral of the von Karman spectrum per bin
+    power[0] += cum[0]  # variance below df/2 goes to the lowest simulated frequency
+    power = power / cum[-1]  # unit variance of the discrete process (docs/wind.md)
+    amplitude = np.sqrt(2.0 * power)  # variance of A cos(.) is A^2/2 = P_k
+    freq = np.arange(1, n_freq + 1, dtype=float) * df
+    freq.setflags(write=False)
+    amplitude.setflags(write=False)
+    return SpectralGrid(n_fft, float(dt), n_fft, df, freq, amplitude,
+                        low_fraction=float(cum[0] / total), high_fraction=float(1.0 - cum[-1] / total))
+
+
+def realization_rng(seed: int, realization: int) -> np.random.Generator:
+    """The generator of realization r (0-based): ``SeedSequence(seed).spawn(r + 1)[r]``.
+
+    Equal to ``SeedSequence(seed, spawn_key=(r,))``, which is what is built (O(1)).
+    """
+    if realization < 0:
+        raise CaseError(f"realization {realization} is not allowed: expected an index >= 0")
+    ss = np.random.SeedSequence(int(seed), spawn_key=(int(realization),))
+    return np.random.Generator(np.random.PCG64(ss))
+
+
+def random_phases(seed: int, realization: int, n_nodes: int, n_freq: int) -> np.ndarray:
+    """Independent phases phi_mk uniform on [0, 2 pi) [rad], shape (n_nodes, n_freq)."""
+    return realization_rng(seed, realization).random((n_nodes, n_freq)) * (2.0 * math.pi)
+
+
+def kms_apply(rho: np.ndarray, xi: np.ndarray) -> np.ndarray:
+    """y = L xi with L the Cholesky factor of the KMS matrix rho^|j-m|, per frequency.
+
+    rho [-] shape (n_freq,) in [0, 1]; xi shape (n_nodes, n_freq) (complex) -> y same shape.
+    L_j0 = rho^j, L_jm = rho^(j-m) sqrt(1 - rho^2) (1 <= m <= j), i.e. the AR(1) recursion
+    y_0 = xi_0, y_j = rho y_(j-1) + sqrt(1 - rho^2) xi_j (Kac, Murdock & Szego 1953).
+    """
+    rho = np.asarray(rho, dtype=float)
+    s = np.sqrt(np.maximum(1.0 - rho * rho, 0.0))
+    y = np.empty_like(xi)
+    y[0] = xi[0]
+    prev = y[0]
+    for j in range(1, xi.shape[0]):
+        # closed-form KMS Cholesky factor (docs/wind.md, derivation): AR(1) recursion along the nodes
+        prev = rho * prev + s * xi[j]
+        y[j] = prev
+    return y
+
+
+def _factor(c: np.ndarray) -> np.ndarray:
+    """A factor L with L L^T = c: lower Cholesky, or Q sqrt(Lambda) from the eigen-decomposition
+    (negative round-off eigenvalues clipped) when c is not numerically positive definite."""
+    try:
+        return cholesky(c, lower=True, check_finite=False)
+    except LinAlgError:
+        lam, q = eigh(c, check_finite=False)
+        return q * np.sqrt(np.clip(lam, 0.0, None))[None, :]
+
+
+def general_apply(x: np.ndarray, freq: np.ndarray, xi: np.ndarray, decay: float, v_mean: float) -> np.ndarray:
+    """y_k = L_k xi_k with L_k a factor of the Davenport coherence matrix at each frequency.
+
+    x [m] shape (n_nodes,) (any spacing); freq [Hz] (n_freq,); xi (n_nodes, n_freq) complex.
+    Dense Cholesky per frequency, eigen fallback where the matrix is not numerically
+    positive definite.  O(N^3) per frequency: the reference path for uneven spacing and
+    the baseline of ``bench/bench_wind.py``.
+    """
+    x = np.asarray(x, dtype=float)
+    dx = np.abs(x[:, None] - x[None, :])
+    y = np.empty_like(xi)
+    rhs = np.empty((x.size, 2))
+    for k, f in enumerate(np.asarray(freq, dtype=float)):
+        lower = _factor(davenport_coherence(f, dx, decay, v_mean))
+        rhs[:, 0], rhs[:, 1] = xi[:, k].real, xi[:, k].imag  # real factor: two real right-hand sides
+        out = lower @ rhs
+        y[:, k] = out[:, 0] + 1j * out[:, 1]
+    return y
+
+
+def _uniform_spacing(x: np.ndarray) -> float | None:
+    d = np.diff(x)
+    if d.size == 0:
+        return 0.0
+    if d[0] > 0 and np.allclose(d, d[0], rtol=1e-9, atol=0.0):
+        return float(d[0])
+    return None
+
+
+def synthesize(x: np.ndarray, grid: SpectralGrid, phases: np.ndarray, decay: float, v_mean: float,
+               method: str = "auto") -> np.ndarray:
+    """Unit-variance field at points x [m] for given phases [rad]: shape (n_steps, n_nodes).
+
+    phases shape (n_nodes, n_freq).  ``method``: "kms" (equal spacing required), "general"
+    (dense factor per frequency) or "auto" (KMS when x is equally spaced).
+    u_j(t_n) = sum_k A_k Re[(L_k e^(i phi_k))_j e^(i 2 pi f_k t_n)] (Deodatis 1996), by inverse FFT.
+    """
+    x = np.asarray(x, dtype=float)
+    n_nodes = x.size
+    if phases.shape != (n_nodes, grid.n_freq):
+        raise ValueError(f"phases shape {phases.shape} != {(n_nodes, grid.n_freq)}")
+    xi = np.exp(1j * phases)
+    spacing = _uniform_spacing(x)
+    if method == "auto":
+        method = "kms" if spacing is not None else "general"
+    if method == "kms":
+        if spacing is None:
+            raise ValueError("the KMS path needs equally spaced, increasing x")
+        rho = davenport_coherence(grid.freq, spacing, decay, v_mean)  # coherence of neighbours: C_jk = rho^|j-k|
+        y = kms_apply(rho, xi)
+    elif method == "general":
+        y = general_apply(x, grid.freq, xi, decay, v_mean)
+    else:
+        raise ValueError(f"unknown method {method!r}")
+    m = grid.n_fft
+    spec = np.zeros((m // 2 + 1, n_nodes), dtype=complex)
+    # Deodatis (1996) spectral sum by FFT: irfft gives (1/M)(X_k e^{..} + conj) = A_k cos(..) for X_k = (M/2) A_k e^{i psi}
+    spec[1:grid.n_freq + 1] = (0.5 * m) * (grid.amplitude[:, None] * y.T)
+    return sfft.irfft(spec, n=m, axis=0)[: grid.n_steps]
+
+
+# ------------------------------------------------------------------------- case-level API
+def unit_field(case: Case, system: LineSystem, n_steps: int, dt: float, realization: int) -> np.ndarray:
+    """Zero-mean, unit-variance turbulence u(x, t) [-] at every global FE node.
+
+    n_steps samples at dt [s]; realization: 0-based index.  Returns shape (n_steps, n_nodes).
+    Bit-identical for the same case, seed, n_steps, dt and realization.
+    """
+    x = system.node_x0
+    v = float(case.wind.v_ref)
+    if not v > 0:
+        raise CaseError("value 0.0 is not allowed for turbulence synthesis: expected v_ref > 0", key="wind.v_ref")
+    grid = spectral_grid(int(n_steps), float(dt), length_scale(case), v)
+    phases = random_phases(case.analysis.seed, realization, x.size, grid.n_freq)
+    return synthesize(x, grid, phases, case.wind.coherence_decay, v)
+
+
+def modulation(case: Case, system: LineSystem, time: np.ndarray) -> np.ndarray:
+    """a(x, t) [m/s] = I V_m(x, t) (downburst, speed magnitude at the nodes) or I V_ref (synoptic).
+
+    Shape (n_steps, n_nodes) for a downburst, (1, 1) for synoptic (broadcasts).  Chay et al. (2006).
+    """
+    i = case.wind.turbulence_intensity
+    # Chay et al. (2006), paper section 2.2: a = I V_m(x, t) (downburst), I V_ref (synoptic)
+    if case.wind.type == "synoptic":
+        return np.full((1, 1), i * case.wind.v_ref)
+    return i * mean_speed_at_nodes(case, system, time)
+
+
+def _record(time: np.ndarray) -> tuple[int, float]:
+    t = np.asarray(time, dtype=float)
+    if t.ndim != 1 or t.size < 4:
+        raise CaseError(f"time axis of {t.size} instants is not allowed: expected at least 4 equally spaced instants")
+    d = np.diff(t)
+    dt = float((t[-1] - t[0]) / (t.size - 1))
+    if not dt > 0 or not np.allclose(d, dt, rtol=1e-6, atol=1e-9 * max(1.0, abs(t[-1]))):
+        raise CaseError("time axis is not allowed: expected equally spaced, increasing instants")
+    # t0 + dt * arange(n) recovers dt only to round-off: keep 12 significant digits so the same
+    # time step always gives the same spectral grid (and bit-identical fields)
+    return t.size, float(f"{dt:.12g}")
+
+
+def fluctuating_velocity(case: Case, system: LineSystem, time: np.ndarray, realizations: Sequence[int]) -> np.ndarray:
+    """Fluctuating along-wind velocity a(x, t) u_r(x, t) [m/s] at the global FE nodes.
+
+    time [s] equally spaced, shape (n_steps,); realizations: 0-based indices.
+    Returns shape (n_real, n_steps, n_nodes).
+    """
+    n_steps, dt = _record(time)
+    a = modulation(case, system, np.asarray(time, dtype=float))
+    reals = list(realizations)
+    out = np.empty((len(reals), n_steps, system.n_nodes))
+    for i, r in enumerate(reals):
+        out[i] = unit_field(case, system, n_steps, dt, int(r))
+        out[i] *= a
+    return out

@@ -67,4 +67,5 @@ def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
         write_json(json_out, doc)
         console.print(f"wrote {json_out}")
 from . import run_cmd  # noqa: E402,F401
+from . import spectral_cmd  # noqa: E402,F401
 from . import wind_cmd  # noqa: E402,F401

@@ -84,15 +84,9 @@ def to_global_nodes(system: LineSystem, span_local: np.ndarray) -> np.ndarray:
 
 def record_time(case: Case) -> np.ndarray:
     """Time grid of steps 2-3 [s], shape (n_steps,): synoptic 0..duration, downburst the event window."""
-    dt = case.analysis.time_step
-    if case.wind.type == "synoptic":
-        t0, t1 = 0.0, case.analysis.duration if case.analysis.duration is not None else 600.0
-    else:
-        from .core.wind.mean import event_window
+    from .core.wind.point import record_times
 
-        t0, t1 = event_window(case)
-    n = int(round((t1 - t0) / dt)) + 1
-    return t0 + dt * np.arange(n)
+    return record_times(case)
 
 
 @dataclass(frozen=True)
@@ -387,18 +381,10 @@ class WindAtP:
 
 def wind_at_p(case: Case, *, realization: int = 0) -> WindAtP:
     """Running-mean and total wind speed at point p over the record (paper Fig. 3)."""
-    from .core.wind.turbulence import fluctuating_velocity
+    from .core.wind.point import point_series
 
-    system = LineSystem(case.line)
-    t = record_time(case)
-    mw = mean_wind(case, system, t if case.wind.type == "downburst" else None)
-    node = int(np.argmin(np.abs(system.node_x0 - mw.point_p)))
-    vn = to_global_nodes(system, mw.normal)
-    vl = to_global_nodes(system, mw.longitudinal)
-    speed = np.hypot(vn, vl)[:, node]
-    speed = np.broadcast_to(speed, t.shape).copy()
-    v = fluctuating_velocity(case, system, t, [realization])[0, :, node]
-    return WindAtP(case, t, speed, speed + v, float(system.node_x0[node]), realization)
+    p = point_series(case, realization)
+    return WindAtP(case, p.time, p.mean_speed, p.total, p.node_x, realization)
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ from .core.case import Case
 from .core.damping import aerodynamic_damping, stiffness_proportional
 from .core.dynamics import integrate
 from .core.errors import Cancelled
-from .core.model import build_model, reaction_matrix_direct
+from .core.model import build_model
 from .core.results import Statistics, compute_statistics
 from .core.static import MeanStates, drag_intensity, solve_mean_states
 from .core.system import LineSystem
@@ -303,15 +303,19 @@ def run_case(
         progress("wind", 1, 1)
     check_cancel()
     coef = wind.air_density * line.drag_coefficient * line.diameter
-    # normal component of the fluctuation: v cos(phi), phi the angle of the mean wind to the normal
-    f_nodes = coef * models[0].tributary[None, None, :] * (vn * cos_n)[None] * v  # (n_real, n_steps, n_nodes)
+    # Eq. 5 per unit v, normal component of the fluctuation: v cos(phi), phi the angle of
+    # the mean wind to the normal of the line
+    per_v = coef * models[0].tributary[None, :] * (vn * cos_n)  # (n_steps, n_nodes)
     free = models[0].dofs.free_nodes
-    loads = np.ascontiguousarray(np.moveaxis(f_nodes[:, :, free], 0, -1))  # (n_steps, n_free, n_real)
-    D = reaction_matrix_direct(system)
-    # loads at pinned nodes go straight into their supports: (n_steps, n_towers*3, n_real)
-    direct = np.einsum("rn,snk->srk", D, np.moveaxis(f_nodes, 0, -1))
-    del f_nodes, v
-
+    pinned = system.tower_nodes[~system.suspension]
+    loads = np.empty((t.size, real.size, free.size))
+    direct = np.zeros((t.size, real.size, 3 * system.n_towers))
+    for i in range(real.size):
+        f_i = per_v * v[i]  # (n_steps, n_nodes)
+        loads[:, i, :] = f_i[:, free]
+        # loads at pinned nodes go straight into their supports (R_y)
+        direct[:, i, 3 * np.flatnonzero(~system.suspension) + 1] = f_i[:, pinned]
+    del v
     cb = None if progress is None else (lambda d, n: progress("steps 2-3: dynamics", d, n))
     resp = integrate(models, damping, state_of_step, loads, dt, direct=direct,
                      weights=weights if interpolate_states else None, progress=cb, cancel=cancel)

@@ -140,3 +140,15 @@ def test_all_shipped_cases_validate():
             assert case.wind.v_ref == (40.0 if n % 2 else 20.0)
             assert case.wind.type == ("synoptic" if n >= 9 else "downburst")
             assert case.line.tower_of_interest == (1 if f.stem.endswith("single") else 4)
+
+
+def test_case_reference_doc_is_up_to_date():
+    """docs/case-files.md is generated from the schema; regenerate with tools/make_case_reference.py."""
+    import importlib.util
+
+    from .conftest import ROOT
+
+    spec = importlib.util.spec_from_file_location("mcr", ROOT / "tools" / "make_case_reference.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    assert (ROOT / "docs" / "case-files.md").read_text() == mod.render()

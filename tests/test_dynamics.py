@@ -79,7 +79,7 @@ def test_newmark_mdof_matches_modal_superposition():
     W = 0.9 * wn[0]
     p = np.linspace(1.0, 2.0, y.size) * 30.0  # load pattern [N]
     F = np.sin(W * t)[:, None] * p[None, :]
-    resp = integrate([model], damping, np.zeros(n, dtype=int), F[:, :, None], dt)
+    resp = integrate([model], damping, np.zeros(n, dtype=int), F[:, None, :], dt)
     # modal: q_i'' + alpha q_i' + w_i^2 q_i = phi_i . p sin(W t), q(0) = q'(0) = 0
     exact_u = np.zeros((n, y.size))
     for i in range(y.size):

@@ -106,10 +106,10 @@ def integrate(
             diagonal (paper Eq. 9) the product C u' is a vector multiply.
         state_of_step: index into ``models`` in force at every step, shape (n_steps,).
         loads: [N] fluctuating transverse (y) loads on the free nodes, shape
-            (n_steps, n_free_nodes, n_real) (paper Eq. 5).
+            (n_steps, n_real, n_free_nodes) (paper Eq. 5).
         dt: [s] time step.
         direct: [N] reactions caused directly by loads applied at pinned nodes,
-            shape (n_steps, n_towers * 3, n_real) (added to both F and B).
+            shape (n_steps, n_real, n_towers * 3) (added to both F and B).
         weights: optional linear interpolation weight toward state ``k+1`` at every step,
             shape (n_steps,): K, C and the reaction map are interpolated and factorised
             at every step (reference scheme; default piecewise constant).
@@ -122,20 +122,16 @@ def integrate(
         transient is created.
     """
     nm = Newmark(dt)
-    n_steps, n_free, n_real = loads.shape
+    n_steps, n_real, n_free = loads.shape
     n_k = len(models)
     mass = models[0].mass
     n_dof = mass.size
     ydof = 3 * np.arange(n_free) + 1  # node-major DOFs: y is the second of each node
-
-    def full(f: np.ndarray) -> np.ndarray:
-        """Scatter y-loads (n_free, ...) into a full DOF vector (n_dof, ...)."""
-        out = np.zeros((n_dof,) + f.shape[1:])
-        out[ydof] = f
-        return out
     n_r = models[0].G.shape[0]
     if not np.all(np.isfinite(loads)):
         raise NumericalError("non-finite fluctuating wind load")
+    # Vectors are kept "transposed", shape (n_real, n_dof) C-ordered, i.e. (n_dof, n_real)
+    # Fortran-ordered as LAPACK wants them: no copies in the step loop.
 
     def mats(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """K band, damping, reaction map in force at step n."""
@@ -147,51 +143,59 @@ def integrate(
         return ((1 - w) * m0.K_band + w * m1.K_band, (1 - w) * damping[k] + w * damping[k + 1],
                 (1 - w) * m0.G + w * m1.G)
 
+    def loads_full(f: np.ndarray) -> np.ndarray:
+        """y-loads (m, n_free) -> full transposed right-hand sides (m, n_dof)."""
+        out = np.zeros((f.shape[0], n_dof))
+        out[:, ydof] = f
+        return out
+
     # -------- step 3: quasi-static background, one factorisation per mean state
-    R_B = np.empty((n_steps, n_r, n_real))
-    chunk = max(1, 4096 // max(n_real, 1))
+    R_B = np.empty((n_steps, n_real, n_r))
+    chunk = max(1, 8192 // max(n_real, 1))
     if weights is None:
         for k in np.unique(state_of_step):
             c = _factor(models[k].K_band, np.zeros(n_dof), f"stiffness of mean state {k + 1}")
             all_steps = np.flatnonzero(state_of_step == k)
+            GT = models[k].G.T
             for i0 in range(0, all_steps.size, chunk):
                 steps = all_steps[i0:i0 + chunk]
-                rhs = full(loads[steps].transpose(1, 0, 2).reshape(n_free, -1))
-                U = _solve(c, rhs).reshape(n_dof, steps.size, n_real)
-                R_B[steps] = np.einsum("rd,dsn->srn", models[k].G, U)
+                UT = _solve(c, loads_full(loads[steps].reshape(-1, n_free)).T).T
+                R_B[steps] = (UT @ GT).reshape(steps.size, n_real, n_r)
     else:
         for n in range(n_steps):
             Kb, _, G = mats(n)
             c = _factor(Kb, np.zeros(n_dof), f"stiffness at step {n}")
-            R_B[n] = G @ _solve(c, full(loads[n]))
+            R_B[n] = _solve(c, loads_full(loads[n]).T).T @ G.T
 
     # -------- step 2: Newmark, one factorisation per mean state
-    Kb0, c0, G0 = mats(0)
+    Kb0, _, G0 = mats(0)
     chol = _factor(Kb0, np.zeros(n_dof), "stiffness at t = 0")
-    U = _solve(chol, full(loads[0]))  # quasi-static start
+    U = _solve(chol, loads_full(loads[0]).T).T  # quasi-static start, (n_real, n_dof)
     V = np.zeros_like(U)
     A = np.zeros_like(U)  # M a0 = F0 - K u0 - C v0 = 0
-    R_F = np.empty((n_steps, n_r, n_real))
-    R_F[0] = G0 @ U
+    R_F = np.empty((n_steps, n_real, n_r))
+    R_F[0] = U @ G0.T
     current = None
-    mcol = mass[:, None]
+    mrow = mass[None, :]
     report = max(1, n_steps // 100)
     a0, a1, a2 = nm.a0, nm.a1, nm.a2
+    half_dt = 0.5 * dt
     for n in range(1, n_steps):
         key = int(state_of_step[n]) if weights is None else n
         if key != current:
             Kb, cd, G = mats(n)
             chat = _factor(Kb, a0 * mass, f"effective stiffness at step {n}", band_add=a1 * cd)
             cmul = _band_multiplier(cd)
+            GT = G.T
             current = key
         # K_hat u_{n+1} = F_{n+1} + M (a0 u + a2 v + a) + C (a1 u + v)   (Bathe Table 9.3)
-        rhs = mcol * (a0 * U + a2 * V + A) + cmul(a1 * U + V)
-        rhs[ydof] += loads[n]
-        U_new = _solve(chat, rhs)
+        rhs = mrow * (a0 * U + a2 * V + A) + cmul(a1 * U + V)
+        rhs[:, ydof] += loads[n]
+        U_new = _solve(chat, rhs.T).T
         A_new = a0 * (U_new - U) - a2 * V - A
-        V += 0.5 * dt * (A + A_new)
+        V += half_dt * (A + A_new)
         U, A = U_new, A_new
-        R_F[n] = G @ U
+        R_F[n] = U @ GT
         if progress is not None and n % report == 0:
             progress(n, n_steps)
             if cancel is not None and cancel.is_set():
@@ -203,22 +207,22 @@ def integrate(
         R_B += direct
     if progress is not None:
         progress(n_steps, n_steps)
-    shape = (n_steps, n_r // 3, 3, n_real)
+    shape = (n_steps, n_real, n_r // 3, 3)
     return DynamicResponse(
-        fluctuating=np.moveaxis(R_F.reshape(shape), -1, 0),
-        background=np.moveaxis(R_B.reshape(shape), -1, 0),
+        fluctuating=np.ascontiguousarray(R_F.reshape(shape).transpose(1, 0, 2, 3)),
+        background=np.ascontiguousarray(R_B.reshape(shape).transpose(1, 0, 2, 3)),
     )
 
 
-
 def _band_multiplier(c_band: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
-    """x -> C x for a symmetric upper-band matrix C (vector multiply when C is diagonal)."""
+    """x -> x C for transposed vectors x (n_real, n_dof) and a symmetric upper-band matrix C
+    (an elementwise multiply when C is diagonal)."""
     if not np.any(c_band[:-1]):
-        d = c_band[-1][:, None]
+        d = c_band[-1][None, :]
         return lambda x: d * x
     from scipy.sparse import csr_matrix
 
     from .model import band_to_dense
 
-    C = csr_matrix(band_to_dense(c_band))
-    return lambda x: C @ x
+    C = csr_matrix(band_to_dense(c_band))  # symmetric: x C = (C x^T)^T
+    return lambda x: (C @ x.T).T

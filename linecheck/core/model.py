@@ -122,24 +122,31 @@ def build_model(system: LineSystem, state: StaticState) -> LinearModel:
     n_el = kb.shape[0]
     ab = np.zeros((BANDWIDTH + 1, n_dof))
     u = BANDWIDTH
+    nd = dm.node_dof
+    ia, ib = np.triu_indices(3)  # upper triangle of a diagonal 3x3 block
+
+    def add_diag_blocks(first: np.ndarray, blocks: np.ndarray) -> None:
+        """Add symmetric 3x3 blocks at DOFs first..first+2 (vectorised, repeated DOFs summed)."""
+        rows = np.broadcast_to(u + ia - ib, (first.size, ia.size))
+        cols = first[:, None] + ib[None, :]
+        np.add.at(ab, (rows, cols), blocks[:, ia, ib])
+
+    left, right = nd[:-1], nd[1:]
+    add_diag_blocks(left[left >= 0], kb[left >= 0])
+    add_diag_blocks(right[right >= 0], kb[right >= 0])
+    both = (left >= 0) & (right >= 0)  # element between two free nodes: -k off the diagonal
+    a, b = np.meshgrid(np.arange(3), np.arange(3), indexing="ij")
+    rows = np.broadcast_to((u + a - 3 - b).ravel(), (int(both.sum()), 9))  # right node = left + 3
+    cols = right[both][:, None] + b.ravel()[None, :]
+    np.add.at(ab, (rows, cols), -kb[both].reshape(-1, 9))
 
     def add_block(r0: int, c0: int, blk: np.ndarray) -> None:
-        # add a 3x3 block at (r0, c0) (r0 <= c0 for the upper triangle; diagonal blocks symmetric)
-        for a in range(3):
-            for b in range(3):
-                i, j = r0 + a, c0 + b
+        # one 3x3 block at (r0, c0), upper triangle only (insulators)
+        for a_ in range(3):
+            for b_ in range(3):
+                i, j = r0 + a_, c0 + b_
                 if i <= j:
-                    ab[u + i - j, j] += blk[a, b]
-
-    nd = dm.node_dof
-    for e in range(n_el):
-        i, j = nd[e], nd[e + 1]
-        if i >= 0:
-            add_block(i, i, kb[e])
-        if j >= 0:
-            add_block(j, j, kb[e])
-        if i >= 0 and j >= 0:
-            add_block(i, j, -kb[e])
+                    ab[u + i - j, j] += blk[a_, b_]
 
     # insulators (issue 4): axially stiff, geometric stiffness R_res/v transversely
     v = line.insulator_length

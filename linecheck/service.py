@@ -149,8 +149,7 @@ def damping_matrices(case: Case, st: StaticResult, models: list) -> np.ndarray:
     if zs > 0:
         k_ref = reference_state_index(case, mean)
         w1 = 2 * np.pi * float(natural_modes(models[k_ref], 1).frequencies_hz[0])
-        beta = 2.0 * zs / w1
-        C = C + np.stack([beta * m.K_band for m in models])
+        C = C + np.stack([stiffness_proportional(m, zs, w1) for m in models])
     return C
 
 
@@ -231,14 +230,49 @@ def burn_in(case: Case, sm: SynopticModel) -> BurnIn:
     return BurnIn(float(used), required, f1, z1, bool(used >= required), src)
 
 
-def _state_of_step(mean_times: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Nearest mean state at each step and the interpolation weight toward the next one."""
+def _state_of_step(mean_times: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Nearest mean state at each step, and the bracketing state k and weight toward k+1."""
     if mean_times.size == 1:
-        return np.zeros(t.size, dtype=int), np.zeros(t.size)
+        zero = np.zeros(t.size, dtype=int)
+        return zero, zero, np.zeros(t.size)
     k = np.clip(np.searchsorted(mean_times, t, side="right") - 1, 0, mean_times.size - 2)
     w = np.clip((t - mean_times[k]) / (mean_times[k + 1] - mean_times[k]), 0.0, 1.0)
     nearest = np.where(w > 0.5, k + 1, k)
-    return nearest, w
+    return nearest, k, w
+
+
+def _interpolated_models(case: Case, st: StaticResult, bracket: np.ndarray, weights: np.ndarray):
+    """model_at(n) for the reference scheme: the step-1 state interpolated linearly in time."""
+    from .core.modes import natural_modes
+    from .core.static import StaticState
+
+    mean, system = st.mean, st.system
+    vn_all = to_global_nodes(system, st.wind.normal)
+    n_k = mean.time.size
+    zs = case.analysis.structural_ratio
+    w1 = 1.0
+    if zs > 0:  # calibrated once, at the reference state (as in damping_matrices)
+        w1 = 2 * np.pi * float(natural_modes(build_model(system, mean.state(reference_state_index(case, mean))), 1)
+                               .frequencies_hz[0])
+
+    def model_at(n: int):
+        k0 = int(bracket[n])
+        k1 = min(k0 + 1, n_k - 1)
+        w = float(weights[n])
+
+        def lerp(a):
+            return (1 - w) * a[k0] + w * a[k1]
+
+        state = StaticState(lerp(mean.displacement), lerp(mean.reactions), lerp(mean.tension),
+                            lerp(mean.insulator_force), lerp(mean.nodes), lerp(mean.element_tension), 0, 0.0)
+        model = build_model(system, state)
+        vn = (1 - w) * vn_all[k0] + w * vn_all[k1]
+        c = aerodynamic_damping(case, model, vn, state.nodes)
+        if zs > 0:
+            c = c + stiffness_proportional(model, zs, w1)
+        return model, c
+
+    return model_at
 
 
 def run_case(
@@ -254,8 +288,9 @@ def run_case(
     Args:
         realizations: which realizations to run (default all ``analysis.realizations``);
             realization r always gets the same turbulence, whatever else is run with it.
-        interpolate_states: interpolate K(t), C(t) between mean states at every step
-            (reference scheme) instead of holding the nearest state.
+        interpolate_states: reference scheme: interpolate the step-1 state linearly in time
+            and rebuild and factorise the model at every step, instead of holding the
+            nearest of the ``analysis.mean_states`` states (slow; validation only).
         progress: ``progress(stage, done, total)``.
         cancel: a :class:`threading.Event`; when set the run stops with ``Cancelled``.
     """
@@ -282,7 +317,7 @@ def run_case(
     if burn.seconds > 0:
         t = t[0] - dt * np.round(burn.seconds / dt) + dt * np.arange(t.size + int(np.round(burn.seconds / dt)))
     keep = t >= t[0] + burn.seconds - 1e-9  # the analysed record (after the burn-in)
-    state_of_step, weights = _state_of_step(mean.time, t)
+    state_of_step, bracket, weights = _state_of_step(mean.time, t)
     check_cancel()
 
     # ---- fluctuating load F_w = rho C_d D L_e V_m v (paper Eq. 5), normal components
@@ -318,7 +353,8 @@ def run_case(
     del v
     cb = None if progress is None else (lambda d, n: progress("steps 2-3: dynamics", d, n))
     resp = integrate(models, damping, state_of_step, loads, dt, direct=direct,
-                     weights=weights if interpolate_states else None, progress=cb, cancel=cancel)
+                     model_at=_interpolated_models(case, st, bracket, weights) if interpolate_states else None,
+                     progress=cb, cancel=cancel)
 
     # ---- mean M(t): step-1 reactions interpolated to the record grid (wind-induced)
     rw = mean.reactions_wind  # (n_k, n_towers, 3)

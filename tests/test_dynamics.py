@@ -25,7 +25,8 @@ def sdof_model(k: float, m: float) -> LinearModel:
     ab[-1] = k
     G = np.zeros((6, 3))
     G[4, 1] = 1.0  # "reaction" row = displacement y (to read u back)
-    return LinearModel(system, dm, ab, np.full(3, m), np.ones(system.n_nodes), G)
+    return LinearModel(system, dm, ab, np.full(3, m), np.ones(system.n_nodes), G,
+                       np.zeros((0, 3)), np.zeros(0, dtype=int), np.zeros_like(ab))
 
 
 def test_newmark_sdof_harmonic_matches_exact_solution():

@@ -34,7 +34,7 @@ from __future__ import annotations
 import numpy as np
 
 from .case import Case
-from .model import BANDWIDTH, LinearModel
+from .model import BANDWIDTH, LinearModel, project_axial
 
 
 def _add_node_blocks(ab: np.ndarray, first_dof: np.ndarray, blocks: np.ndarray) -> None:
@@ -74,7 +74,7 @@ def aerodynamic_damping(case: Case, model: LinearModel, vn_nodes: np.ndarray, no
     first = model.dofs.node_dof[free]
     if case.analysis.damping == "paper":
         ab[BANDWIDTH, first + 1] = c  # Eq. 9: transverse DOF only
-        return ab
+        return project_axial(model, ab)  # a rigid insulator carries the axial part
     if nodes is None:
         raise ValueError("quasi-steady damping needs the mean-state node coordinates")
     e = node_tangents(model, nodes)[free]  # (n_free, 3)
@@ -84,11 +84,15 @@ def aerodynamic_damping(case: Case, model: LinearModel, vn_nodes: np.ndarray, no
     ww = w[:, :, None] * w[:, None, :]
     blocks = c[:, None, None] * (ww + 0.5 * (P - ww))
     _add_node_blocks(ab, first, blocks)
-    return ab
+    return project_axial(model, ab)  # a rigid insulator carries the axial part
 
 
 def stiffness_proportional(model: LinearModel, ratio: float, omega1: float) -> np.ndarray:
-    """Structural damping C_s = (2 zeta_s / omega_1) K [N s/m], upper band storage."""
+    """Structural damping C_s = (2 zeta_s / omega_1) K_c [N s/m], upper band storage.
+
+    K_c is the stiffness without the insulator axial penalty, projected normal to the
+    insulator axes (a rigid insulator does not deform, so it dissipates nothing).
+    """
     if ratio <= 0.0:
         return np.zeros_like(model.K_band)
-    return (2.0 * ratio / omega1) * model.K_band
+    return (2.0 * ratio / omega1) * project_axial(model, model.K_band - model.K_axial_band)

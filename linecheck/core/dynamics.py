@@ -6,8 +6,9 @@ and C(t) taken from the step-1 mean state in force at each time step.  Step 3
 (paper Eq. 14): K(t) u = F_w(t) gives the background B; the resonant part is
 R = F - B.
 
-Structure exploited (issue 4): K is banded (half-bandwidth 5), M and C are
-diagonal; K_hat = K + 2/dt C + 4/dt^2 M is factorised once per mean state
+Structure exploited (issue 4): K, C and M are banded (half-bandwidth 5; M is diagonal
+but for the 3x3 blocks of the insulator attachment nodes, projected normal to the
+insulator axis); K_hat = K + 2/dt C + 4/dt^2 M is factorised once per mean state
 (banded Cholesky, LAPACK dpbtrf), never per step; all realizations are columns of
 one right-hand side.  For downbursts K(t), C(t) are piecewise constant between
 the mean-state instants (default), or linearly interpolated at every step
@@ -93,7 +94,7 @@ def integrate(
     dt: float,
     *,
     direct: np.ndarray | None = None,
-    weights: np.ndarray | None = None,
+    model_at: Callable[[int], tuple[LinearModel, np.ndarray]] | None = None,
     progress: Callable[[int, int], None] | None = None,
     cancel: threading.Event | None = None,
 ) -> DynamicResponse:
@@ -110,9 +111,10 @@ def integrate(
         dt: [s] time step.
         direct: [N] reactions caused directly by loads applied at pinned nodes,
             shape (n_steps, n_real, n_towers * 3) (added to both F and B).
-        weights: optional linear interpolation weight toward state ``k+1`` at every step,
-            shape (n_steps,): K, C and the reaction map are interpolated and factorised
-            at every step (reference scheme; default piecewise constant).
+        model_at: optional ``model_at(n) -> (model, damping band)`` giving the linear model of
+            step n itself (reference scheme: the step-1 state interpolated in time and the
+            model rebuilt and factorised at every step); default: ``models[state_of_step[n]]``
+            held piecewise constant.
         progress: ``progress(done, total)`` every few hundred steps.
         cancel: stop early (raises :class:`Cancelled`).
 
@@ -123,9 +125,7 @@ def integrate(
     """
     nm = Newmark(dt)
     n_steps, n_real, n_free = loads.shape
-    n_k = len(models)
-    mass = models[0].mass
-    n_dof = mass.size
+    n_dof = models[0].mass.size
     ydof = 3 * np.arange(n_free) + 1  # node-major DOFs: y is the second of each node
     n_r = models[0].G.shape[0]
     if not np.all(np.isfinite(loads)):
@@ -133,15 +133,17 @@ def integrate(
     # Vectors are kept "transposed", shape (n_real, n_dof) C-ordered, i.e. (n_dof, n_real)
     # Fortran-ordered as LAPACK wants them: no copies in the step loop.
 
-    def mats(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """K band, damping, reaction map in force at step n."""
+    def model_of(n: int) -> tuple[LinearModel, np.ndarray]:
+        """Linear model and damping band in force at step n."""
+        if model_at is not None:
+            return model_at(n)
         k = int(state_of_step[n])
-        if weights is None or k + 1 >= n_k:
-            return models[k].K_band, damping[k], models[k].G
-        w = float(weights[n])
-        m0, m1 = models[k], models[k + 1]
-        return ((1 - w) * m0.K_band + w * m1.K_band, (1 - w) * damping[k] + w * damping[k + 1],
-                (1 - w) * m0.G + w * m1.G)
+        return models[k], damping[k]
+
+    def mats(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """K band, damping band, mass band and reaction map in force at step n."""
+        m, c = model_of(n)
+        return m.K_band, c, m.M_band, m.G
 
     def loads_full(f: np.ndarray) -> np.ndarray:
         """y-loads (m, n_free) -> full transposed right-hand sides (m, n_dof)."""
@@ -152,7 +154,7 @@ def integrate(
     # -------- step 3: quasi-static background, one factorisation per mean state
     R_B = np.empty((n_steps, n_real, n_r))
     chunk = max(1, 8192 // max(n_real, 1))
-    if weights is None:
+    if model_at is None:
         for k in np.unique(state_of_step):
             c = _factor(models[k].K_band, np.zeros(n_dof), f"stiffness of mean state {k + 1}")
             all_steps = np.flatnonzero(state_of_step == k)
@@ -163,12 +165,12 @@ def integrate(
                 R_B[steps] = (UT @ GT).reshape(steps.size, n_real, n_r)
     else:
         for n in range(n_steps):
-            Kb, _, G = mats(n)
+            Kb, _, _, G = mats(n)
             c = _factor(Kb, np.zeros(n_dof), f"stiffness at step {n}")
             R_B[n] = _solve(c, loads_full(loads[n]).T).T @ G.T
 
     # -------- step 2: Newmark, one factorisation per mean state
-    Kb0, _, G0 = mats(0)
+    Kb0, _, _, G0 = mats(0)
     chol = _factor(Kb0, np.zeros(n_dof), "stiffness at t = 0")
     U = _solve(chol, loads_full(loads[0]).T).T  # quasi-static start, (n_real, n_dof)
     V = np.zeros_like(U)
@@ -176,25 +178,32 @@ def integrate(
     R_F = np.empty((n_steps, n_real, n_r))
     R_F[0] = U @ G0.T
     current = None
-    mrow = mass[None, :]
     report = max(1, n_steps // 100)
     a0, a1, a2 = nm.a0, nm.a1, nm.a2
     half_dt = 0.5 * dt
     for n in range(1, n_steps):
-        key = int(state_of_step[n]) if weights is None else n
+        key = int(state_of_step[n]) if model_at is None else n
         if key != current:
-            Kb, cd, G = mats(n)
-            chat = _factor(Kb, a0 * mass, f"effective stiffness at step {n}", band_add=a1 * cd)
+            Kb, cd, Mb, G = mats(n)
+            chat = _factor(Kb, np.zeros(n_dof), f"effective stiffness at step {n}", band_add=a1 * cd + a0 * Mb)
             cmul = _band_multiplier(cd)
+            mmul = _band_multiplier(Mb)
+            drop_axial = _axial_remover(model_of(n)[0])
             GT = G.T
             current = key
         # K_hat u_{n+1} = F_{n+1} + M (a0 u + a2 v + a) + C (a1 u + v)   (Bathe Table 9.3)
-        rhs = mrow * (a0 * U + a2 * V + A) + cmul(a1 * U + V)
+        rhs = mmul(a0 * U + a2 * V + A) + cmul(a1 * U + V)
         rhs[:, ydof] += loads[n]
         U_new = _solve(chat, rhs.T).T
         A_new = a0 * (U_new - U) - a2 * V - A
         V += half_dt * (A + A_new)
         U, A = U_new, A_new
+        # a rigid insulator: the attachment node has no velocity or acceleration along the
+        # insulator axis (its axial displacement is the static one); without this the
+        # algebraic axial DOF keeps an undamped (-1)^n Newmark residue that leaks into the
+        # tangential motion whenever the mean state (and so the axis) changes
+        drop_axial(V)
+        drop_axial(A)
         R_F[n] = U @ GT
         if progress is not None and n % report == 0:
             progress(n, n_steps)
@@ -214,15 +223,27 @@ def integrate(
     )
 
 
+def _axial_remover(model: LinearModel) -> Callable[[np.ndarray], None]:
+    """In-place removal of the insulator-axial components of transposed vectors (n_real, n_dof)."""
+    if model.axial_dof.size == 0:
+        return lambda x: None
+    idx = model.axial_dof[:, None] + np.arange(3)[None, :]  # (n_s, 3)
+    a = model.axes  # (n_s, 3)
+
+    def drop(x: np.ndarray) -> None:
+        xs = x[:, idx]  # (n_real, n_s, 3)
+        x[:, idx] = xs - np.einsum("rsd,sd->rs", xs, a)[..., None] * a[None]
+
+    return drop
+
+
 def _band_multiplier(c_band: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
     """x -> x C for transposed vectors x (n_real, n_dof) and a symmetric upper-band matrix C
     (an elementwise multiply when C is diagonal)."""
     if not np.any(c_band[:-1]):
         d = c_band[-1][None, :]
         return lambda x: d * x
-    from scipy.sparse import csr_matrix
+    from .model import band_to_sparse
 
-    from .model import band_to_dense
-
-    C = csr_matrix(band_to_dense(c_band))  # symmetric: x C = (C x^T)^T
+    C = band_to_sparse(c_band)  # symmetric: x C = (C x^T)^T
     return lambda x: (C @ x.T).T

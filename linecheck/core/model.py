@@ -8,7 +8,12 @@ the nodes at strain towers removed (pinned).  Element matrices:
 - insulator (issue 4): from the fixed point to the attachment node, axially stiff
   (penalty EA_ins/v, see :data:`INSULATOR_AXIAL_FACTOR`) and with the geometric
   stiffness R_res/v transversely;
-- lumped mass (paper Eq. 8): m = W L_u / (ne g) per element, half to each node;
+- lumped mass (paper Eq. 8): m = W L_u / (ne g) per element, half to each node.
+  A rigid insulator keeps its attachment node from moving along the insulator axis, so
+  that node has neither inertia nor damping along the axis (M and C are projected onto
+  the plane normal to it): the axial direction is a static equation, solved exactly at
+  every step, and the stiff penalty creates no spurious high-frequency mode.  Eigen
+  analyses condense that direction out exactly (:func:`condensed`);
 - aerodynamic damping (paper Eqs 9-13): c_i = rho C_d D L_i |V_i| on the y DOF of
   node i (L_i its tributary conductor length, V_i the local running-mean normal speed).
 
@@ -69,10 +74,13 @@ class LinearModel:
         dofs: the DOF map.
         K_band: [N/m] symmetric stiffness in LAPACK upper banded storage, shape (6, n_dof)
             (half-bandwidth 5, node-major ordering).
-        mass: [kg] lumped mass per DOF, shape (n_dof,).
+        mass: [kg] lumped nodal mass per DOF, shape (n_dof,) (before the axial projection).
         tributary: [m] tributary unstretched conductor length of every global node, (n_nodes,).
         G: [N/m] reactions from free displacements, shape (n_towers * 3, n_dof); row 3j+c is
             component c (x, y, z-down) of tower j.
+        axes: unit insulator axes at the suspension attachment nodes, shape (n_susp, 3).
+        axial_dof: first DOF of each suspension attachment node, shape (n_susp,).
+        K_axial_band: [N/m] the insulator axial penalty part of ``K_band`` (same storage).
     """
 
     system: LineSystem
@@ -81,6 +89,16 @@ class LinearModel:
     mass: np.ndarray
     tributary: np.ndarray
     G: np.ndarray
+    axes: np.ndarray
+    axial_dof: np.ndarray
+    K_axial_band: np.ndarray
+
+    @cached_property
+    def M_band(self) -> np.ndarray:
+        """[kg] mass in upper band storage, projected normal to the insulator axes."""
+        ab = np.zeros_like(self.K_band)
+        ab[-1] = self.mass
+        return project_axial(self, ab)
 
     @cached_property
     def K_dense(self) -> np.ndarray:
@@ -101,6 +119,24 @@ def band_to_dense(ab: np.ndarray) -> np.ndarray:
         A[idx, idx + k] = d
         A[idx + k, idx] = d
     return A
+
+
+def band_to_sparse(ab: np.ndarray):
+    """Upper banded storage to a symmetric scipy CSR matrix (no dense intermediate)."""
+    from scipy.sparse import dia_matrix
+
+    u, n = ab.shape[0] - 1, ab.shape[1]
+    data, offsets = [], []
+    for k in range(u + 1):
+        row = ab[u - k]
+        data.append(row)  # dia convention: data[i, j] = A[j - offset, j]
+        offsets.append(k)
+        if k:
+            low = np.zeros(n)
+            low[: n - k] = row[k:]  # A[j + k, j] = A[j, j + k]
+            data.append(low)
+            offsets.append(-k)
+    return dia_matrix((np.array(data), np.array(offsets)), shape=(n, n)).tocsr()
 
 
 def _cable_blocks(nodes: np.ndarray, tension: np.ndarray, ea: float) -> np.ndarray:
@@ -153,6 +189,8 @@ def build_model(system: LineSystem, state: StaticState) -> LinearModel:
     ea_cable_el = line.ea / (system.unstretched_length / system.ne)
     k_ax = INSULATOR_AXIAL_FACTOR * ea_cable_el
     ins_blocks = {}
+    axes, axial_dof = [], []
+    K_axial = np.zeros_like(ab)
     for j in np.flatnonzero(system.suspension):
         d = state.displacement[j]
         axis = np.array([d[0], d[1], d[2] - v]) / v  # from fixed point to attachment (points down)
@@ -162,6 +200,11 @@ def build_model(system: LineSystem, state: StaticState) -> LinearModel:
         ins_blocks[j] = blk
         r = nd[system.tower_nodes[j]]
         add_block(r, r, blk)
+        for a_ in range(3):
+            for b_ in range(a_, 3):
+                K_axial[u + a_ - b_, r + b_] += k_ax * P[a_, b_]
+        axes.append(axis)
+        axial_dof.append(r)
 
     # lumped mass (paper Eq. 8) by tributary unstretched length
     Le_u = system.unstretched_length / system.ne
@@ -186,7 +229,95 @@ def build_model(system: LineSystem, state: StaticState) -> LinearModel:
                 if 0 <= e < n_el and nd[other] >= 0:
                     c = nd[other]
                     G[3 * j:3 * j + 3, c:c + 3] += flip[:, None] * kb[e]
-    return LinearModel(system, dm, ab, mass, trib, G)
+    return LinearModel(system, dm, ab, mass, trib, G, np.array(axes).reshape(-1, 3),
+                       np.array(axial_dof, dtype=int), K_axial)
+
+
+def project_axial(model: LinearModel, ab: np.ndarray) -> np.ndarray:
+    """P^T A P for a symmetric upper-band matrix A, P = I - a a^T at every suspension
+    attachment node (identity elsewhere): removes the components along the insulator axes.
+
+    Suspension nodes are at least two FE nodes (6 DOFs) apart, beyond the half-bandwidth,
+    so each node's rows/columns can be transformed in a small dense window.
+    """
+    out = ab.copy()
+    n = ab.shape[1]
+    u = ab.shape[0] - 1
+    for first, a in zip(model.axial_dof, model.axes):
+        lo, hi = max(0, first - u), min(n, first + 3 + u)
+        W = band_window(out, lo, hi)
+        P = np.eye(hi - lo)
+        k = first - lo
+        P[k:k + 3, k:k + 3] -= np.outer(a, a)
+        set_band_window(out, lo, hi, P.T @ W @ P)
+    return out
+
+
+def band_window(ab: np.ndarray, lo: int, hi: int) -> np.ndarray:
+    """Dense copy of rows/columns lo..hi-1 of a symmetric upper-band matrix (entries outside
+    the band are zero)."""
+    u = ab.shape[0] - 1
+    m = hi - lo
+    W = np.zeros((m, m))
+    for i in range(m):
+        for j in range(i, min(m, i + u + 1)):
+            W[i, j] = W[j, i] = ab[u + i - j, lo + j]
+    return W
+
+
+def set_band_window(ab: np.ndarray, lo: int, hi: int, W: np.ndarray) -> None:
+    """Write a dense symmetric window back into upper band storage (within the band)."""
+    u = ab.shape[0] - 1
+    m = hi - lo
+    for i in range(m):
+        for j in range(i, min(m, i + u + 1)):
+            ab[u + i - j, lo + j] = W[i, j]
+
+
+@dataclass(frozen=True)
+class Condensed:
+    """The model with the insulator-axial directions condensed out (exact for massless,
+    undamped DOFs): u = S t, K* = S^T K S, M* = S^T M S, C* = S^T C S.
+
+    Attributes:
+        S: [-] map from condensed to full DOFs, shape (n_dof, n_t).
+        K, M, C: dense condensed matrices, shape (n_t, n_t).
+    """
+
+    S: np.ndarray
+    K: np.ndarray
+    M: np.ndarray
+    C: np.ndarray
+
+
+def condensed(model: LinearModel, damping_band: np.ndarray | None = None) -> Condensed:
+    """Static condensation of the axial directions at suspension nodes (Guyan 1965; exact
+    here because those directions carry no mass and no damping)."""
+    n = model.mass.size
+    K = model.K_dense
+    keep = np.ones(n, dtype=bool)
+    Tt = np.eye(n)
+    ax_cols = []
+    for first, a in zip(model.axial_dof, model.axes):
+        # orthonormal basis (t1, t2, a) of the node's space
+        basis = np.linalg.svd(np.eye(3) - np.outer(a, a))[0][:, :2]
+        Tt[first:first + 3, first:first + 3] = 0.0
+        Tt[first:first + 3, first:first + 2] = basis
+        keep[first + 2] = False
+        col = np.zeros(n)
+        col[first:first + 3] = a
+        ax_cols.append(col)
+    T = Tt[:, keep]  # (n, n_t): condensed coordinates
+    if ax_cols:
+        Ax = np.array(ax_cols).T  # (n, n_a)
+        Kaa = Ax.T @ K @ Ax
+        Kat = Ax.T @ K @ T
+        S = T - Ax @ np.linalg.solve(Kaa, Kat)  # u = T t + a u_a, u_a = -Kaa^-1 Kat t
+    else:
+        S = T
+    M = band_to_dense(model.M_band)
+    C = np.zeros_like(K) if damping_band is None else band_to_dense(damping_band)
+    return Condensed(S, S.T @ K @ S, S.T @ M @ S, S.T @ C @ S)
 
 
 def reaction_matrix_direct(system: LineSystem) -> np.ndarray:

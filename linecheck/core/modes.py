@@ -1,6 +1,7 @@
 """Natural frequencies and mode shapes of a linearised state (issue 4, `linecheck modes`).
 
-Generalised eigenproblem K phi = omega^2 M phi with the lumped (diagonal) mass,
+Generalised eigenproblem K phi = omega^2 M phi with the lumped (diagonal) mass, on the
+model with the insulator-axial directions condensed out (:func:`~linecheck.core.model.condensed`),
 solved as the symmetric standard problem M^-1/2 K M^-1/2 psi = omega^2 psi.
 """
 
@@ -11,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import eigh
 
-from .model import LinearModel
+from .model import LinearModel, condensed
 
 
 @dataclass(frozen=True)
@@ -34,11 +35,13 @@ class Modes:
 
 def natural_modes(model: LinearModel, n_modes: int = 20) -> Modes:
     """The ``n_modes`` lowest undamped modes of ``model`` (dense symmetric eigensolver)."""
-    n = min(n_modes, model.mass.size)
-    s = 1.0 / np.sqrt(model.mass)
-    A = model.K_dense * s[:, None] * s[None, :]
+    c = condensed(model)
+    m = np.diag(c.M)  # diagonal in the condensed coordinates (lumped mass)
+    n = min(n_modes, m.size)
+    s = 1.0 / np.sqrt(m)
+    A = c.K * s[:, None] * s[None, :]
     w2, psi = eigh(A, subset_by_index=[0, n - 1])
-    phi = psi * s[:, None]
+    phi = c.S @ (psi * s[:, None])  # back to the full DOFs, mass-normalised
     freq = np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi)
     shapes = np.zeros((n, model.system.n_nodes, 3))
     free = model.dofs.free_nodes

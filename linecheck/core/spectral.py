@@ -39,7 +39,7 @@ import numpy as np
 from scipy.linalg import eig, lapack, solve_banded
 
 from .errors import NumericalError
-from .model import BANDWIDTH, LinearModel, band_to_dense, reaction_matrix_direct
+from .model import BANDWIDTH, LinearModel, condensed, reaction_matrix_direct
 from .wind.turbulence import von_karman_cumulative, von_karman_psd
 
 EULER_GAMMA = 0.5772156649
@@ -67,7 +67,10 @@ class ComplexModes:
         frequencies_hz: [Hz] undamped-equivalent natural frequency |lambda|/(2 pi), (n,).
         damping_ratio: [-] zeta = -Re(lambda)/|lambda|, (n,).
         poles: complex eigenvalues lambda, (n,).
-        right, left: state eigenvectors psi_k, chi_k as columns, (2 n_dof, n), or None.
+        right, left: state eigenvectors psi_k, chi_k as columns, (2 n_t, n), or None, in the
+            condensed coordinates t of :func:`~linecheck.core.model.condensed` (u = S t).
+        S: [-] condensed-to-full DOF map (n_dof, n_t), or None.
+        mass: [kg] condensed (diagonal) mass, (n_t,), or None.
     """
 
     frequencies_hz: np.ndarray
@@ -75,6 +78,8 @@ class ComplexModes:
     poles: np.ndarray
     right: np.ndarray | None = None
     left: np.ndarray | None = None
+    S: np.ndarray | None = None
+    mass: np.ndarray | None = None
 
 
 def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None = None,
@@ -86,14 +91,13 @@ def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None 
         max_hz: keep only modes below this frequency [Hz].
         vectors: also return right and left eigenvectors.
     """
-    K = model.K_dense
-    n = K.shape[0]
-    minv = 1.0 / model.mass
-    C = band_to_dense(damping)
+    cd = condensed(model, damping)  # insulator-axial directions condensed out (exact)
+    n = cd.K.shape[0]
+    minv = 1.0 / np.diag(cd.M)  # diagonal lumped mass in condensed coordinates
     A = np.zeros((2 * n, 2 * n))
     A[:n, n:] = np.eye(n)
-    A[n:, :n] = -minv[:, None] * K
-    A[n:, n:] = -minv[:, None] * C
+    A[n:, :n] = -minv[:, None] * cd.K
+    A[n:, n:] = -minv[:, None] * cd.C
     if vectors:
         lam, vl, vr = eig(A, left=True, right=True)
     else:
@@ -106,7 +110,8 @@ def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None 
     lam = lam[idx]
     w = np.abs(lam)
     return ComplexModes(w / (2 * np.pi), -lam.real / w, lam,
-                        None if vr is None else vr[:, idx], None if vl is None else vl[:, idx])
+                        None if vr is None else vr[:, idx], None if vl is None else vl[:, idx],
+                        cd.S if vectors else None, np.diag(cd.M).copy() if vectors else None)
 
 
 def frequency_grid(f_lo: float, f_hi: float, modes: ComplexModes, *, n_log: int = 400, n_peak: int = 33,
@@ -231,15 +236,15 @@ def random_vibration(
     base[kl:] = K_gen
     cbase = np.zeros_like(base)
     cbase[kl:] = _general_band(damping)
-    mrow = kl + BANDWIDTH  # main diagonal row
+    mbase = np.zeros_like(base)
+    mbase[kl:] = _general_band(model.M_band)
     rhs0 = np.asfortranarray(Gt.T.astype(complex))
     tF = np.empty((f.size, 3, system.n_nodes), dtype=complex)
     tF[:] = Dt[None]
     zgbsv = lapack.zgbsv
     for k, fk in enumerate(f):
         w = 2 * np.pi * fk
-        ab = base + (1j * w) * cbase  # K - w^2 M + i w C
-        ab[mrow] -= w**2 * model.mass
+        ab = base + (1j * w) * cbase - w**2 * mbase  # K - w^2 M + i w C
         _, _, x, info = zgbsv(kl, kl, ab, rhs0, overwrite_ab=1)
         if info != 0:
             raise NumericalError(f"dynamic stiffness singular at {fk:.6g} Hz (LAPACK zgbsv info {info})")
@@ -402,11 +407,11 @@ def modal_contributions(
     Args:
         modes: complex modes of ``model`` with its damping, computed with ``vectors=True``.
     """
-    if modes.right is None or modes.left is None:
+    if modes.right is None or modes.left is None or modes.S is None:
         raise ValueError("modal_contributions needs complex modes computed with vectors=True")
     system = model.system
-    n = model.mass.size
-    minv = 1.0 / model.mass
+    S = modes.S
+    n = S.shape[1]
     sel = modes.frequencies_hz <= max_hz
     lam, vl, vr = modes.poles[sel], modes.left[:, sel], modes.right[:, sel]
     f = modes.frequencies_hz[sel]
@@ -414,9 +419,10 @@ def modal_contributions(
     ydof = model.dofs.node_dof[free] + 1
     rows = slice(3 * tower, 3 * tower + 3)
     norm = np.abs(np.einsum("ik,ik->k", vl.conj(), vr))  # |chi^H psi|
-    r = model.G[rows] @ vr[:n]  # (3, n_modes)
+    r = model.G[rows] @ (S @ vr[:n])  # (3, n_modes) reaction per unit modal amplitude
+    L = S[ydof].T / modes.mass[:, None]  # M*^-1 S^T maps a y-load at free node i to b
     cvec = np.zeros((lam.size, system.n_nodes), dtype=complex)
-    cvec[:, free] = (vl[n + ydof].conj() * minv[ydof][:, None]).T * load_per_v[free][None, :]
+    cvec[:, free] = (vl[n:].conj().T @ L) * load_per_v[free][None, :]
     dx = system.line.span_length / system.ne
     rho = np.exp(-coherence_decay * f * dx / v_mean)
     SQ = von_karman(f, sigma, length_scale, v_mean) * _quad_kms(cvec, rho)

@@ -69,3 +69,4 @@ def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
 from . import run_cmd  # noqa: E402,F401
 from . import spectral_cmd  # noqa: E402,F401
 from . import wind_cmd  # noqa: E402,F401
+from . import export_cmd  # noqa: E402,F401

@@ -17,6 +17,7 @@ from ..core.results import REACTIONS
 from ..io.atomic import check_target
 from ..io.jsonout import _num, run_to_dict, write_json
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
+from .export_cmd import ExcelOpt, ForceOpt, TemplateOpt
 from .progress import progress_bar
 
 RealOpt = Annotated[int | None, typer.Option("--realizations", "-n", help="Number of realizations (overrides the case).", min=1)]
@@ -76,11 +77,18 @@ def run(
     realizations: RealOpt = None,
     seed: SeedOpt = None,
     full_histories: Annotated[bool, typer.Option("--full-histories", help="Keep full-resolution time histories in the outputs.")] = False,
+    excel: ExcelOpt = None,
+    template: TemplateOpt = None,
+    force: ForceOpt = False,
 ) -> None:
     """Steps 1-3: mean, background and resonant reactions, gust factors and contributions."""
     case = override(read_case(case_file), realizations, seed)
     if json_out is not None:
         check_target(json_out, what="JSON")
+    if excel is not None:
+        from ..excel.writer import check_excel_target
+
+        check_excel_target(excel, force=force, template=template)
     with progress_bar() as cb:
         res = service.run_case(case, progress=cb)
     doc = run_to_dict(res, full_histories=full_histories)
@@ -93,6 +101,11 @@ def run(
     if json_out is not None:
         write_json(json_out, doc)
         console.print(f"wrote {json_out}")
+    if excel is not None:
+        from ..excel.writer import write_workbook
+
+        write_workbook([doc], excel, template=template, force=force)
+        console.print(f"wrote {excel}")
 
 
 @app.command()

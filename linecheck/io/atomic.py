@@ -40,6 +40,10 @@ def atomic_path(path: str | Path, *, force: bool = True, what: str = "output") -
     tmp_path = Path(tmp)
     try:
         yield tmp_path
+        # mkstemp creates 0600; give the output the permissions a plain open() would
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp_path, 0o666 & ~umask)
         if p.exists() and not force:
             raise CaseError(f"{what} file appeared while writing; use --force to replace it", file=str(p))
         try:

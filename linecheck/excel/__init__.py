@@ -1,0 +1,10 @@
+"""Excel design sheets (front-end side: imports openpyxl; never imported by the core).
+
+:func:`write_workbook` writes the workbook of one or more run result documents
+(``run_to_dict`` dicts or the same dicts loaded from JSON); ``linecheck run --excel``,
+``linecheck batch --excel`` and ``linecheck export`` all call it.
+"""
+
+from .writer import check_excel_target, load_result_docs, write_workbook
+
+__all__ = ["write_workbook", "check_excel_target", "load_result_docs"]

@@ -1,0 +1,166 @@
+"""Shared pieces of the workbook: number formats, cell values, styles helpers, sheet names."""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Sequence
+from typing import Any
+
+from openpyxl.styles import Alignment, Font
+from openpyxl.worksheet.hyperlink import Hyperlink
+from openpyxl.worksheet.worksheet import Worksheet
+
+REACTIONS = ("Rx", "Ry", "Rz")
+#: Reactions of the Summary and Peaks sheets by default: the paper's Table 5 and Fig. 13 (Rz, the
+#: vertical reaction, whose wind-induced part is small beside the conductor weight, is on the case sheets).
+SUMMARY_REACTIONS = ("Rx", "Ry")
+
+# number formats
+KN = "#,##0.00"
+KN3 = "#,##0.000"
+RATIO = "0.00"
+PCT = "0.00%"
+NORM = "0.000"
+SEC = "0.0"
+
+#: Summary columns after the identification columns: (statistic, header, format, kind, with ± std).
+SUMMARY_STATS: tuple[tuple[str, str, str, str, bool], ...] = (
+    ("mean_max", "mean_max\n(kN)", KN, "kN", False),
+    ("peak_quasi_static", "peak QS\n(kN)", KN, "kN", True),
+    ("peak_dynamic", "peak Dy\n(kN)", KN, "kN", True),
+    ("GF_Dy", "GF_Dy", RATIO, "gf", True),
+    ("GF_QS", "GF_QS", RATIO, "gf", True),
+    ("Cont_M", "Cont_M\n(%)", PCT, "pct", True),
+    ("Cont_BG", "Cont_BG\n(%)", PCT, "pct", True),
+    ("Cont_R", "Cont_R\n(%)", PCT, "pct", True),
+    ("peak_normalised", "peak /\n(g*yp Lx)", NORM, "ratio", True),
+)
+SUMMARY_IDS = (("Case", 16), ("Wind", 14), ("Spans", 6), ("L_x\n(m)", 7), ("V_ref\n(m/s)", 7),
+               ("Tower", 6), ("n", 5), ("Reaction", 8))
+
+#: Statistics of the case sheets: key -> (unit, format, kind, meaning).
+STAT_INFO = {
+    "mean_max": ("kN", KN3, "kN", "max over time of |M|, wind-induced mean"),
+    "rms_background": ("kN", KN3, "kN", "r.m.s. of the background B"),
+    "rms_resonant": ("kN", KN3, "kN", "r.m.s. of the resonant R = F - B"),
+    "rms_fluctuating": ("kN", KN3, "kN", "r.m.s. of B + R"),
+    "peak_quasi_static": ("kN", KN3, "kN", "max |M + B| (quasi-static peak)"),
+    "peak_dynamic": ("kN", KN3, "kN", "max |M + B + R| (dynamic peak)"),
+    "peak_quasi_static_total": ("kN", KN3, "kN", "quasi-static peak incl. still air"),
+    "peak_dynamic_total": ("kN", KN3, "kN", "dynamic peak incl. still air"),
+    "GF_Dy": ("-", RATIO, "gf", "peak_dynamic / mean_max (Eq. 15)"),
+    "GF_QS": ("-", RATIO, "gf", "peak_quasi_static / mean_max (Eq. 15)"),
+    "Cont_M": ("%", PCT, "pct", "mean_max / peak (Eq. 16)"),
+    "Cont_BG": ("%", PCT, "pct", "(peak_QS - mean_max) / peak (Eq. 16)"),
+    "Cont_R": ("%", PCT, "pct", "(peak - peak_QS) / peak (Eq. 16)"),
+    "peak_normalised": ("-", NORM, "ratio", "peak_dynamic / (g*yp Lx) (Eq. 17)"),
+    "peak_normalised_total": ("-", NORM, "ratio", "peak_dynamic_total / (g*yp Lx)"),
+}
+
+#: Default thinning of the time histories for the charts (points per case).
+CHART_POINTS = 1000
+
+FLAG_NOTE = "dynamic analysis recommended"
+GF_UNDEFINED = "**"
+
+_RESERVED = {"summary", "peaks"}
+
+
+def is_num(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def cell_value(v: Any, kind: str) -> Any:
+    """The cell value of JSON value ``v``: kN for forces, fractions for %, ``**`` for a null GF."""
+    if not is_num(v):
+        return GF_UNDEFINED if kind == "gf" else None
+    if kind == "kN":
+        return v / 1000.0
+    return v
+
+
+def kn(v: Any) -> Any:
+    return v / 1000.0 if is_num(v) else None
+
+
+def sheet_name(name: str, taken: set[str]) -> str:
+    """A valid, unique (case-insensitive) sheet name from a case name."""
+    base = re.sub(r"[\[\]:*?/\\]", "_", str(name)).strip("' ") or "case"
+    base = base[:31]
+    cand, k = base, 2
+    while cand.lower() in taken or cand.lower() in _RESERVED:
+        suffix = f" ({k})"
+        cand = base[: 31 - len(suffix)] + suffix
+        k += 1
+    taken.add(cand.lower())
+    return cand
+
+
+def wind_label(doc: dict) -> str:
+    wind = str(doc.get("wind", ""))
+    params = doc.get("parameters") or {}
+    db = (params.get("wind") or {}).get("downburst") or {}
+    preset = db.get("preset") if isinstance(db, dict) else None
+    return f"{wind} {preset}" if preset else wind
+
+
+def align(cell, **changes: Any) -> None:
+    """Change some alignment attributes of a cell, keeping the others."""
+    a = cell.alignment
+    cell.alignment = Alignment(horizontal=changes.get("horizontal", a.horizontal),
+                               vertical=changes.get("vertical", a.vertical),
+                               wrap_text=changes.get("wrap_text", a.wrap_text),
+                               indent=changes.get("indent", a.indent))
+
+
+def link(cell, sheet: str) -> None:
+    cell.hyperlink = Hyperlink(ref=cell.coordinate, location=f"'{sheet}'!A1", display=str(cell.value))
+    cell.font = Font(name="Calibri", size=10, color="0563C1", underline="single")
+
+
+def page_setup(ws: Worksheet, like: Worksheet | None, *, landscape: bool = True) -> None:
+    ws.page_setup.orientation = "landscape" if landscape else "portrait"
+    ws.page_setup.paperSize = (like.page_setup.paperSize if like is not None and like.page_setup.paperSize
+                               else ws.PAPERSIZE_A4)
+    ws.sheet_properties.pageSetUpPr.fitToPage = True
+    ws.page_setup.fitToWidth = 1
+    ws.page_setup.fitToHeight = 0
+    ws.page_margins.left = ws.page_margins.right = 0.5
+    ws.page_margins.top = ws.page_margins.bottom = 0.75
+    ws.page_margins.header = ws.page_margins.footer = 0.3
+    ws.oddFooter.left.text = "linecheck design sheet"
+    ws.oddFooter.right.text = "page &P of &N"
+
+
+class Cursor:
+    """Writes styled cells down a sheet."""
+
+    def __init__(self, ws: Worksheet, row: int = 1) -> None:
+        self.ws = ws
+        self.row = row
+
+    def put(self, row: int, col: int, value: Any, style: str = "lc_number", fmt: str | None = None):
+        c = self.ws.cell(row=row, column=col, value=value)
+        c.style = style
+        if fmt is not None and is_num(value):
+            c.number_format = fmt
+        return c
+
+    def section(self, text: str, width: int = 8) -> None:
+        self.row += 1
+        for col in range(1, width + 1):
+            self.ws.cell(row=self.row, column=col).style = "lc_section"
+        self.ws.cell(row=self.row, column=1, value=text)
+        self.row += 1
+
+    def header(self, labels: Sequence[str], col0: int = 1) -> None:
+        for k, label in enumerate(labels):
+            self.put(self.row, col0 + k, label, "lc_header")
+        self.row += 1
+
+    def note(self, text: str) -> None:
+        self.put(self.row, 1, text, "lc_note")
+        self.row += 1
+
+

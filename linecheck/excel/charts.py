@@ -1,0 +1,186 @@
+"""Native Excel charts of a case sheet (paper Figs B1-B12, 7, 12) and their data columns."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from openpyxl.chart import BarChart, Reference, ScatterChart, Series
+from openpyxl.chart.text import RichText, Text
+from openpyxl.chart.title import Title
+from openpyxl.drawing.text import CharacterProperties, Paragraph, ParagraphProperties, RegularTextRun
+from openpyxl.worksheet.worksheet import Worksheet
+
+from .cells import is_num
+
+#: Layout of a case sheet: charts to the right of the tables (columns A-H), data outside the print area.
+CHART_COL = 10  # J
+DATA_COL = 21   # U
+CHART_W, CHART_H, CHART_ROWS = 17.0, 7.4, 15
+
+
+def chart_indices(columns: list[np.ndarray], max_points: int) -> np.ndarray:
+    """Sample indices for charts: first, last and every block's min and max of each column."""
+    n = columns[0].size if columns else 0
+    if n <= max_points:
+        return np.arange(n)
+    per_block = 2 * len(columns)
+    nb = max(1, max_points // per_block)
+    edges = np.linspace(0, n, nb + 1).astype(int)
+    keep = [np.array([0, n - 1])]
+    stack = np.stack([np.nan_to_num(c, nan=0.0) for c in columns], axis=1)
+    for a, b in zip(edges[:-1], edges[1:]):
+        if b <= a:
+            continue
+        blk = stack[a:b]
+        keep.append(a + blk.argmin(axis=0))
+        keep.append(a + blk.argmax(axis=0))
+    return np.unique(np.concatenate(keep))
+
+
+def as_array(values: Any) -> np.ndarray:
+    """A JSON list (nulls allowed) as a float array (NaN for null)."""
+    return np.asarray([np.nan if v is None else v for v in (values or [])], dtype=float)
+
+
+def _write_column(ws: Worksheet, col: int, row0: int, header: str, values: np.ndarray) -> None:
+    ws.cell(row=row0, column=col, value=header)
+    for i, v in enumerate(values.tolist()):
+        ws.cell(row=row0 + 1 + i, column=col, value=v if math.isfinite(v) else None)
+
+
+def _line_series(ws: Worksheet, xcol: int, ycol: int, row0: int, n: int, color: str, width: int) -> Series:
+    x = Reference(ws, min_col=xcol, min_row=row0 + 1, max_row=row0 + n)
+    y = Reference(ws, min_col=ycol, min_row=row0, max_row=row0 + n)
+    s = Series(y, x, title_from_data=True)
+    s.marker.symbol = "none"
+    s.smooth = False
+    s.graphicalProperties.line.solidFill = color
+    s.graphicalProperties.line.width = width
+    return s
+
+
+def chart_title(text: str, size: int = 1100) -> Title:
+    """A chart title in a moderate font (openpyxl's default is 18 pt)."""
+    cp = CharacterProperties(sz=size, b=True)
+    para = Paragraph(pPr=ParagraphProperties(defRPr=cp), r=[RegularTextRun(rPr=cp, t=text)])
+    return Title(tx=Text(rich=RichText(p=[para])), overlay=False)
+
+
+def _scatter(title: str, xtitle: str, ytitle: str, yfmt: str = "0") -> ScatterChart:
+    ch = ScatterChart()
+    ch.title = chart_title(title)
+    ch.style = 2
+    ch.scatterStyle = "line"
+    ch.x_axis.title = xtitle
+    ch.y_axis.title = ytitle
+    ch.y_axis.number_format = yfmt
+    ch.x_axis.number_format = "0"
+    ch.x_axis.delete = False
+    ch.y_axis.delete = False
+    ch.x_axis.majorGridlines = None
+    ch.x_axis.tickLblPos = "low"  # time labels below the plot even when the reaction goes negative
+    ch.legend.position = "b"
+    ch.width, ch.height = CHART_W, CHART_H
+    return ch
+
+
+def case_charts(ws: Worksheet, doc: dict, chart_points: int, contrib_rows: tuple[int, int]) -> list:
+    """Charts of a case sheet (histories of Rx and Ry, tension H/T0, contributions); data from column U.
+
+    ``contrib_rows``: first and last row of the sheet's contributions table (reaction in
+    column A, Cont_M/Cont_BG/Cont_R in C-E, headers on the row above).
+    """
+    charts = []
+    col = DATA_COL
+    ws.cell(row=1, column=col, value="Chart data (from the JSON result; time histories thinned keeping "
+                                     "each block's extremes unless saved with --full-histories)").style = "lc_note"
+    th = doc.get("time_histories")
+    if isinstance(th, dict) and th.get("time"):
+        t = as_array(th["time"])
+        series: dict[str, dict[str, np.ndarray]] = {}
+        for r in ("Rx", "Ry"):
+            comp = th.get(r) or {}
+            m, b, rr = as_array(comp.get("M")), as_array(comp.get("B")), as_array(comp.get("R"))
+            if m.size == t.size and b.size == t.size and rr.size == t.size:
+                series[r] = {"M": m / 1e3, "M+B": (m + b) / 1e3, "M+B+R": (m + b + rr) / 1e3}
+        if series:
+            full = th.get("decimated") is False
+            idx = np.arange(t.size) if full else chart_indices(
+                [s[k] for s in series.values() for k in ("M+B+R", "M+B")], chart_points)
+            row0 = 3
+            _write_column(ws, col, row0, "t (s)", t[idx])
+            xcol = col
+            col += 1
+            real = th.get("realization", 1)
+            for r, s in series.items():
+                ch = _scatter(f"{r} at tower {doc['tower_of_interest']}: M, M+B, M+B+R (realization {real})",
+                              "time (s)", f"{r} (kN)", "0.0")
+                cols = {}
+                for key in ("M", "M+B", "M+B+R"):
+                    _write_column(ws, col, row0, f"{r} {key} (kN)", s[key][idx])
+                    cols[key] = col
+                    col += 1
+                for key, color, width in (("M+B+R", "C55A11", 9525), ("M+B", "2E75B6", 9525),
+                                          ("M", "000000", 22225)):
+                    ch.series.append(_line_series(ws, xcol, cols[key], row0, idx.size, color, width))
+                if t.size:
+                    ch.x_axis.scaling.min = float(np.nanmin(t))
+                    ch.x_axis.scaling.max = float(np.nanmax(t))
+                charts.append(ch)
+            col += 1
+    # ---- Fig. 7: running-mean tension / T0 of the spans next to the tower of interest
+    static = doc.get("static")
+    still = doc.get("still_air") or {}
+    t0 = still.get("tension_nominal") if isinstance(still, dict) else None
+    if isinstance(static, dict) and static.get("tension") and is_num(t0) and t0 > 0:
+        times = as_array(static.get("time"))
+        h = np.asarray([[np.nan if v is None else v for v in row] for row in static["tension"]], dtype=float)
+        toi = int(doc["tower_of_interest"])
+        spans = [s for s in (toi - 1, toi) if 1 <= s <= h.shape[1]]
+        if times.size == 1:  # synoptic: constant over the record
+            dur = doc.get("duration") if is_num(doc.get("duration")) else 600.0
+            times = np.array([0.0, float(dur)])
+            h = np.repeat(h, 2, axis=0)
+        if times.size == h.shape[0] and spans:
+            row0 = 3
+            _write_column(ws, col, row0, "t (s)", times)
+            xcol = col
+            col += 1
+            ch = _scatter(f"Running-mean span tension H / T0 (Fig. 7), T0 = {t0 / 1e3:.1f} kN",
+                          "time (s)", "H / T0", "0.00")
+            for s, color in zip(spans, ("2E75B6", "C55A11")):
+                side = "left" if s == toi - 1 else "right"
+                _write_column(ws, col, row0, f"span {s} ({side})", h[:, s - 1] / t0)
+                ch.series.append(_line_series(ws, xcol, col, row0, times.size, color, 19050))
+                col += 1
+            ch.x_axis.scaling.min = float(times.min())
+            ch.x_axis.scaling.max = float(times.max())
+            charts.append(ch)
+            col += 1
+    # ---- Fig. 12: contributions, stacked bars from the visible contributions table
+    first, last = contrib_rows
+    bar = BarChart()
+    bar.type = "col"
+    bar.grouping = "stacked"
+    bar.overlap = 100
+    bar.title = chart_title("Contributions to the peak reaction (Fig. 12)")
+    bar.y_axis.title = "share of peak"
+    bar.y_axis.number_format = "0%"
+    bar.y_axis.scaling.min = 0.0
+    bar.y_axis.scaling.max = 1.0
+    bar.x_axis.delete = False
+    bar.y_axis.delete = False
+    bar.add_data(Reference(ws, min_col=3, max_col=5, min_row=first - 1, max_row=last), titles_from_data=True)
+    bar.set_categories(Reference(ws, min_col=1, min_row=first, max_row=last))
+    for s, color in zip(bar.series, ("A6A6A6", "2E75B6", "C55A11")):
+        s.graphicalProperties.solidFill = color
+        s.graphicalProperties.line.solidFill = color
+    bar.gapWidth = 80
+    bar.legend.position = "b"
+    bar.width, bar.height = CHART_W, CHART_H
+    charts.append(bar)
+    return charts
+
+

@@ -1,0 +1,200 @@
+"""The "Summary" (paper Table 5 layout) and "Peaks" (Fig. 13) sheets."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from openpyxl.chart import BarChart, Reference
+from openpyxl.formatting.rule import CellIsRule
+from openpyxl.styles import Font, PatternFill
+from openpyxl.utils import get_column_letter
+from openpyxl.worksheet.worksheet import Worksheet
+
+from . import template as tpl
+from .cells import (
+    FLAG_NOTE,
+    GF_UNDEFINED,
+    NORM,
+    SUMMARY_IDS,
+    SUMMARY_STATS,
+    Cursor,
+    align,
+    cell_value,
+    is_num,
+    link,
+    page_setup,
+    wind_label,
+)
+from .charts import chart_title
+
+
+# --------------------------------------------------------------------------- Summary
+def write_summary(ws: Worksheet, docs: list[dict], names: list[str | None], threshold: float,
+                  top: int, left: int, summary_reactions: Sequence[str]) -> None:
+    """The Table 5 table from (top, left): one row per case and reaction, flags, notes, print setup."""
+    with_std = any(int(d.get("realizations") or 1) > 1 for d in docs if "error" not in d)
+    cols: list[tuple[str, Any, int]] = []  # (header, spec, width)
+    for label, width in SUMMARY_IDS:
+        cols.append((label, None, width))
+    for spec in SUMMARY_STATS:
+        cols.append((spec[1], (spec, "mean"), 9))
+        if with_std and spec[4]:
+            cols.append(("±", (spec, "std"), 7))
+    cols.append(("Note", None, 44))
+    cur = Cursor(ws, top)
+    for k, (label, _, width) in enumerate(cols):
+        cur.put(top, left + k, label, "lc_header")
+        letter = get_column_letter(left + k)
+        current = ws.column_dimensions[letter].width
+        ws.column_dimensions[letter].width = max(width, current if current and current != 13 else 0)
+    ws.row_dimensions[top].height = 30
+    row = top + 1
+    cont_r_col = None
+    band = PatternFill("solid", fgColor=tpl.BAND_FILL)
+    for n_doc, doc in enumerate(docs):
+        failed = "error" in doc
+        reactions = ("—",) if failed else summary_reactions
+        for r in reactions:
+            if failed:
+                idvals = [doc["case"], doc.get("wind", ""), None, None, None, None, None, None]
+            else:
+                idvals = [doc["case"], wind_label(doc), doc.get("spans"), doc.get("span_length"), doc.get("v_ref"),
+                          doc.get("tower_of_interest"), doc.get("realizations"), r]
+            c = 0
+            for k, v in enumerate(idvals):
+                cell = cur.put(row, left + c, v, "lc_text" if k in (0, 1, 7) else "lc_number")
+                if k == 3 or k == 4:
+                    cell.number_format = "0.#"
+                if k in (2, 5, 6, 7):
+                    align(cell, horizontal="center")
+                if k == 0 and not failed:
+                    link(cell, names[n_doc])
+                c += 1
+            note = ""
+            for label, spec, _ in cols[len(SUMMARY_IDS):-1]:
+                (stat, _h, fmt, kind, _s), which = spec
+                if failed:
+                    cur.put(row, left + c, None)
+                else:
+                    entry = doc["reactions"][r][stat]
+                    if which == "std" and int(doc.get("realizations") or 1) < 2:
+                        value = None
+                    else:
+                        value = cell_value(entry.get(which), kind if which == "mean" else ("kN" if kind == "kN" else "x"))
+                    cur.put(row, left + c, value, "lc_number", fmt)
+                    if stat == "Cont_R" and which == "mean":
+                        cont_r_col = left + c
+                        v = entry.get("mean")
+                        if is_num(v) and v > threshold:
+                            note = FLAG_NOTE
+                c += 1
+            if failed:
+                note = f"FAILED: {doc['error']}"
+            ncell = cur.put(row, left + c, note, "lc_text")
+            align(ncell, indent=1)
+            if failed:
+                ncell.font = Font(name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT)
+                align(ncell, wrap_text=True)
+            elif note:
+                ncell.font = Font(name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT)
+            if n_doc % 2 == 1:
+                for k in range(len(cols)):
+                    ws.cell(row=row, column=left + k).fill = band
+            row += 1
+    last = row - 1
+    right = left + len(cols) - 1
+    if cont_r_col is not None and last > top:
+        letter = get_column_letter(cont_r_col)
+        ws.conditional_formatting.add(
+            f"{letter}{top + 1}:{letter}{last}",
+            CellIsRule(operator="greaterThan", formula=[repr(float(threshold))],
+                       fill=PatternFill("solid", fgColor=tpl.FLAG_FILL, bgColor=tpl.FLAG_FILL),
+                       font=Font(bold=True, color=tpl.FLAG_FONT)))
+    cur.row = last + 2
+    cur.note(f"Cont_R above {threshold:.0%} is flagged: {FLAG_NOTE} (the resonant share of the peak "
+             "that a quasi-static analysis misses; paper Sect. 5).")
+    cur.note(f"{GF_UNDEFINED} : GF undefined, the mean reaction is zero by symmetry or below 1 % of the "
+             "largest mean reaction of the case; peaks and contributions are still given.")
+    cur.note("Values are those of the JSON results: forces N/1000; Cont_* are the JSON fractions shown in %; "
+             "± is the standard deviation over the realizations (n).")
+    cur.note("Reactions at the tower of interest, wind-induced (still air excluded): Rx along the line, "
+             "Ry transverse (wind), Rz vertical" + ("" if "Rz" in summary_reactions else
+                                                    " (Rz on the case sheets: its wind-induced part is small beside "
+                                                    "the conductor weight)") + ".")
+    ws.auto_filter.ref = f"{get_column_letter(left)}{top}:{get_column_letter(right)}{last}"
+    ws.freeze_panes = ws.cell(row=top + 1, column=left + 1)
+    ws.print_title_rows = f"{top}:{top}"
+    ws.print_area = f"A1:{get_column_letter(right)}{cur.row}"
+    ws.sheet_properties.pageSetUpPr.fitToPage = True
+    ws.page_setup.fitToWidth = 1
+    ws.page_setup.fitToHeight = 0
+    if not ws.page_setup.orientation:
+        ws.page_setup.orientation = "landscape"
+
+
+# --------------------------------------------------------------------------- Peaks
+def write_peaks(ws: Worksheet, cases: list[tuple[dict, str]], like: Worksheet,
+                reactions: Sequence[str]) -> None:
+    """Normalised peaks of every case and their bar chart (Fig. 13)."""
+    docs = [d for d, _ in cases]
+    cur = Cursor(ws, 1)
+    cur.put(1, 1, "Normalised peak reactions peak_dynamic / (g*yp Lx) (paper Fig. 13)", "lc_title")
+    cur.put(2, 1, "g*yp = ½ ρ C_d V_ref² D (Eq. 17); reactions at the tower of interest; mean over realizations.",
+            "lc_subtitle")
+    cur.row = 4
+    with_std = any(int(d.get("realizations") or 1) > 1 for d in docs)
+    nr = len(reactions)
+    labels = ["Case", "Wind", "Spans", "L_x\n(m)", "V_ref\n(m/s)", *reactions]
+    if with_std:
+        labels += [f"± {r}" for r in reactions]
+    cur.header(labels)
+    ws.row_dimensions[cur.row - 1].height = 30
+    widths = [18, 14, 6, 8, 9] + [8] * nr + [7] * nr
+    for k, w in enumerate(widths[: len(labels)]):
+        ws.column_dimensions[get_column_letter(k + 1)].width = w
+    first = cur.row
+    for doc, name in cases:
+        r = cur.row
+        cell = cur.put(r, 1, doc["case"], "lc_text")
+        link(cell, name)
+        cur.put(r, 2, wind_label(doc), "lc_text")
+        cur.put(r, 3, doc.get("spans"))
+        cur.put(r, 4, doc.get("span_length"), fmt="0.#")
+        cur.put(r, 5, doc.get("v_ref"), fmt="0.#")
+        n = int(doc.get("realizations") or 1)
+        for k, rn in enumerate(reactions):
+            e = doc["reactions"][rn]["peak_normalised"]
+            cur.put(r, 6 + k, cell_value(e.get("mean"), "ratio"), fmt=NORM)
+            if with_std:
+                cur.put(r, 6 + nr + k, cell_value(e.get("std"), "ratio") if n > 1 else None, fmt=NORM)
+        cur.row += 1
+    last = cur.row - 1
+    ch = BarChart()
+    ch.type = "col"
+    ch.grouping = "clustered"
+    ch.title = chart_title("Normalised peak reactions (Fig. 13)")
+    ch.y_axis.title = "peak / (g*yp Lx)"
+    ch.y_axis.number_format = "0.0"
+    ch.x_axis.delete = False
+    ch.y_axis.delete = False
+    data = Reference(ws, min_col=6, max_col=5 + nr, min_row=first - 1, max_row=last)
+    ch.add_data(data, titles_from_data=True)
+    ch.set_categories(Reference(ws, min_col=1, min_row=first, max_row=last))
+    for s, color in zip(ch.series, ("2E75B6", "C55A11", "7F7F7F")):
+        s.graphicalProperties.solidFill = color
+        s.graphicalProperties.line.solidFill = color
+    ch.legend.position = "b"
+    ch.width = max(16.0, min(34.0, 1.3 * len(docs) + 8))
+    ch.height = 9.0
+    anchor_col = len(labels) + 2
+    ws.column_dimensions[get_column_letter(anchor_col - 1)].width = 3
+    ws.add_chart(ch, f"{get_column_letter(anchor_col)}4")
+    ws.freeze_panes = f"B{first}"
+    ws.print_title_rows = f"{first - 1}:{first - 1}"
+    right_col = anchor_col + int(ch.width / 1.7) + 1
+    ws.print_area = f"A1:{get_column_letter(right_col)}{max(last, 4 + int(ch.height / 0.53) + 1)}"
+    page_setup(ws, like)
+    ws.sheet_view.showGridLines = False
+
+

@@ -1,0 +1,239 @@
+"""Excel design sheets from run result documents.
+
+Input: the JSON result documents of :func:`linecheck.io.jsonout.run_to_dict` (the
+dicts themselves, or the same dicts loaded from saved ``.json`` files), so every
+number in the workbook is the number of the JSON it came from.  ``run --excel``,
+``batch --excel`` and ``export`` all go through :func:`write_workbook`.
+
+Cell values (never formulas, openpyxl writes no cached values):
+
+- forces: kN = JSON N / 1000;
+- Cont_M, Cont_BG, Cont_R: the JSON fraction itself, shown with a percent format
+  (0.042 shows as 4.20 %);
+- GF_Dy, GF_QS, peak_normalised: as in the JSON; a GF that is null (mean zero by
+  symmetry or negligible) is the text ``**`` as in the paper's Table 5.
+
+openpyxl stores numbers with 16 significant digits, so a cell equals its JSON value to
+that precision (Excel shows 15).
+
+Sheets: "Summary" (paper Table 5 layout, one row per case and reaction Rx, Ry;
+``reactions=`` adds Rz), "Peaks" (Fig. 13), one sheet per case (inputs, still-air state, step-1 mean state,
+statistics, contributions, all towers, spectral check when present, and charts:
+Figs B1-B12, 7 and 12).  Time histories are thinned for the charts keeping every
+block's extremes, unless the result was saved with ``--full-histories``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import Any
+
+from openpyxl import Workbook
+
+from ..core.errors import CaseError
+from ..io.atomic import atomic_path, check_target
+from . import template as tpl
+from .case_sheet import write_case
+from .cells import (
+    CHART_POINTS,
+    FLAG_NOTE,
+    GF_UNDEFINED,
+    REACTIONS,
+    SUMMARY_REACTIONS,
+    SUMMARY_STATS,
+    cell_value,
+    sheet_name,
+)
+from .charts import chart_indices
+from .summary import write_peaks, write_summary
+
+
+# =========================================================================== public API
+def check_excel_target(path: str | Path, *, force: bool = False, template: str | Path | None = None) -> Path:
+    """Check an Excel output path (and template) before any work is done.
+
+    Raises :class:`CaseError` (one line) for a wrong suffix, an existing file without
+    ``force``, a missing or unwritable folder, a file open in another program, or a
+    bad template.
+    """
+    p = Path(path)
+    if p.suffix.lower() != ".xlsx":
+        raise CaseError(f"Excel output must be an .xlsx file name, got '{p.suffix or p.name}'", file=str(p))
+    check_target(p, force=force, what="Excel")
+    for lock in (p.parent / f"~${p.name}", p.parent / f".~lock.{p.name}#"):
+        if lock.exists():
+            raise CaseError(f"Excel file is open in another program (lock file {lock.name}); close it and retry",
+                            file=str(p))
+    if template is not None:
+        tpl.check_template(template)
+    return p
+
+
+def write_workbook(
+    docs: Sequence[dict[str, Any]],
+    path: str | Path,
+    *,
+    template: Path | None = None,
+    force: bool = False,
+    cont_r_threshold: float = 0.10,
+    title: dict | None = None,
+    chart_points: int = CHART_POINTS,
+    reactions: Sequence[str] = SUMMARY_REACTIONS,
+) -> Path:
+    """Write the design-sheet workbook of ``docs`` to ``path`` atomically.
+
+    Args:
+        docs: run result documents (``run_to_dict`` dicts or loaded JSON); a failed
+            case may be given as ``{"case": name, "error": message}`` and is listed in
+            the summary with its error.
+        path: ``.xlsx`` file; an existing file is replaced only with ``force``.
+        template: workbook with the title-block defined names (default
+            ``templates/design_sheet.xlsx``).
+        cont_r_threshold: Cont_R (fraction) above which a row is flagged
+            "dynamic analysis recommended".
+        title: title-block values by defined name (project, line, section, engineer,
+            checked_by, date, revision, units_note).
+        chart_points: about how many samples of each thinned time history go to the
+            charts (results saved with ``--full-histories`` are written in full).
+        reactions: reactions with a row in the Summary and a bar in Peaks (default Rx, Ry
+            as the paper's Table 5; the case sheets always show Rx, Ry, Rz).
+
+    Returns the path written.  Raises :class:`CaseError` for bad input or an
+    unwritable/locked/existing target; nothing is left half-written.
+    """
+    p = check_excel_target(path, force=force)
+    if isinstance(cont_r_threshold, bool) or not isinstance(cont_r_threshold, (int, float)) \
+            or not 0.0 < float(cont_r_threshold) < 1.0:
+        raise CaseError(f"value {cont_r_threshold!r} is not allowed: expected a fraction between 0 and 1 "
+                        "(0.10 = 10 %)", key="--cont-r-threshold")
+    reactions = tuple(reactions)
+    if not reactions or any(r not in REACTIONS for r in reactions):
+        raise CaseError(f"reactions {list(reactions)} not allowed: expected some of Rx, Ry, Rz", key="reactions")
+    docs = list(docs)
+    if not docs:
+        raise CaseError("no results to write", file=str(p))
+    for i, doc in enumerate(docs):
+        validate_doc(doc, f"result {i + 1}")
+    values = tpl.title_values(title)
+    wb = tpl.load_template(template)
+    build_workbook(wb, docs, values, float(cont_r_threshold), max(int(chart_points), 16), reactions)
+    try:
+        with atomic_path(p, force=force, what="Excel") as tmp:
+            wb.save(tmp)
+            _set_mode(tmp, p)
+    except OSError as exc:
+        raise CaseError(f"cannot write Excel file: {exc.strerror or exc}", file=str(p)) from None
+    return p
+
+
+def _set_mode(tmp: Path, target: Path) -> None:
+    """Give the temporary file the mode of the file it replaces (new file: 0666 less the umask)."""
+    try:
+        mode = target.stat().st_mode & 0o777
+    except FileNotFoundError:
+        mode = 0o666 & ~_umask()
+    os.chmod(tmp, mode)
+
+
+def _umask() -> int:
+    """The process umask, read without changing it where the system allows (threads: TUI export)."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    umask = os.umask(0o022)
+    os.umask(umask)
+    return umask
+
+
+def validate_doc(doc: Any, source: str) -> None:
+    """Check that ``doc`` is a run result document (or a failed-case entry)."""
+    if not isinstance(doc, dict):
+        raise CaseError("not a linecheck run result (expected a JSON object from `linecheck run --json`)",
+                        file=source)
+    if "error" in doc:
+        if not isinstance(doc.get("case"), str):
+            raise CaseError("failed-case entry needs a \"case\" name beside its \"error\"", file=source)
+        return
+    if "reactions" not in doc and "towers" in doc and "spans" in doc:
+        raise CaseError("is a step-1 (static) result: export needs run results (`linecheck run --json`)",
+                        file=source)
+    for key in ("case", "wind", "reactions", "realizations", "tower_of_interest"):
+        if key not in doc:
+            raise CaseError(f"not a linecheck run result: missing key \"{key}\" "
+                            "(expected the JSON of `linecheck run --json`)", file=source)
+    reactions = doc["reactions"]
+    for r in REACTIONS:
+        block = reactions.get(r) if isinstance(reactions, dict) else None
+        if not isinstance(block, dict):
+            raise CaseError(f"not a linecheck run result: \"reactions\" lacks \"{r}\"", file=source)
+        for stat, *_ in SUMMARY_STATS:
+            entry = block.get(stat)
+            if not isinstance(entry, dict) or "mean" not in entry:
+                raise CaseError(f"not a linecheck run result: reactions.{r}.{stat} needs a \"mean\"", file=source)
+
+
+def load_result_docs(paths: Iterable[str | Path]) -> list[dict[str, Any]]:
+    """Read saved run results (one JSON object, or a list of them, per file)."""
+    docs: list[dict[str, Any]] = []
+    for path in paths:
+        p = Path(path)
+        try:
+            text = p.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise CaseError("file not found (expected a JSON result of `linecheck run --json`)", file=str(p)) from None
+        except IsADirectoryError:
+            raise CaseError("is a directory, expected a JSON result file", file=str(p)) from None
+        except UnicodeDecodeError:
+            raise CaseError("not a UTF-8 text file (expected a JSON result)", file=str(p)) from None
+        except OSError as exc:
+            raise CaseError(f"cannot read: {exc.strerror}", file=str(p)) from None
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise CaseError(f"invalid JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}", file=str(p)) from None
+        items = data if isinstance(data, list) else [data]
+        for k, doc in enumerate(items):
+            validate_doc(doc, str(p) if len(items) == 1 else f"{p}[{k}]")
+            docs.append(doc)
+    if not docs:
+        raise CaseError("no results to export (empty list)")
+    return docs
+
+
+# =========================================================================== workbook
+def build_workbook(wb: Workbook, docs: list[dict], title: dict[str, Any], threshold: float,
+                   chart_points: int = CHART_POINTS, reactions: Sequence[str] = SUMMARY_REACTIONS) -> None:
+    """Fill a loaded template with the summary, peaks and case sheets (in place)."""
+    tpl.ensure_styles(wb)
+    tpl.fill_title(wb, title)
+    anchor = tpl.destination(wb, tpl.SUMMARY_ANCHOR)
+    if anchor is not None:
+        summary, cell = anchor
+        start = summary[cell]
+        top, left = start.row, start.column
+    else:
+        summary = wb["Summary"] if "Summary" in wb.sheetnames else wb.create_sheet("Summary", 0)
+        top, left = (summary.max_row + 2 if summary.max_row > 1 or summary["A1"].value is not None else 1), 1
+    taken = {n.lower() for n in wb.sheetnames}
+    names = [None if "error" in d else sheet_name(d["case"], taken) for d in docs]
+    ok = [(d, n) for d, n in zip(docs, names) if n is not None]
+    peaks_name = "Peaks" if "peaks" not in {n.lower() for n in wb.sheetnames} else sheet_name("Peaks (linecheck)", taken)
+    write_summary(summary, docs, names, threshold, top, left, reactions)
+    if ok:
+        write_peaks(wb.create_sheet(peaks_name), ok, summary, reactions)
+    header_text = str(title.get("project") or "")
+    for d, name in ok:
+        ws = wb.create_sheet(name)
+        write_case(ws, d, threshold, chart_points, summary, header_text, reactions)
+    wb.active = wb.sheetnames.index(summary.title)
+
+
+__all__ = ["write_workbook", "check_excel_target", "load_result_docs", "validate_doc", "build_workbook",
+           "cell_value", "chart_indices", "sheet_name", "FLAG_NOTE", "GF_UNDEFINED", "SUMMARY_REACTIONS",
+           "CHART_POINTS"]

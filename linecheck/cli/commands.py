@@ -70,3 +70,4 @@ from . import run_cmd  # noqa: E402,F401
 from . import spectral_cmd  # noqa: E402,F401
 from . import wind_cmd  # noqa: E402,F401
 from . import export_cmd  # noqa: E402,F401
+from . import validate_cmd  # noqa: E402,F401

@@ -9,6 +9,7 @@ This module imports only the numerical core (numpy/scipy) and never prints.
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -134,21 +135,24 @@ def reference_state_index(case: Case, mean: MeanStates) -> int:
     return int(np.argmax(np.abs(mean.reactions_wind[:, j, :]).max(axis=1)))
 
 
-def damping_matrices(case: Case, st: StaticResult, models: list) -> np.ndarray:
-    """Damping of every mean state [N s/m], upper band storage, shape (n_k, 6, n_dof).
+def damping_matrices(case: Case, st: StaticResult, models: list, states: list[int] | None = None) -> np.ndarray:
+    """Damping of mean states [N s/m], upper band storage, shape (len(models), 6, n_dof).
 
+    ``models[i]`` is the model of mean state ``states[i]`` (default: all states in order).
     Aerodynamic (``analysis.damping``) plus stiffness-proportional structural damping
     calibrated at the lowest mode of the reference mean state (docs/method.md, damping).
     """
     from .core.modes import natural_modes
 
     system, mean = st.system, st.mean
+    states = list(range(len(models))) if states is None else list(states)
     vn = to_global_nodes(system, st.wind.normal)  # (n_k, n_nodes)
-    C = np.stack([aerodynamic_damping(case, models[k], vn[k], mean.nodes[k]) for k in range(len(models))])
+    C = np.stack([aerodynamic_damping(case, m, vn[k], mean.nodes[k]) for m, k in zip(models, states)])
     zs = case.analysis.structural_ratio
     if zs > 0:
         k_ref = reference_state_index(case, mean)
-        w1 = 2 * np.pi * float(natural_modes(models[k_ref], 1).frequencies_hz[0])
+        ref = models[states.index(k_ref)] if k_ref in states else build_model(system, mean.state(k_ref))
+        w1 = 2 * np.pi * float(natural_modes(ref, 1).frequencies_hz[0])
         C = C + np.stack([stiffness_proportional(m, zs, w1) for m in models])
     return C
 
@@ -387,6 +391,7 @@ class ModesResult:
     still_air: "Modes"
     mean: "Modes"
     mean_time: float
+    damped: "object" = None  # ComplexModes of the mean state with the case's damping
 
 
 def modes_analysis(case: Case, *, n_modes: int = 20) -> ModesResult:
@@ -397,9 +402,16 @@ def modes_analysis(case: Case, *, n_modes: int = 20) -> ModesResult:
     system, mean = st.system, st.mean
     j = case.line.tower_of_interest - 1
     k = int(np.argmax(np.abs(mean.reactions_wind[:, j, :]).max(axis=1)))
+    from .core.spectral import complex_modes
+
     still = natural_modes(build_model(system, mean.still_air), n_modes)
-    at_mean = natural_modes(build_model(system, mean.state(k)), n_modes)
-    return ModesResult(case, still, at_mean, float(mean.time[k]))
+    model = build_model(system, mean.state(k))
+    at_mean = natural_modes(model, n_modes)
+    cm = complex_modes(model, damping_matrices(case, st, [model], states=[k])[0])
+    n = min(n_modes, cm.poles.size)
+    damped = dataclasses.replace(cm, frequencies_hz=cm.frequencies_hz[:n], damping_ratio=cm.damping_ratio[:n],
+                                 poles=cm.poles[:n])
+    return ModesResult(case, still, at_mean, float(mean.time[k]), damped)
 
 
 @dataclass(frozen=True)

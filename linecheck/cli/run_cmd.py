@@ -69,6 +69,23 @@ def results_table(doc: dict) -> Table:
     return t
 
 
+def print_burn_in(doc: dict) -> None:
+    """Say how much of a synoptic record was discarded, and when it is not enough (issue 10)."""
+    b = doc.get("burn_in")
+    if not b or doc.get("wind") != "synoptic":
+        return
+    if b["sufficient"]:
+        console.print(f"[dim]burn-in {b['seconds']:.0f} s discarded ({b['source']}); statistics from a stationary "
+                      f"response (slowest significant mode {b['mode_hz']:.3f} Hz, zeta {b['zeta']:.3g}).[/]",
+                      highlight=False)
+    else:
+        need = "never (undamped)" if b["required"] is None else f"{b['required']:.0f} s"
+        console.print(f"[yellow]record too short for a stationary response:[/] mode {b['mode_hz']:.3f} Hz with "
+                      f"zeta {b['zeta']:.2g} needs a burn-in of {need}, {b['seconds']:.0f} s used ({b['source']}). "
+                      "Its resonant part is not at its stationary level; see docs/method.md (damping).",
+                      highlight=False)
+
+
 @app.command()
 @handle_errors
 def run(
@@ -97,6 +114,7 @@ def run(
                   "Cont_R = share of the peak that a quasi-static analysis misses.[/]")
     from .spectral_cmd import print_sanity
 
+    print_burn_in(doc)
     print_sanity(doc)
     if json_out is not None:
         write_json(json_out, doc)
@@ -122,14 +140,23 @@ def modes(
         check_target(json_out, what="JSON")
     res = service.modes_analysis(case, n_modes=count)
     t = Table(title=f"{case.name}: natural frequencies (Hz)", title_justify="left")
-    for c in ("mode", "still air", "direction", "mean state", "direction"):
+    for c in ("mode", "still air", "direction", "mean state", "direction", "damped (Hz)", "damping ratio"):
         t.add_column(c, justify="right")
     dirs = "xyz"
     ds, dm = res.still_air.dominant_direction(), res.mean.dominant_direction()
+    cm = res.damped
     for i in range(res.still_air.frequencies_hz.size):
+        damped = ("", "")
+        if cm is not None and i < cm.frequencies_hz.size:
+            z = cm.damping_ratio[i]
+            style = "[bold red]" if z < 0.005 else ""
+            damped = (f"{cm.frequencies_hz[i]:.4f}", f"{style}{z:.3g}{'[/]' if style else ''}")
         t.add_row(str(i + 1), f"{res.still_air.frequencies_hz[i]:.4f}", dirs[ds[i]],
-                  f"{res.mean.frequencies_hz[i]:.4f}", dirs[dm[i]])
+                  f"{res.mean.frequencies_hz[i]:.4f}", dirs[dm[i]], *damped)
     console.print(t)
+    console.print(f"[dim]damped modes: complex eigenvalues of the mean state with damping = "
+                  f"\"{case.analysis.damping}\" (structural {case.analysis.structural_ratio:g}); "
+                  "red: damping ratio below 0.5 %.[/]")
     if case.wind.type == "downburst":
         console.print(f"[dim]mean state at t = {res.mean_time:.1f} s (largest mean reaction at the tower of interest)[/]")
     if json_out is not None:
@@ -137,7 +164,10 @@ def modes(
                "still_air": {"frequencies_hz": _num(res.still_air.frequencies_hz),
                              "direction": [dirs[i] for i in ds]},
                "mean": {"frequencies_hz": _num(res.mean.frequencies_hz), "direction": [dirs[i] for i in dm],
-                        "time": res.mean_time}}
+                        "time": res.mean_time,
+                        "damped_frequencies_hz": _num(res.damped.frequencies_hz),
+                        "damping_ratios": _num(res.damped.damping_ratio)},
+               "damping": case.analysis.damping}
         if shapes:
             doc["still_air"]["shapes"] = _num(res.still_air.shapes)
             doc["mean"]["shapes"] = _num(res.mean.shapes)

@@ -171,6 +171,12 @@ def run_to_dict(res: Any, *, full_histories: bool = False, max_points: int = 200
         },
         "parameters": case_parameters(case),
     }
+    if res.burn_in is not None:
+        b = res.burn_in
+        doc["burn_in"] = {"seconds": _num(b.seconds), "required": _num(b.required), "mode_hz": _num(b.mode_hz),
+                          "zeta": _num(b.zeta), "sufficient": b.sufficient, "source": b.source}
+    doc["damping"] = case.analysis.damping
+    doc["structural_damping"] = case.analysis.structural_ratio
     if res.spectral is not None:
         from ..service import sanity_check
 

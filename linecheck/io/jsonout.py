@@ -30,6 +30,17 @@ def _num(x: Any) -> Any:
     return x
 
 
+def _header(case: Any) -> dict[str, Any]:
+    """Keys every result document starts with."""
+    return {
+        "case": case.name,
+        "description": case.description,
+        "wind": case.wind.type,
+        "units": "SI",
+        "tower_of_interest": case.line.tower_of_interest,
+    }
+
+
 def static_to_dict(res: StaticResult) -> dict[str, Any]:
     """Step-1 JSON: ``{"case", "units", "tower_of_interest", "towers": [...], "spans": [...]}``.
 
@@ -70,11 +81,7 @@ def static_to_dict(res: StaticResult) -> dict[str, Any]:
             "tension_nominal": _num(system.tension_nominal),
         })
     doc: dict[str, Any] = {
-        "case": case.name,
-        "description": case.description,
-        "wind": case.wind.type,
-        "units": "SI",
-        "tower_of_interest": case.line.tower_of_interest,
+        **_header(case),
         "unstretched_length": _num(system.unstretched_length),
         "towers": towers,
         "spans": spans,
@@ -141,11 +148,7 @@ def run_to_dict(res: Any, *, full_histories: bool = False, max_points: int = 200
     still = res.static.mean.still_air
     m = res.static.mean
     doc: dict[str, Any] = {
-        "case": case.name,
-        "description": case.description,
-        "wind": case.wind.type,
-        "units": "SI",
-        "tower_of_interest": case.line.tower_of_interest,
+        **_header(case),
         "g_yp_L": _num(case.g_yp_L),
         "v_ref": case.wind.v_ref,
         "span_length": case.line.span_length,

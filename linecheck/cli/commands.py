@@ -71,3 +71,4 @@ from . import spectral_cmd  # noqa: E402,F401
 from . import wind_cmd  # noqa: E402,F401
 from . import export_cmd  # noqa: E402,F401
 from . import validate_cmd  # noqa: E402,F401
+from . import tui_cmd  # noqa: E402,F401

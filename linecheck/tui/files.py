@@ -1,0 +1,60 @@
+"""Files the TUI writes: the edited case (save as) and the exports.  Plain Python, no Textual.
+
+Every write is atomic and replaces an existing file only when ``replace`` is true.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from ..core.case import Case, case_to_toml, with_value
+from ..io.atomic import write_text_atomic
+from .formatting import case_differences
+
+
+def free_path(path: Path) -> Path:
+    """``path``, or ``stem-2.ext``, ``stem-3.ext``... the first that does not exist."""
+    if not path.exists():
+        return path
+    n = 2
+    while (candidate := path.with_name(f"{path.stem}-{n}{path.suffix}")).exists():
+        n += 1
+    return candidate
+
+
+def case_for_saving(case: Case, original: Case | None, path: Path) -> Case:
+    """``case`` as it will be written to ``path``.
+
+    Unless the user changed them: the name becomes the file stem (results and sheets of
+    the two files stay apart) and the description notes the edits (the old description
+    would describe the old values).  Raises :class:`CaseError` like any edit.
+    """
+    if original is None:
+        return case
+    out = case
+    if out.name == original.name:
+        out = with_value(out, "name", path.stem)
+    if out.description == original.description:
+        edits = [f"{k} = {b}" for k, _a, b in case_differences(original, out) if k not in ("name", "description")]
+        if edits:
+            note = f"edited from {original.name}: " + ", ".join(edits)
+            out = with_value(out, "description", f"{out.description} ({note})" if out.description else note)
+    return out
+
+
+def save_case(case: Case, path: Path, *, replace: bool) -> Path:
+    """Write ``case`` as TOML (units as comments)."""
+    return write_text_atomic(path, case_to_toml(case), force=replace, what="case")
+
+
+def export(kind: str, doc: dict[str, Any], path: Path, *, replace: bool) -> Path:
+    """Write a ``run_to_dict`` document: ``kind`` "xlsx" (the Excel design sheet) or "json"."""
+    if kind == "xlsx":
+        from ..excel.writer import write_workbook  # lazy: openpyxl only when exporting
+
+        write_workbook([doc], path, force=replace)
+        return path
+    from ..io.jsonout import write_json
+
+    return write_json(path, doc, force=replace)

@@ -1,0 +1,77 @@
+"""The run job of the TUI: service calls only, no Textual (runs in a thread worker).
+
+``execute`` runs steps 1-3 (:func:`linecheck.service.run_case`), builds the JSON
+document exactly as ``linecheck run`` does (:func:`linecheck.io.jsonout.run_to_dict`),
+then the natural frequencies and the wind at point p for the extra result tabs.
+Progress goes through ``progress(stage, done, total)``; ``cancel`` is a plain
+:class:`threading.Event` checked by the service and between the jobs.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from dataclasses import dataclass
+from typing import Any
+
+from .. import service
+from ..core.case import Case
+from ..core.errors import Cancelled
+from ..io.jsonout import run_to_dict
+
+STAGE_MODES = "natural frequencies"
+STAGE_WIND_P = "wind at point p"
+
+
+@dataclass(frozen=True)
+class RunOutput:
+    """Everything the result tabs show for one run.
+
+    ``doc`` is the ``linecheck run`` JSON document of ``result``; ``modes`` and
+    ``wind`` are ``None`` if they were not computed.
+    """
+
+    case: Case
+    result: service.RunResult
+    doc: dict[str, Any]
+    modes: service.ModesResult | None
+    wind: service.WindAtP | None
+    seconds: float
+
+    @property
+    def label(self) -> str:
+        return f"{self.case.name} (V_ref {self.case.wind.v_ref:g} m/s)"
+
+
+def execute(
+    case: Case,
+    *,
+    progress: service.Progress | None = None,
+    cancel: threading.Event | None = None,
+    extras: bool = True,
+) -> RunOutput:
+    """Run ``case`` and collect the result tabs' data (raises ``Cancelled`` when ``cancel`` is set)."""
+    t0 = time.perf_counter()
+
+    def check() -> None:
+        if cancel is not None and cancel.is_set():
+            raise Cancelled("run cancelled")
+
+    def report(stage: str, done: int, total: int) -> None:
+        if progress is not None:
+            progress(stage, done, total)
+
+    result = service.run_case(case, progress=progress, cancel=cancel)
+    doc = run_to_dict(result)
+    modes = wind = None
+    if extras:
+        check()
+        report(STAGE_MODES, 0, 1)
+        modes = service.modes_analysis(case)
+        report(STAGE_MODES, 1, 1)
+        check()
+        report(STAGE_WIND_P, 0, 1)
+        wind = service.wind_at_p(case, realization=int(result.realizations[0]))
+        report(STAGE_WIND_P, 1, 1)
+    check()
+    return RunOutput(case, result, doc, modes, wind, time.perf_counter() - t0)

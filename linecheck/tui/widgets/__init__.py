@@ -1,0 +1,1 @@
+"""Views of the TUI's main tabs."""

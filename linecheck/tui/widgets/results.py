@@ -1,0 +1,220 @@
+"""Result tabs of the last run: summary, time histories, mean states, wind at p,
+contributions, spectral check, natural frequencies."""
+
+from __future__ import annotations
+
+from rich.text import Text
+from textual import on
+from textual.app import ComposeResult
+from textual.containers import Horizontal, Vertical, VerticalScroll
+from textual.widgets import DataTable, RadioButton, RadioSet, Static, TabbedContent, TabPane
+
+from .. import figures
+from ..formatting import (REACTIONS, cont_r_flags, davenport_lines, sanity_rows, spectral_compare_rows, spectral_rows,
+                          summary_rows, summary_title)
+from ..plotting import PlotView
+from ..runner import RunOutput
+
+NO_RUN = "No results yet: open a case and press r to run it."
+TABS = ("res-summary", "res-histories", "res-mean", "res-wind", "res-contrib", "res-spectral", "res-freq")
+
+
+class ReactionChoice(RadioSet):
+    """Rx / Ry / Rz: the arrow keys pick a reaction at once (no enter needed)."""
+
+    def _step(self, step: int) -> None:
+        buttons = list(self.query(RadioButton))
+        i = max(self.pressed_index, 0)
+        buttons[(i + step) % len(buttons)].value = True
+
+    def action_next_button(self) -> None:
+        self._step(1)
+
+    def action_previous_button(self) -> None:
+        self._step(-1)
+
+
+class ResultsView(Vertical):
+    """Tabs over one :class:`~linecheck.tui.runner.RunOutput` (plus the pinned one in Contributions)."""
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__(**kwargs)
+        self.output: RunOutput | None = None
+        self.pinned: RunOutput | None = None
+        self.reaction = "Ry"
+
+    def compose(self) -> ComposeResult:
+        yield Static(NO_RUN, id="results-title")
+        with TabbedContent(id="results-tabs"):
+            with TabPane("Summary", id="res-summary"):
+                yield DataTable(id="summary-table", cursor_type="row", zebra_stripes=True)
+                yield Static("", id="summary-notes")
+            with TabPane("Reactions", id="res-histories"):
+                with Horizontal(id="reaction-bar"):
+                    yield Static("reaction (←/→): ", classes="inline-label")
+                    with ReactionChoice(id="reaction-choice"):
+                        for r in REACTIONS:
+                            yield RadioButton(r, value=(r == self.reaction), id=f"pick-{r}")
+                yield PlotView(NO_RUN, id="plot-history")
+            with TabPane("Mean states", id="res-mean"):
+                yield PlotView(NO_RUN, id="plot-tension")
+                yield PlotView(NO_RUN, id="plot-displacement")
+            with TabPane("Wind at p", id="res-wind"):
+                yield PlotView(NO_RUN, id="plot-wind")
+            with TabPane("Contributions", id="res-contrib"):
+                yield PlotView(NO_RUN, id="plot-contrib")
+            with TabPane("Spectral check", id="res-spectral"):
+                with VerticalScroll(id="spectral-box"):
+                    yield Static(NO_RUN, id="spectral-notes")
+                    yield DataTable(id="spectral-table", cursor_type="row", zebra_stripes=True)
+                    yield Static("", id="spectral-davenport")
+                    yield DataTable(id="sanity-table", cursor_type="row", zebra_stripes=True)
+            with TabPane("Frequencies", id="res-freq"):
+                yield Static(NO_RUN, id="freq-notes")
+                yield DataTable(id="freq-table", cursor_type="row", zebra_stripes=True)
+
+    def on_mount(self) -> None:
+        t = self.query_one("#summary-table", DataTable)
+        for c in ("statistic", "unit", "Rx", "Ry", "Rz"):
+            t.add_column(c, key=c)
+        self.query_one("#sanity-table", DataTable).add_columns(
+            "reaction", "sanity check", "time domain ± std", "frequency domain", "allowed difference", "verdict")
+        self.query_one("#freq-table", DataTable).add_columns("mode", "still air (Hz)", "dir", "mean state (Hz)", "dir")
+
+    # ------------------------------------------------------------------ tabs
+    @property
+    def active_tab(self) -> str:
+        return self.query_one("#results-tabs", TabbedContent).active
+
+    @active_tab.setter
+    def active_tab(self, tab: str) -> None:
+        self.query_one("#results-tabs", TabbedContent).active = tab
+
+    def cycle_tab(self, step: int) -> None:
+        i = TABS.index(self.active_tab) if self.active_tab in TABS else 0
+        self.active_tab = TABS[(i + step) % len(TABS)]
+
+    # ------------------------------------------------------------------ content
+    def show(self, output: RunOutput, pinned: RunOutput | None = None, *, stale: str | None = None) -> None:
+        """Fill every tab from ``output``; ``stale``: why it is not the current case (shown)."""
+        self.output, self.pinned = output, pinned
+        doc = output.doc
+        title = Text(summary_title(doc), style="bold")
+        title.append(f"   run in {output.seconds:.1f} s", style="dim")
+        if stale:
+            title.append(f"   ({stale})", style="yellow")
+        self.query_one("#results-title", Static).update(title)
+        self._summary(doc)
+        self._history()
+        self.query_one("#plot-tension", PlotView).show(figures.mean_tension(output.result))
+        self.query_one("#plot-displacement", PlotView).show(figures.mean_displacement(output.result))
+        wind = self.query_one("#plot-wind", PlotView)
+        wind.show(figures.wind_at_p(output.wind) if output.wind is not None else None, "wind at p not computed")
+        self.show_contributions()
+        self._spectral(doc)
+        self._frequencies(output)
+
+    def mark_stale(self, stale: str | None) -> None:
+        if self.output is not None:
+            self.show(self.output, self.pinned, stale=stale)
+
+    def _summary(self, doc: dict) -> None:
+        t = self.query_one("#summary-table", DataTable)
+        t.clear()
+        flagged = cont_r_flags(doc)
+        for row in summary_rows(doc):
+            cells = list(row)
+            if row[0] == "Cont_R":
+                cells = [cells[0], cells[1]] + [Text(c, style="bold yellow") if r in flagged else c
+                                                for r, c in zip(REACTIONS, cells[2:])]
+            t.add_row(*cells, key=row[0])
+        notes = Text()
+        notes.append("Wind-induced reactions (still air removed) at the tower of interest; "
+                     "** : GF undefined, mean zero by symmetry or < 1 % of the largest mean. "
+                     "Cont_R: share of the peak a quasi-static analysis misses.", style="dim")
+        if flagged:
+            notes.append(f"\nCont_R above 10 % for {', '.join(flagged)}: dynamic analysis recommended.",
+                         style="bold yellow")
+        sa = doc.get("still_air", {}).get("reactions", {})
+        if sa:
+            notes.append("\nstill air: " + ", ".join(f"{r} {v / 1e3:.3f} kN" for r, v in sa.items() if v is not None),
+                         style="dim")
+        self.query_one("#summary-notes", Static).update(notes)
+
+    def _history(self) -> None:
+        if self.output is not None:
+            self.query_one("#plot-history", PlotView).show(figures.reaction_history(self.output.doc, self.reaction))
+
+    @on(TabbedContent.TabActivated, "#results-tabs")
+    def _tab_activated(self, event: TabbedContent.TabActivated) -> None:
+        if event.pane.id == "res-histories":
+            self.query_one(ReactionChoice).focus()
+
+    @on(RadioSet.Changed, "#reaction-choice")
+    def _reaction_changed(self, event: RadioSet.Changed) -> None:
+        event.stop()
+        self.reaction = str(event.pressed.label)
+        self._history()
+
+    def show_contributions(self) -> None:
+        if self.output is None:
+            return
+        docs = [("", self.output.doc)]
+        if self.pinned is not None and self.pinned is not self.output:
+            docs = [("pinned", self.pinned.doc), ("current", self.output.doc)]
+        self.query_one("#plot-contrib", PlotView).show(figures.contributions(docs))
+
+    def _spectral(self, doc: dict) -> None:
+        """Frequency-domain check beside the time domain (synoptic runs with a "spectral" block)."""
+        notes = self.query_one("#spectral-notes", Static)
+        table = self.query_one("#spectral-table", DataTable)
+        sanity = self.query_one("#sanity-table", DataTable)
+        dav = self.query_one("#spectral-davenport", Static)
+        table.clear(columns=True)
+        sanity.clear()
+        if not isinstance(doc.get("spectral"), dict):
+            why = ("a downburst is non-stationary: the frequency-domain check applies to synoptic winds"
+                   if doc.get("wind") == "downburst" else "this result has no \"spectral\" block")
+            notes.update(Text(f"No spectral check: {why}.", style="dim"))
+            for w in (table, sanity, dav):
+                w.display = False
+            return
+        compare = spectral_compare_rows(doc)
+        checks = sanity_rows(doc)
+        lines = davenport_lines(doc)
+        if compare:
+            table.add_columns("statistic", "unit", *(f"{r} {d}" for r in REACTIONS for d in ("time", "freq")))
+            for row in compare:
+                table.add_row(*row)
+            notes.update(Text("Time domain (mean over realizations) beside the frequency domain "
+                              "(exact linear random vibration of the same model).", style="dim"))
+        else:  # unknown layout: list every number
+            table.add_columns("quantity", "frequency domain", "time domain (mean)")
+            for row in spectral_rows(doc):
+                table.add_row(*row)
+            notes.update(Text("Frequency-domain block (SI units).", style="dim"))
+        table.display = True
+        dav.display = bool(lines)
+        dav.update(Text("\n".join(lines)))
+        sanity.display = bool(checks)
+        for row in checks:
+            verdict = Text(row[-1], style="green" if row[-1] == "ok" else "bold yellow")
+            sanity.add_row(*row[:-1], verdict)
+
+    def _frequencies(self, output: RunOutput) -> None:
+        table = self.query_one("#freq-table", DataTable)
+        table.clear()
+        notes = self.query_one("#freq-notes", Static)
+        m = output.modes
+        if m is None:
+            notes.update("natural frequencies not computed")
+            return
+        dirs = "xyz"
+        ds, dm = m.still_air.dominant_direction(), m.mean.dominant_direction()
+        for i in range(m.still_air.frequencies_hz.size):
+            table.add_row(str(i + 1), f"{m.still_air.frequencies_hz[i]:.4f}", dirs[ds[i]],
+                          f"{m.mean.frequencies_hz[i]:.4f}", dirs[dm[i]])
+        text = "Undamped natural frequencies of the still-air state and of the mean state"
+        if output.case.wind.type == "downburst":
+            text += f" at t = {m.mean_time:.1f} s (largest mean reaction at the tower of interest)"
+        notes.update(Text(text + "; dir: direction holding most of the mode's kinetic energy.", style="dim"))

@@ -45,6 +45,10 @@ class Check:
     tolerance: str
     passed: bool | None
 
+    def __post_init__(self) -> None:
+        if self.passed is not None:  # numpy bools are not JSON-serialisable
+            object.__setattr__(self, "passed", bool(self.passed))
+
 
 def _pct(a: float, b: float) -> str:
     return f"{100 * (a / b - 1):+.2f} %"

@@ -7,6 +7,7 @@ on one line, to stderr, with its exit code (2 for bad input); no tracebacks.
 from __future__ import annotations
 
 import functools
+import os
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -51,6 +52,14 @@ def handle_errors(fn: F) -> F:
         except KeyboardInterrupt:
             err_console.print("[bold red]interrupted[/]")
             raise typer.Exit(130) from None
+        except (typer.Exit, typer.Abort):
+            raise
+        except Exception as err:  # a bug, not a user error: one line unless debugging
+            if os.environ.get("LINECHECK_DEBUG"):
+                raise
+            err_console.print(f"[bold red]internal error:[/] {type(err).__name__}: {err} "
+                              "(set LINECHECK_DEBUG=1 for the traceback; please report it)", highlight=False)
+            raise typer.Exit(1) from None
 
     return wrapper  # type: ignore[return-value]
 

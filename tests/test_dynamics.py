@@ -210,3 +210,19 @@ def test_time_step_halving_changes_rms_by_less_than_one_percent():
                    np.sqrt((resp.resonant[0, keep, 0, :2] ** 2).mean(axis=0)))
     for k in range(2):
         np.testing.assert_allclose(out[0.05][k], out[0.025][k], rtol=0.01)
+
+
+def test_non_positive_definite_state_and_nan_loads_are_reported():
+    """Issue 4: a non-positive-definite stiffness or non-finite loads raise NumericalError
+    (one line naming the state), never a result."""
+    from linecheck.core.errors import NumericalError
+
+    model = sdof_model(-5.0, 1.0)  # negative stiffness: not positive definite
+    damping = np.zeros((1, 6, 3))
+    with pytest.raises(NumericalError, match="not positive definite"):
+        integrate([model], damping, np.zeros(4, dtype=int), np.ones((4, 1, 1)), 0.05)
+    good = sdof_model(5.0, 1.0)
+    loads = np.ones((4, 1, 1))
+    loads[2] = np.nan
+    with pytest.raises(NumericalError, match="non-finite"):
+        integrate([good], damping, np.zeros(4, dtype=int), loads, 0.05)

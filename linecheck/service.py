@@ -191,8 +191,9 @@ class SynopticModel:
     modes: object
 
 
-def synoptic_model(case: Case, st: StaticResult) -> SynopticModel:
-    """Model, damping, load per unit turbulence (Eq. 5) and complex modes of the synoptic state."""
+def synoptic_model(case: Case, st: StaticResult, *, vectors: bool = True) -> SynopticModel:
+    """Model, damping, load per unit turbulence (Eq. 5) and complex modes of the synoptic state
+    (with eigenvectors when ``vectors``: the burn-in needs them, the frequency grid does not)."""
     from .core.spectral import complex_modes
 
     system = st.system
@@ -202,7 +203,7 @@ def synoptic_model(case: Case, st: StaticResult) -> SynopticModel:
     line, wind = case.line, case.wind
     a = wind.air_density * line.drag_coefficient * line.diameter * model.tributary * vn  # Eq. 5 per unit v
     f_top = 0.75 / case.analysis.time_step
-    modes = complex_modes(model, damping, max_hz=f_top, vectors=True)
+    modes = complex_modes(model, damping, max_hz=f_top, vectors=vectors)
     return SynopticModel(model, damping, a, modes)
 
 
@@ -470,7 +471,7 @@ def spectral_analysis(case: Case, *, static: StaticResult | None = None,
                         file=str(case.source) if case.source else None, key="wind.type")
     st = static if static is not None else static_analysis(case)
     mean = st.mean
-    sm = synoptic if synoptic is not None else synoptic_model(case, st)  # same model as the time domain
+    sm = synoptic if synoptic is not None else synoptic_model(case, st, vectors=False)  # same model as the time domain
     line, wind = case.line, case.wind
     t = record_time(case)
     j = case.line.tower_of_interest - 1

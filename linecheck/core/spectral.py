@@ -99,7 +99,13 @@ def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None 
     A[n:, :n] = -minv[:, None] * cd.K
     A[n:, n:] = -minv[:, None] * cd.C
     if vectors:
-        lam, vl, vr = eig(A, left=True, right=True)
+        lam, vr = eig(A, right=True)
+        # left eigenvectors from the right ones (symmetric K, M, C): A^T w = lambda w with
+        # w = [(lambda M + C) phi; M phi], phi the displacement part of psi (Tisseur &
+        # Meerbergen 2001, section 3.4); chi = conj(w) so that chi^H A = lambda chi^H
+        phi = vr[:n]
+        w_top = lam[None, :] * (cd.M @ phi) + cd.C @ phi
+        vl = np.conj(np.vstack([w_top, cd.M @ phi]))
     else:
         lam, vl, vr = eig(A, right=False), None, None
     keep = lam.imag > 1e-12

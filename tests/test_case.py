@@ -152,3 +152,17 @@ def test_case_reference_doc_is_up_to_date():
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     assert (ROOT / "docs" / "case-files.md").read_text() == mod.render()
+
+
+def test_cli_error_is_one_line_exit_2_and_keeps_brackets(tmp_path):
+    """Messages name TOML tables in brackets; the CLI must not eat them as markup."""
+    from typer.testing import CliRunner
+
+    from linecheck.cli.app import app
+
+    bad = write(tmp_path, "[line]\nspans = 1\n")
+    r = CliRunner().invoke(app, ["run", str(bad)])
+    assert r.exit_code == 2
+    out = r.output.strip()
+    assert "missing required table [wind]" in out and "Traceback" not in out
+    assert len(out.splitlines()) == 1

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Annotated, Any, TypeVar
 
 import typer
+from rich.markup import escape
 from rich.console import Console
 
 from ..core.case import Case, load_case
@@ -47,7 +48,7 @@ def handle_errors(fn: F) -> F:
         try:
             return fn(*args, **kwargs)
         except LinecheckError as err:
-            err_console.print(f"[bold red]error:[/] {err}", highlight=False, soft_wrap=True)
+            err_console.print(f"[bold red]error:[/] {escape(str(err))}", highlight=False, soft_wrap=True)
             raise typer.Exit(err.exit_code) from None
         except KeyboardInterrupt:
             err_console.print("[bold red]interrupted[/]")
@@ -57,7 +58,7 @@ def handle_errors(fn: F) -> F:
         except Exception as err:  # a bug, not a user error: one line unless debugging
             if os.environ.get("LINECHECK_DEBUG"):
                 raise
-            err_console.print(f"[bold red]internal error:[/] {type(err).__name__}: {err} "
+            err_console.print(f"[bold red]internal error:[/] {type(err).__name__}: {escape(str(err))} "
                               "(set LINECHECK_DEBUG=1 for the traceback; please report it)", highlight=False)
             raise typer.Exit(1) from None
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import typer
+from rich.markup import escape
 from rich.table import Table
 
 from .. import service
@@ -24,10 +25,11 @@ def check(cases: CasesArg) -> None:
         try:
             case = read_case(path)
         except CaseError as err:
-            err_console.print(f"[bold red]error:[/] {err}", highlight=False, soft_wrap=True)
+            err_console.print(f"[bold red]error:[/] {escape(str(err))}", highlight=False, soft_wrap=True)
             failed += 1
             continue
-        console.print(f"[green]ok[/] {path}  [dim]{case.name}: {case.description}[/]", highlight=False)
+        console.print(f"[green]ok[/] {escape(str(path))}  [dim]{escape(case.name)}: {escape(case.description)}[/]",
+                      highlight=False)
     if failed:
         raise typer.Exit(2)
 
@@ -57,9 +59,10 @@ def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
             *(f"{rw[k, j, c] / 1e3:.3f}" for c in range(3)),
         )
     console.print(table)
-    tens = ", ".join(f"{h / 1e3:.2f}" for h in m.tension[0])
-    console.print(f"span tensions H (kN): {tens}   still air: {m.still_air.tension[0] / 1e3:.2f}   "
-                  f"nominal T0: {res.system.tension_nominal / 1e3:.2f}")
+    series = case.wind.type == "downburst"
+    tens = ", ".join(f"{h / 1e3:.2f}" for h in (m.tension.max(axis=0) if series else m.tension[0]))
+    console.print(f"span tensions H (kN{', largest over the event' if series else ''}): {tens}   "
+                  f"still air: {m.still_air.tension[0] / 1e3:.2f}   nominal T0: {res.system.tension_nominal / 1e3:.2f}")
     if case.wind.type == "downburst":
         console.print(f"[dim]{m.time.size} mean states over t = {m.time[0]:.0f} to {m.time[-1]:.0f} s; "
                       "rows show the instant of peak wind-induced Ry at each tower.[/]")
@@ -69,6 +72,7 @@ def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
 from . import run_cmd  # noqa: E402,F401
 from . import spectral_cmd  # noqa: E402,F401
 from . import wind_cmd  # noqa: E402,F401
-from . import export_cmd  # noqa: E402,F401
-from . import validate_cmd  # noqa: E402,F401
 from . import tui_cmd  # noqa: E402,F401
+from . import export_cmd  # noqa: E402,F401
+from . import batch_cmd  # noqa: E402,F401
+from . import validate_cmd  # noqa: E402,F401

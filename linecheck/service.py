@@ -213,19 +213,26 @@ def burn_in(case: Case, sm: SynopticModel) -> BurnIn:
     from .core.wind.turbulence import length_scale
 
     duration = case.analysis.duration if case.analysis.duration is not None else 600.0
-    mc = modal_contributions(
-        sm.model, sm.modes, sm.load_per_v, case.line.tower_of_interest - 1,
-        sigma=case.wind.turbulence_intensity * case.wind.v_ref, length_scale=length_scale(case),
-        v_mean=case.wind.v_ref, coherence_decay=case.wind.coherence_decay, max_hz=0.5 / case.analysis.time_step,
-    )
-    sig = np.flatnonzero(mc.significant(SIGNIFICANT_FRACTION))
+    f_top = 0.5 / case.analysis.time_step
+    if sm.modes.right is not None:
+        mc = modal_contributions(
+            sm.model, sm.modes, sm.load_per_v, case.line.tower_of_interest - 1,
+            sigma=case.wind.turbulence_intensity * case.wind.v_ref, length_scale=length_scale(case),
+            v_mean=case.wind.v_ref, coherence_decay=case.wind.coherence_decay, max_hz=f_top,
+        )
+        freq, zeta, rate_all = mc.frequencies_hz, mc.damping_ratio, mc.decay_rate
+        sig = np.flatnonzero(mc.significant(SIGNIFICANT_FRACTION))
+    else:  # no eigenvectors (paper damping): every mode in the band counts (conservative)
+        cm = sm.modes
+        freq, zeta, rate_all = cm.frequencies_hz, cm.damping_ratio, -cm.poles.real
+        sig = np.flatnonzero(freq <= f_top)
     if sig.size == 0:
         required, f1, z1 = 0.0, float("nan"), float("nan")
     else:
-        i = sig[np.argmin(mc.decay_rate[sig])]
-        rate = mc.decay_rate[i]
+        i = sig[np.argmin(rate_all[sig])]
+        rate = rate_all[i]
         required = float(BURN_IN_DECAY / rate) if rate > 0 else float("inf")
-        f1, z1 = float(mc.frequencies_hz[i]), float(mc.damping_ratio[i])
+        f1, z1 = float(freq[i]), float(zeta[i])
     if case.analysis.burn_in is not None:
         used, src = float(case.analysis.burn_in), "analysis.burn_in"
     elif case.analysis.damping == "paper":
@@ -316,7 +323,10 @@ def run_case(
     models = [build_model(system, mean.state(k)) for k in range(mean.time.size)]
     vn_states = to_global_nodes(system, st.wind.normal)  # (n_k, n_nodes)
     damping = damping_matrices(case, st, models)
-    sm = synoptic_model(case, st) if wind.type == "synoptic" else None
+    # eigenvectors only where the burn-in must tell significant modes apart (issue 10): the
+    # paper's damping gets no burn-in, and its verdict needs only the least-damped mode
+    needs_vectors = case.analysis.damping != "paper" and case.analysis.burn_in is None
+    sm = synoptic_model(case, st, vectors=needs_vectors) if wind.type == "synoptic" else None
     burn = burn_in(case, sm) if sm is not None else BurnIn(
         0.0, 0.0, float("nan"), float("nan"), True, "none: a downburst starts from a weak running mean")
     if burn.seconds > 0:

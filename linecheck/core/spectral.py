@@ -93,6 +93,8 @@ def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None 
     """
     cd = condensed(model, damping)  # insulator-axial directions condensed out (exact)
     n = cd.K.shape[0]
+    if n > LARGE_SYSTEM_DOF:
+        return _approximate_complex_modes(cd, max_hz, vectors)
     minv = 1.0 / np.diag(cd.M)  # diagonal lumped mass in condensed coordinates
     A = np.zeros((2 * n, 2 * n))
     A[:n, n:] = np.eye(n)
@@ -118,6 +120,36 @@ def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None 
     return ComplexModes(w / (2 * np.pi), -lam.real / w, lam,
                         None if vr is None else vr[:, idx], None if vl is None else vl[:, idx],
                         cd.S if vectors else None, np.diag(cd.M).copy() if vectors else None)
+
+
+LARGE_SYSTEM_DOF = 600  # above this the dense state-space eigenproblem (O((2n)^3)) is too slow
+
+
+def _approximate_complex_modes(cd, max_hz: float | None, vectors: bool) -> ComplexModes:
+    """Complex modes of large systems from the undamped modes and their modal damping
+    zeta_k = phi^T C phi / (2 omega_k) (classical-damping approximation, Clough & Penzien
+    2003 section 12-5): lambda = -zeta omega + i omega sqrt(1 - zeta^2).  It cannot see the
+    near-degenerate pairs that non-proportional damping splits (docs/method.md)."""
+    from scipy.linalg import eigh as _eigh
+
+    m = np.diag(cd.M)
+    s = 1.0 / np.sqrt(m)
+    A = cd.K * s[:, None] * s[None, :]
+    if max_hz is None:
+        w2, psi = _eigh(A)
+    else:
+        w2, psi = _eigh(A, subset_by_value=[-np.inf, (2 * np.pi * max_hz) ** 2])
+    phi = psi * s[:, None]  # mass-normalised
+    w = np.sqrt(np.clip(w2, 1e-30, None))
+    zeta = np.einsum("ik,ij,jk->k", phi, cd.C, phi) / (2 * w)
+    zc = np.clip(zeta, 0.0, 0.999999)
+    lam = -zc * w + 1j * w * np.sqrt(1 - zc**2)
+    right = left = None
+    if vectors:
+        phi_c = phi.astype(complex)
+        right = np.vstack([phi_c, lam[None, :] * phi_c])
+        left = np.conj(np.vstack([lam[None, :] * (cd.M @ phi_c) + cd.C @ phi_c, cd.M @ phi_c]))
+    return ComplexModes(w / (2 * np.pi), zc, lam, right, left, cd.S if vectors else None, m.copy() if vectors else None)
 
 
 def frequency_grid(f_lo: float, f_hi: float, modes: ComplexModes, *, n_log: int = 400, n_peak: int = 33,
@@ -245,25 +277,34 @@ def random_vibration(
     mbase = np.zeros_like(base)
     mbase[kl:] = _general_band(model.M_band)
     rhs0 = np.asfortranarray(Gt.T.astype(complex))
-    tF = np.empty((f.size, 3, system.n_nodes), dtype=complex)
-    tF[:] = Dt[None]
     zgbsv = lapack.zgbsv
-    for k, fk in enumerate(f):
-        w = 2 * np.pi * fk
-        ab = base + (1j * w) * cbase - w**2 * mbase  # K - w^2 M + i w C
-        _, _, x, info = zgbsv(kl, kl, ab, rhs0, overwrite_ab=1)
-        if info != 0:
-            raise NumericalError(f"dynamic stiffness singular at {fk:.6g} Hz (LAPACK zgbsv info {info})")
-        tF[k][:, free] += x[ydof].T
+    dx = system.line.span_length / system.ne
     a = load_per_v[None, None, :]
     # the synthesis scales the spectrum to unit variance below its top frequency
     # (linecheck.core.wind.turbulence.spectral_grid); do the same here
     Sv = von_karman(f, sigma, length_scale, v_mean) / float(von_karman_cumulative(band[1], length_scale, v_mean))
-    dx = system.line.span_length / system.ne
     rho = np.exp(-coherence_decay * f * dx / v_mean)  # Davenport coherence between neighbours
-    SB = Sv[:, None] * _quad_kms(np.broadcast_to(tB[None] * a, tF.shape), rho)
-    SF = Sv[:, None] * _quad_kms(tF * a, rho)
-    SR = Sv[:, None] * _quad_kms((tF - tB[None]) * a, rho)
+    SB = np.empty((f.size, 3))
+    SF = np.empty((f.size, 3))
+    SR = np.empty((f.size, 3))
+    tBa = tB[None] * a
+    chunk = 256  # frequencies per block: bounded memory for long lines
+    for c0 in range(0, f.size, chunk):
+        fc = f[c0:c0 + chunk]
+        tF = np.empty((fc.size, 3, system.n_nodes), dtype=complex)
+        tF[:] = Dt[None]
+        for k, fk in enumerate(fc):
+            w = 2 * np.pi * fk
+            ab = base + (1j * w) * cbase - w**2 * mbase  # K - w^2 M + i w C
+            _, _, x, info = zgbsv(kl, kl, ab, rhs0, overwrite_ab=1)
+            if info != 0:
+                raise NumericalError(f"dynamic stiffness singular at {fk:.6g} Hz (LAPACK zgbsv info {info})")
+            tF[k][:, free] += x[ydof].T
+        sl = slice(c0, c0 + fc.size)
+        tFa = tF * a
+        SB[sl] = Sv[sl, None] * _quad_kms(np.broadcast_to(tBa, tF.shape), rho[sl])
+        SF[sl] = Sv[sl, None] * _quad_kms(tFa, rho[sl])
+        SR[sl] = Sv[sl, None] * _quad_kms(tFa - tBa, rho[sl])
 
     def integ(y: np.ndarray) -> np.ndarray:
         return np.trapezoid(y, f, axis=0)

@@ -31,12 +31,13 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from scipy.linalg import solve_banded
+from scipy.linalg import lapack
 
 from .errors import Cancelled, ConvergenceError
 from .system import LineSystem
 
 MAX_STRAIN = 0.05  # conductor strain above this is not an admissible elastic state
+_dgtsv = lapack.dgtsv
 _GAUSS_T, _GAUSS_W = np.polynomial.legendre.leggauss(3)  # exact for degree 5
 
 
@@ -217,7 +218,7 @@ def solve_static(
     gy: np.ndarray,
     *,
     initial: StaticState | None = None,
-    tol: float = 1e-9,
+    tol: float = 1e-8,
     max_iter: int = 500,
     label: str = "mean state",
 ) -> StaticState:
@@ -282,15 +283,15 @@ def solve_static(
             diag = diag.copy()
             diag[:-1] -= C
             diag[1:] -= C
-            # restrict to suspension nodes (strain nodes are fixed)
+            # restrict to suspension nodes (strain nodes are fixed); neighbours that are both
+            # free are adjacent towers j, j+1 -> a symmetric tridiagonal system (LAPACK dgtsv)
             k = idx.size
-            ab = np.zeros((3, k))
-            ab[1] = diag[idx]
-            # neighbours that are both free are adjacent towers j, j+1
+            off = np.zeros(max(k - 1, 0))
             adj = np.flatnonzero(np.diff(idx) == 1)
-            ab[0, adj + 1] = C[idx[adj]]
-            ab[2, adj] = C[idx[adj]]
-            step = solve_banded((1, 1), ab, -f)
+            off[adj] = C[idx[adj]]
+            _, _, _, step, info = _dgtsv(off, diag[idx].copy(), off.copy(), -f)
+            if info != 0:
+                raise ConvergenceError(f"{label}: singular longitudinal tangent (K_x, Eq. 3)")
             d[idx, 0] += step
             if np.max(np.abs(step)) <= 1e-3 * tol_d:
                 break

@@ -1,0 +1,321 @@
+"""Where batch tasks run: in this process, in a local process pool, or on Dask.
+
+All three share one small interface used by the batch and scan runners:
+
+- ``submit(fn, *args, **kwargs)`` -> a handle (``fn`` a top-level importable function
+  of :mod:`linecheck.batch.tasks` taking plain data);
+- ``wait(handles, timeout)`` -> indices of the handles that are finished;
+- ``outcome(handle)`` -> the task's return value, or a :class:`~.tasks.Failure`
+  when the task raised (a bug, a killed worker, a broken pool);
+- ``running(handle)`` -> best-effort "has started" flag (progress display only);
+- ``abort(handles)`` -> cancel what has not run and stop what is running;
+- ``close()``.
+
+The sequential executor runs one task per ``wait`` call in the calling process and
+passes it the batch's ``cancel`` event and a progress callback (``in_process``).
+The process pool and Dask run tasks elsewhere; cancellation takes effect between
+tasks (pending ones are cancelled, running pool workers are terminated).
+Dask is imported lazily: without the ``dask`` extra a :class:`CaseError` says how
+to install it.  Nothing here prints or imports a UI library.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import multiprocessing
+import os
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor
+from concurrent.futures import wait as futures_wait
+from typing import Any
+
+from ..core.errors import Cancelled, CaseError
+from .tasks import Failure, ignore_sigint, noop
+
+
+def default_jobs() -> int:
+    """Number of local workers by default: the CPUs this process may use."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):  # pragma: no cover - non-Linux
+        return max(1, os.cpu_count() or 1)
+
+
+class Executor(ABC):
+    """Common interface of the batch executors (see the module docstring)."""
+
+    name: str = "executor"
+    #: tasks run in the calling process and accept ``progress=``/``cancel=`` keywords
+    in_process: bool = False
+
+    @property
+    @abstractmethod
+    def workers(self) -> int:
+        """Number of tasks that can run at once."""
+
+    @abstractmethod
+    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Any: ...
+
+    @abstractmethod
+    def wait(self, handles: Sequence[Any], timeout: float | None = None) -> list[int]: ...
+
+    @abstractmethod
+    def outcome(self, handle: Any) -> Any: ...
+
+    def running(self, handle: Any) -> bool:
+        return False
+
+    @abstractmethod
+    def cancel(self, handles: Sequence[Any]) -> None:
+        """Cancel tasks that have not started (running ones finish; their results are ignored)."""
+
+    @abstractmethod
+    def abort(self, handles: Sequence[Any]) -> None:
+        """Stop the batch: cancel pending tasks and stop running ones where possible."""
+
+    def close(self) -> None:  # noqa: B027 - optional hook
+        pass
+
+    def describe(self) -> str:
+        return f"{self.name} ({self.workers} worker{'s' if self.workers != 1 else ''})"
+
+    def __enter__(self) -> Executor:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+# --------------------------------------------------------------------------- sequential
+class _Deferred:
+    __slots__ = ("fn", "args", "kwargs", "state", "value")
+
+    def __init__(self, fn: Callable[..., Any], args: tuple, kwargs: dict) -> None:
+        self.fn, self.args, self.kwargs = fn, args, kwargs
+        self.state = "pending"  # pending | running | done | cancelled
+        self.value: Any = None
+
+
+class SequentialExecutor(Executor):
+    """Run tasks one by one in this process (``--jobs 1``)."""
+
+    name = "sequential"
+    in_process = True
+
+    @property
+    def workers(self) -> int:
+        return 1
+
+    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> _Deferred:
+        return _Deferred(fn, args, kwargs)
+
+    def wait(self, handles: Sequence[_Deferred], timeout: float | None = None) -> list[int]:
+        done = [i for i, h in enumerate(handles) if h.state in ("done", "cancelled")]
+        if done:
+            return done
+        for i, h in enumerate(handles):
+            if h.state == "pending":
+                h.state = "running"
+                try:
+                    h.value = h.fn(*h.args, **h.kwargs)
+                except Cancelled:
+                    h.state = "cancelled"
+                    raise
+                except Exception as exc:  # a bug in one task must not stop the others
+                    h.value = Failure.of(exc)
+                h.state = "done"
+                return [i]
+        return []
+
+    def outcome(self, handle: _Deferred) -> Any:
+        return handle.value
+
+    def running(self, handle: _Deferred) -> bool:
+        return handle.state != "pending"
+
+    def cancel(self, handles: Sequence[_Deferred]) -> None:
+        for h in handles:
+            if h.state == "pending":
+                h.state = "cancelled"
+
+    def abort(self, handles: Sequence[_Deferred]) -> None:
+        self.cancel(handles)
+
+
+# --------------------------------------------------------------------------- process pool
+#: environment of the pool's worker processes: one BLAS/OpenMP thread each (N workers already
+#: use the N cores; with more threads the workers' spinning BLAS threads fight for them)
+WORKER_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+
+
+@contextlib.contextmanager
+def _worker_environment() -> Iterator[None]:
+    """Set :data:`WORKER_ENV` (where not set by the user) while worker processes start."""
+    added = {k: v for k, v in WORKER_ENV.items() if k not in os.environ}
+    os.environ.update(added)
+    try:
+        yield
+    finally:
+        for k in added:
+            os.environ.pop(k, None)
+
+
+class ProcessPool(Executor):
+    """A local :class:`concurrent.futures.ProcessPoolExecutor` (``--jobs N``).
+
+    Workers are started at once with the ``spawn`` method -- they never inherit the
+    coordinator's threads (progress display, Dask) -- and with one BLAS thread each
+    (:data:`WORKER_ENV`, unless set by the user).  Ctrl-C is left to the coordinator.
+    """
+
+    name = "process pool"
+
+    def __init__(self, jobs: int | None = None) -> None:
+        if jobs is not None and jobs < 1:
+            raise CaseError(f"--jobs: value {jobs} is not allowed: expected an integer >= 1")
+        self._jobs = jobs or default_jobs()
+        self._pool = ProcessPoolExecutor(max_workers=self._jobs, mp_context=multiprocessing.get_context("spawn"),
+                                         initializer=ignore_sigint)
+        with _worker_environment():  # each submit starts one worker while none is idle
+            for _ in range(self._jobs):
+                self._pool.submit(noop)
+
+    @property
+    def workers(self) -> int:
+        return self._jobs
+
+    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Future:
+        return self._pool.submit(fn, *args, **kwargs)
+
+    def wait(self, handles: Sequence[Future], timeout: float | None = None) -> list[int]:
+        futures_wait(handles, timeout=timeout, return_when=FIRST_COMPLETED)
+        return [i for i, f in enumerate(handles) if f.done()]
+
+    def outcome(self, handle: Future) -> Any:
+        if handle.cancelled():
+            return Failure("Cancelled", "cancelled", 130)
+        exc = handle.exception()
+        if exc is not None:
+            return Failure.of(exc)
+        return handle.result()
+
+    def running(self, handle: Future) -> bool:
+        return handle.running() or handle.done()
+
+    def cancel(self, handles: Sequence[Future]) -> None:
+        for f in handles:
+            f.cancel()
+
+    def abort(self, handles: Sequence[Future]) -> None:
+        self.cancel(handles)
+        processes = dict(getattr(self._pool, "_processes", None) or {})
+        self._pool.shutdown(wait=False, cancel_futures=True)
+        for p in processes.values():  # stop chunks that are running now (Python < 3.14 has no API)
+            if p.is_alive():
+                p.terminate()
+        for p in processes.values():
+            p.join(timeout=5)
+
+    def close(self) -> None:
+        self._pool.shutdown(wait=True, cancel_futures=True)
+
+
+# --------------------------------------------------------------------------- Dask
+DASK_MISSING = ("--scheduler needs Dask distributed, which is not installed: "
+                "pip install 'linecheck[dask]' (or: pip install 'dask[distributed]')")
+
+
+def check_scheduler_address(address: str) -> str:
+    """Validate a scheduler address (``tcp://HOST:PORT``, ``tls://...``, ``inproc://...``)."""
+    scheme, sep, rest = address.partition("://")
+    if not sep or not scheme or not rest:
+        raise CaseError(f"--scheduler: value {address!r} is not allowed: expected an address like tcp://HOST:PORT")
+    return address
+
+
+class DaskExecutor(Executor):
+    """Tasks on a Dask distributed cluster (``--scheduler tcp://HOST:PORT``).
+
+    Pass either the scheduler ``address`` (a client is opened and closed here) or an
+    existing ``client`` (left open).  Workers need linecheck installed and the case
+    files (and any downburst field files) at the same paths -- a shared file system.
+    """
+
+    name = "dask"
+
+    def __init__(self, address: str | None = None, *, client: Any = None, timeout: float = 10.0) -> None:
+        try:
+            import distributed
+        except ImportError:
+            raise CaseError(DASK_MISSING) from None
+        self._distributed = distributed
+        self._own = client is None
+        if client is None:
+            if address is None:
+                raise CaseError("--scheduler: no address given")
+            check_scheduler_address(address)
+            try:
+                client = distributed.Client(address, timeout=timeout, set_as_default=False)
+            except (OSError, TimeoutError, ValueError) as exc:
+                raise CaseError(f"--scheduler: cannot connect to the Dask scheduler at {address}: {exc}") from None
+        self.client = client
+        self.address = address or getattr(client.scheduler, "address", "")
+
+    @property
+    def workers(self) -> int:
+        try:
+            return max(1, sum(self.client.nthreads().values()))
+        except Exception:  # pragma: no cover - scheduler gone
+            return 1
+
+    def describe(self) -> str:
+        n = self.workers
+        return f"dask at {self.address} ({n} worker thread{'s' if n != 1 else ''})"
+
+    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Any:
+        return self.client.submit(fn, *args, pure=False, **kwargs)
+
+    def wait(self, handles: Sequence[Any], timeout: float | None = None) -> list[int]:
+        try:
+            self._distributed.wait(list(handles), timeout=timeout, return_when="FIRST_COMPLETED")
+        except TimeoutError:
+            pass
+        except Exception:  # noqa: BLE001 - e.g. the scheduler went away: outcome() reports it
+            pass
+        return [i for i, f in enumerate(handles) if f.done()]
+
+    def outcome(self, handle: Any) -> Any:
+        if handle.status == "cancelled":
+            return Failure("Cancelled", "cancelled", 130)
+        try:
+            return handle.result()
+        except Exception as exc:  # noqa: BLE001 - KilledWorker, lost scheduler, bugs
+            return Failure.of(exc)
+
+    def cancel(self, handles: Sequence[Any]) -> None:
+        if not handles:
+            return
+        try:
+            self.client.cancel(list(handles))
+        except Exception:  # noqa: BLE001  # pragma: no cover
+            pass
+
+    def abort(self, handles: Sequence[Any]) -> None:
+        self.cancel(handles)
+
+    def close(self) -> None:
+        if self._own:
+            self.client.close()
+
+
+def make_executor(jobs: int | None = None, scheduler: str | None = None) -> Executor:
+    """The executor for ``--jobs`` / ``--scheduler`` (CaseError for bad values)."""
+    if scheduler is not None:
+        if jobs is not None:
+            raise CaseError("--jobs and --scheduler cannot be combined: the cluster's workers set the parallelism")
+        return DaskExecutor(scheduler)
+    if jobs is not None and jobs < 1:
+        raise CaseError(f"--jobs: value {jobs} is not allowed: expected an integer >= 1")
+    n = jobs or default_jobs()
+    return SequentialExecutor() if n == 1 else ProcessPool(n)

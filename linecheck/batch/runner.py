@@ -1,0 +1,430 @@
+"""Batch runs: many cases, each split into realization chunks, on any executor.
+
+Contract:
+
+- Every case is split into chunks of at most ``chunk_size`` consecutive realizations
+  (:func:`chunk_ranges`, default :data:`DEFAULT_CHUNK`); each chunk is one task
+  (:func:`~.tasks.run_chunk`, plain data in: case file path, hash, indices), so a
+  large case also spreads over workers.  The chunks of a case are joined with
+  :func:`~.merge.merge_runs` in realization order.  The chunks depend on the case
+  only, never on the executor or the number of workers, so results are
+  bit-identical whatever ``--jobs`` or scheduler (realization r always gets the same
+  turbulence).  A case of at most ``chunk_size`` realizations is one task and equals
+  ``service.run_case(case)`` exactly; a different chunk size changes the resonant
+  part in the last bits only (the core's ``G @ U`` is a BLAS gemm for several
+  realizations and a gemv for one).
+- A case whose chunks are all in is saved at once (``<json_dir>/<file stem>.json``,
+  the :func:`~linecheck.io.jsonout.run_to_dict` document plus ``"case_file"`` and
+  ``"case_hash"``, written atomically), so an interrupted batch loses only running
+  cases.  With ``resume`` a case whose saved JSON carries the same file hash is
+  skipped and its saved document reused.
+- One failing case (bad file, non-convergence, any LinecheckError, a crashed worker)
+  is reported in its :class:`CaseOutcome`; the other cases complete.
+- Progress goes to ``progress(event)`` (:class:`BatchEvent`, overall and per case);
+  setting ``cancel`` (a :class:`threading.Event`) or Ctrl-C stops the batch after
+  saving what is finished.
+
+No UI imports: this runs under the CLI, the TUI or a notebook alike.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ..core.case import Case, case_hash, load_case
+from ..core.errors import Cancelled, CaseError, LinecheckError
+from .executors import Executor, SequentialExecutor
+from .merge import merge_runs
+from .tasks import Failure, apply_changes, run_chunk
+
+POLL_S = 0.2  # how often the coordinator checks the cancel event while tasks run
+
+
+# --------------------------------------------------------------------------- public data
+@dataclass(frozen=True)
+class BatchEvent:
+    """One progress report of a batch.
+
+    kind: ``"start"`` (batch planned), ``"case_start"``, ``"case_progress"``,
+    ``"case_done"``, ``"case_skipped"`` (resume), ``"case_failed"``, ``"finish"``.
+    ``case`` is the case index (-1 for batch-level events); ``done``/``total`` count
+    that case's realizations (``done`` may be fractional while a chunk runs in
+    process), ``overall_done``/``overall_total`` all realizations of the batch.
+    """
+
+    kind: str
+    case: int
+    name: str
+    done: float
+    total: int
+    overall_done: float
+    overall_total: int
+    message: str = ""
+
+
+BatchProgress = Callable[[BatchEvent], None]
+
+
+@dataclass
+class CaseOutcome:
+    """What happened to one case of a batch.
+
+    status: ``"done"`` (run and saved), ``"skipped"`` (resume: saved result reused),
+    ``"failed"`` (``error`` says why), ``"cancelled"`` (not finished when the batch stopped).
+    ``doc`` is the per-case JSON document (done/skipped), ``result`` the merged
+    :class:`~linecheck.service.RunResult` when the batch was asked to keep results.
+    """
+
+    path: Path
+    name: str
+    status: str = "pending"
+    hash: str | None = None
+    realizations: int = 0
+    json_path: Path | None = None
+    doc: dict[str, Any] | None = None
+    result: Any = None
+    error: str | None = None
+    error_kind: str | None = None
+    elapsed: float = 0.0
+
+    @property
+    def ok(self) -> bool:
+        return self.status in ("done", "skipped")
+
+    def excel_doc(self) -> dict[str, Any]:
+        """The document handed to the Excel writer: the result, or ``{"case", "error"}``."""
+        if self.doc is not None:
+            return self.doc
+        return {"case": self.name, "error": self.error or self.status}
+
+
+@dataclass
+class BatchReport:
+    """Outcome of a batch, in the order the cases were given."""
+
+    outcomes: list[CaseOutcome]
+    executor: str = ""
+    elapsed: float = 0.0
+    cancelled: bool = False
+    interrupted: bool = False  # Ctrl-C (KeyboardInterrupt) rather than the cancel event
+
+    @property
+    def failed(self) -> list[CaseOutcome]:
+        return [o for o in self.outcomes if o.status == "failed"]
+
+    @property
+    def exit_code(self) -> int:
+        """0 all cases done, 1 any case failed, 130 cancelled."""
+        if self.cancelled:
+            return 130
+        return 1 if self.failed else 0
+
+    def docs(self) -> list[dict[str, Any]]:
+        """Per-case documents for the Excel workbook (errors as ``{"case", "error"}``)."""
+        return [o.excel_doc() for o in self.outcomes if o.status != "pending"]
+
+
+@dataclass
+class RunJob:
+    """One case to run: a file, optional key changes, a label (scan --dynamic uses changes)."""
+
+    path: Path
+    label: str | None = None
+    changes: Mapping[str, Any] | None = None
+    json_name: str | None = None
+
+
+# --------------------------------------------------------------------------- helpers
+DEFAULT_CHUNK = 10  # realizations per task
+
+
+def chunk_ranges(n: int, size: int = DEFAULT_CHUNK) -> list[list[int]]:
+    """Split ``range(n)`` into ceil(n/size) chunks of consecutive realizations, sizes within one.
+
+    The chunks depend only on ``n`` and ``size`` -- never on the executor or the number
+    of workers -- so a batch gives bit-identical results on any executor.
+    """
+    size = max(1, int(size))
+    if n <= 0:
+        return []
+    k = -(-n // size)
+    edges = [round(i * n / k) for i in range(k + 1)]
+    return [list(range(a, b)) for a, b in zip(edges[:-1], edges[1:])]
+
+
+def json_name_for(path: Path) -> str:
+    return f"{path.stem}.json"
+
+
+def saved_result(json_path: Path, digest: str, changes: Mapping[str, Any] | None = None) -> dict[str, Any] | None:
+    """The saved document at ``json_path`` if it carries ``digest`` as its case hash
+    (and the same key ``changes``, for runs that alter the file's case)."""
+    try:
+        doc = json.loads(json_path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(doc, dict) or doc.get("case_hash") != digest or "reactions" not in doc:
+        return None
+    if doc.get("changes") != (json.loads(json.dumps(dict(changes))) if changes else None):
+        return None
+    return doc
+
+
+def result_document(result: Any, path: Path, digest: str | None, changes: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """The per-case JSON document: ``run_to_dict`` plus ``case_file``, ``case_hash`` (and ``changes``)."""
+    from ..io.jsonout import run_to_dict
+
+    doc = run_to_dict(result)
+    doc["case_file"] = str(path)
+    doc["case_hash"] = digest
+    if changes:
+        doc["changes"] = {k: v for k, v in changes.items()}
+    return doc
+
+
+# --------------------------------------------------------------------------- the runner
+@dataclass
+class _CaseState:
+    index: int
+    job: RunJob
+    outcome: CaseOutcome
+    case: Case | None = None
+    chunks: list[list[int]] = field(default_factory=list)
+    parts: list[Any] = field(default_factory=list)
+    handles: list[Any] = field(default_factory=list)
+    done: float = 0.0
+    started: bool = False
+    t0: float = 0.0
+
+
+def run_batch(
+    cases: Sequence[str | Path | RunJob],
+    *,
+    executor: Executor | None = None,
+    json_dir: str | Path | None = None,
+    resume: bool = False,
+    chunk_size: int | None = None,
+    keep_results: bool = False,
+    progress: BatchProgress | None = None,
+    cancel: threading.Event | None = None,
+) -> BatchReport:
+    """Run every case (all realizations) and save each result as it completes.
+
+    Args:
+        cases: case files (or :class:`RunJob`); the same file given twice runs once.
+        executor: where tasks run (default :class:`SequentialExecutor`); not closed here.
+        json_dir: folder of the per-case JSON results (created if missing; ``None``: no files).
+        resume: skip cases whose saved JSON carries the case file's current hash.
+        chunk_size: realizations per task (default :data:`DEFAULT_CHUNK`); chunks never
+            depend on the executor, so neither do the results.
+        keep_results: keep the merged RunResult of each case in its outcome.
+        progress: ``progress(BatchEvent)``; called in the calling thread.
+        cancel: a threading.Event; when set the batch stops, finished cases stay saved.
+
+    Returns:
+        A :class:`BatchReport`; it never raises for a failing case.
+    Raises:
+        CaseError: ``json_dir`` cannot be created, two cases would write the same JSON,
+            or ``resume`` without ``json_dir``.
+    """
+    t_start = time.perf_counter()
+    executor = executor or SequentialExecutor()
+    cancel = cancel or threading.Event()
+    out_dir = Path(json_dir) if json_dir is not None else None
+    if resume and out_dir is None:
+        raise CaseError("--resume needs a results folder (--json-dir)")
+    if out_dir is not None:
+        if out_dir.exists() and not out_dir.is_dir():
+            raise CaseError("results folder is a file, expected a folder", file=str(out_dir))
+        try:
+            out_dir.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise CaseError(f"cannot create results folder: {exc.strerror}", file=str(out_dir)) from None
+
+    # ---- plan: one state per distinct job
+    jobs: list[RunJob] = []
+    seen: set[tuple[Path, str]] = set()
+    for c in cases:
+        job = c if isinstance(c, RunJob) else RunJob(Path(c))
+        key = (job.path.resolve(), json.dumps(dict(job.changes or {}), sort_keys=True, default=str))
+        if key in seen:
+            continue
+        seen.add(key)
+        jobs.append(job)
+    names: dict[str, Path] = {}
+    for job in jobs:
+        jn = job.json_name or json_name_for(job.path)
+        if out_dir is not None and jn in names:
+            raise CaseError(f"two cases would save to the same result {out_dir / jn} "
+                            f"({names[jn]} and {job.path}): rename one file", file=str(job.path))
+        names[jn] = job.path
+
+    states: list[_CaseState] = []
+    for i, job in enumerate(jobs):
+        st = _CaseState(i, job, CaseOutcome(job.path, job.label or job.path.stem))
+        o = st.outcome
+        if out_dir is not None:
+            o.json_path = out_dir / (job.json_name or json_name_for(job.path))
+        try:
+            case = apply_changes(load_case(job.path), job.changes)
+            o.hash = case_hash(job.path)
+            st.case = case
+        except LinecheckError as err:
+            o.status, o.error, o.error_kind = "failed", str(err), type(err).__name__
+        except OSError as exc:
+            o.status, o.error, o.error_kind = "failed", f"{job.path}: cannot read: {exc.strerror}", "CaseError"
+        if st.case is not None:
+            o.name = job.label or st.case.name
+            o.realizations = st.case.analysis.realizations
+        states.append(st)
+
+    overall_total = sum(s.outcome.realizations for s in states)
+    overall_done = 0.0
+
+    def emit(kind: str, st: _CaseState | None, message: str = "") -> None:
+        if progress is None:
+            return
+        if st is None:
+            progress(BatchEvent(kind, -1, "", overall_done, overall_total, overall_done, overall_total, message))
+        else:
+            progress(BatchEvent(kind, st.index, st.outcome.name, st.done, st.outcome.realizations,
+                                overall_done, overall_total, message))
+
+    # ---- resume
+    for st in states:
+        o = st.outcome
+        if st.case is None or not resume or o.json_path is None:
+            continue
+        doc = saved_result(o.json_path, o.hash or "", st.job.changes)
+        if doc is not None:
+            o.status, o.doc = "skipped", doc
+            st.done = o.realizations
+            overall_done += o.realizations
+
+    emit("start", None, executor.describe())
+    for st in states:
+        if st.outcome.status == "failed":
+            emit("case_failed", st, st.outcome.error or "")
+        elif st.outcome.status == "skipped":
+            emit("case_skipped", st, str(st.outcome.json_path))
+
+    # ---- submit
+    size = DEFAULT_CHUNK if chunk_size is None else max(1, int(chunk_size))
+    todo = [s for s in states if s.case is not None and s.outcome.status == "pending"]
+
+    handles: list[Any] = []
+    owner: list[tuple[_CaseState, int]] = []  # per handle: its case and chunk number
+
+    def in_process_progress(st: _CaseState, before: int, n: int) -> Callable[[str, int, int], None]:
+        def cb(stage: str, d: int, total: int) -> None:
+            nonlocal overall_done
+            if not stage.startswith("steps 2-3") or total <= 0:
+                return
+            new = before + n * d / total
+            overall_done += new - st.done
+            st.done = new
+            emit("case_progress", st)
+        return cb
+
+    for st in todo:
+        st.chunks = chunk_ranges(st.outcome.realizations, size)
+        st.parts = [None] * len(st.chunks)
+        before = 0
+        for k, chunk in enumerate(st.chunks):
+            kwargs: dict[str, Any] = {}
+            if executor.in_process:
+                kwargs = {"cancel": cancel, "progress": in_process_progress(st, before, len(chunk))}
+            h = executor.submit(run_chunk, str(st.job.path), chunk, st.outcome.hash,
+                                dict(st.job.changes) if st.job.changes else None, **kwargs)
+            st.handles.append(h)
+            handles.append(h)
+            owner.append((st, k))
+            before += len(chunk)
+
+    report = BatchReport([s.outcome for s in states], executor=executor.describe())
+
+    def fail_case(st: _CaseState, failure: Failure) -> None:
+        nonlocal overall_done
+        o = st.outcome
+        o.status, o.error, o.error_kind = "failed", failure.message, failure.kind
+        o.elapsed = time.perf_counter() - st.t0 if st.t0 else 0.0
+        executor.cancel([h for h, p in zip(st.handles, st.parts) if p is None])
+        overall_done += st.outcome.realizations - st.done
+        st.parts = []
+        emit("case_failed", st, failure.message)
+
+    def finish_case(st: _CaseState) -> None:
+        o = st.outcome
+        try:
+            merged = merge_runs([p for p in st.parts])
+            doc = result_document(merged, st.job.path, o.hash, st.job.changes)
+            if o.json_path is not None:
+                from ..io.jsonout import write_json
+
+                write_json(o.json_path, doc)
+        except LinecheckError as err:
+            fail_case(st, Failure.of(err))
+            return
+        o.status, o.doc = "done", doc
+        o.result = merged if keep_results else None
+        o.elapsed = time.perf_counter() - st.t0
+        st.parts = []
+        emit("case_done", st, str(o.json_path) if o.json_path else "")
+
+    # ---- collect
+    pending = list(range(len(handles)))
+    try:
+        while pending:
+            if cancel.is_set():
+                raise Cancelled("batch cancelled")
+            for idx in pending:  # best-effort start notices
+                st, _ = owner[idx]
+                if not st.started and executor.running(handles[idx]):
+                    st.started, st.t0 = True, time.perf_counter()
+                    emit("case_start", st)
+            if executor.in_process:  # the next task runs now: announce its case first
+                st, _ = owner[pending[0]]
+                if not st.started:
+                    st.started, st.t0 = True, time.perf_counter()
+                    emit("case_start", st)
+            done_local = executor.wait([handles[i] for i in pending], timeout=POLL_S)
+            finished = [pending[i] for i in done_local]
+            for idx in finished:
+                st, k = owner[idx]
+                value = executor.outcome(handles[idx])
+                if st.outcome.status != "pending":
+                    continue  # its case already failed
+                if not st.started:
+                    st.started, st.t0 = True, time.perf_counter()
+                    emit("case_start", st)
+                if isinstance(value, Failure):
+                    fail_case(st, value)
+                    continue
+                st.parts[k] = value
+                new = sum(len(c) for c, p in zip(st.chunks, st.parts) if p is not None)
+                overall_done += new - st.done
+                st.done = new
+                emit("case_progress", st)
+                if all(p is not None for p in st.parts):
+                    finish_case(st)
+            fs = set(finished)
+            # drop finished tasks and every task of a case that has failed meanwhile
+            pending = [i for i in pending if i not in fs and owner[i][0].outcome.status == "pending"]
+    except (Cancelled, KeyboardInterrupt) as exc:
+        report.cancelled = True
+        report.interrupted = isinstance(exc, KeyboardInterrupt)
+        cancel.set()
+        executor.abort([handles[i] for i in pending])
+        for st in states:
+            if st.outcome.status == "pending":
+                st.outcome.status = "cancelled"
+                st.parts = []
+    report.elapsed = time.perf_counter() - t_start
+    emit("finish", None, "cancelled" if report.cancelled else "")
+    return report

@@ -1,0 +1,383 @@
+"""Critical-downburst scan: step 1 over a grid of downburst positions and sizes.
+
+The paper's Db_x / Db_y configurations come from such a scan (El Damatty et al. 2013):
+for each reaction at the tower of interest, the downburst configuration -- distance
+R [m] from the tower to the centre, angle Theta [deg] from the perpendicular to the
+line (paper Fig. 2), jet diameter D_j [m] -- giving the largest magnitude of the
+wind-induced mean reaction over the event,
+``max_t |service.static_analysis(case).mean.reactions_wind[t, tower, comp]|``.
+
+Each grid point is the case with its ``[wind.downburst]`` preset dropped and
+``distance``, ``angle``, ``jet_diameter`` set (:func:`~.tasks.scan_changes`; every
+other key, e.g. an explicit ``r_max``, is kept; keys left to their default follow
+D_j).
+
+Storm strength (``hold``): a case's V_ref is the running-mean speed at point p, so
+keeping V_ref while moving the storm would make the storm stronger wherever p falls in
+weak outflow (near the centre) -- the scan would then favour degenerate positions.
+By default (``hold="jet"``) every configuration is the *same storm*: V_max of the
+field is held at its value for the case's own configuration (e.g. its preset), as in a
+scan of one CFD downburst (El Damatty et al. 2013); the V_ref at p that this implies
+is reported per point.  ``hold="vref"`` keeps the case's V_ref at p instead.  Points run on the batch executors (:func:`~.tasks.scan_chunk`); a point whose
+analysis fails (e.g. no outflow reaches the line) is reported and left out.
+``run_critical`` then runs the full three-step analysis at the critical
+configurations through :func:`~.runner.run_batch`.  No UI imports.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import re
+import threading
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..core.case import Case, case_hash, load_case
+from ..core.errors import Cancelled, CaseError, LinecheckError
+from ..core.results import REACTIONS
+from .executors import Executor, SequentialExecutor
+from .runner import BatchProgress, BatchReport, RunJob, run_batch
+from .tasks import Failure, ScanChunk, scan_changes, scan_chunk
+
+MAX_POINTS = 1_000_000
+DEFAULT_DISTANCE = "0.5:2.5:0.1Dj"
+DEFAULT_ANGLE = "-80:80:10"
+HOLDS = ("jet", "vref")
+_RELATIVE = re.compile(r"\s*\*?\s*d_?j\s*", re.IGNORECASE)
+
+
+# --------------------------------------------------------------------------- grid
+def parse_values(text: str, option: str) -> tuple[tuple[float, ...], bool]:
+    """Values of a scan option: ``A:B:STEP`` (B included), a comma list or one number.
+
+    A ``Dj`` suffix (``0.5:2.5:0.1Dj``, ``1.2Dj``) makes the values multiples of the
+    jet diameter.  Returns (values, relative).  Raises CaseError (exit 2) on bad text.
+    """
+    raw = text.strip()
+    relative = bool(_RELATIVE.search(raw))
+    body = _RELATIVE.sub("", raw).strip()
+    expected = "expected START:STOP:STEP (STOP included), a comma-separated list or a number, optionally followed by Dj"
+
+    def num(s: str) -> float:
+        try:
+            v = float(s)
+        except ValueError:
+            raise CaseError(f"{option}: value {text!r} is not allowed: {expected}") from None
+        if not math.isfinite(v):
+            raise CaseError(f"{option}: value {text!r} is not allowed: expected finite numbers")
+        return v
+
+    if not body:
+        raise CaseError(f"{option}: empty value: {expected}")
+    if ":" in body:
+        parts = body.split(":")
+        if len(parts) != 3:
+            raise CaseError(f"{option}: value {text!r} is not allowed: {expected}")
+        a, b, step = (num(p) for p in parts)
+        if step == 0 or (b - a) * step < 0:
+            raise CaseError(f"{option}: value {text!r} is not allowed: STEP must be non-zero and go from A toward B")
+        n = int(math.floor((b - a) / step + 1e-9)) + 1
+        if n > MAX_POINTS:
+            raise CaseError(f"{option}: value {text!r} gives {n} values: expected at most {MAX_POINTS}")
+        values = tuple(float(round(a + i * step, 10)) for i in range(n))
+    else:
+        values = tuple(num(p) for p in body.split(",") if p.strip())
+        if not values:
+            raise CaseError(f"{option}: empty value: {expected}")
+    return values, relative
+
+
+@dataclass(frozen=True)
+class ScanGrid:
+    """Downburst configurations to scan.
+
+    distances: R values [m], or multiples of D_j when ``distance_relative``;
+    angles: Theta [deg]; jet_diameters: D_j [m].
+    """
+
+    distances: tuple[float, ...]
+    angles: tuple[float, ...]
+    jet_diameters: tuple[float, ...]
+    distance_relative: bool = False
+
+    @classmethod
+    def from_options(cls, case: Case, distance: str | None = None, angle: str | None = None,
+                     jet_diameter: str | None = None) -> ScanGrid:
+        """The grid of the CLI options; defaults: R = 0.5..2.5 D_j by 0.1 D_j,
+        Theta = -80..80 deg by 10 deg (at +-90 deg the centre is on the line and V_ref at p
+        is undefined), D_j of the case."""
+        db = case.wind.downburst
+        if case.wind.type != "downburst" or db is None:
+            raise CaseError('wind.type: a scan needs a downburst case (type = "downburst")',
+                            file=str(case.source) if case.source else None)
+        dist, rel = parse_values(distance or DEFAULT_DISTANCE, "--distance")
+        ang, ang_rel = parse_values(angle or DEFAULT_ANGLE, "--angle")
+        if ang_rel:
+            raise CaseError(f"--angle: value {angle!r} is not allowed: angles are in degrees (no Dj)")
+        if jet_diameter is None:
+            dj: tuple[float, ...] = (float(db.jet_diameter),)
+        else:
+            dj, dj_rel = parse_values(jet_diameter, "--jet-diameter")
+            if dj_rel:
+                raise CaseError(f"--jet-diameter: value {jet_diameter!r} is not allowed: give D_j in metres")
+        for v in dj:
+            if v <= 0:
+                raise CaseError(f"--jet-diameter: value {v:g} is out of range: expected D_j > 0 m")
+        for v in dist:
+            if v < 0:
+                raise CaseError(f"--distance: value {v:g} is out of range: expected R >= 0")
+        for v in ang:
+            if not -180.0 <= v <= 180.0:
+                raise CaseError(f"--angle: value {v:g} is out of range: expected -180 to 180 deg")
+        grid = cls(dist, ang, dj, rel)
+        if grid.size > MAX_POINTS:
+            raise CaseError(f"scan grid has {grid.size} points: expected at most {MAX_POINTS}")
+        return grid
+
+    @property
+    def size(self) -> int:
+        return len(self.distances) * len(self.angles) * len(self.jet_diameters)
+
+    def points(self) -> np.ndarray:
+        """(n, 3) array of (R [m], Theta [deg], D_j [m]); D_j outermost, Theta innermost."""
+        out = []
+        for dj in self.jet_diameters:
+            for r in self.distances:
+                for th in self.angles:
+                    out.append((r * dj if self.distance_relative else r, th, dj))
+        return np.array(out, dtype=float).reshape(-1, 3)
+
+
+# --------------------------------------------------------------------------- results
+@dataclass(frozen=True)
+class Critical:
+    """The configuration giving the largest |mean| of one reaction.
+
+    value: [N] the signed wind-induced mean reaction there; time: [s] its instant;
+    v_ref: [m/s] running-mean speed at point p in that configuration (scan's storm).
+    """
+
+    reaction: str
+    index: int
+    distance: float
+    angle: float
+    jet_diameter: float
+    value: float
+    time: float
+    v_ref: float = math.nan
+
+    @property
+    def distance_over_dj(self) -> float:
+        return self.distance / self.jet_diameter
+
+    def changes(self) -> dict[str, Any]:
+        """Case key changes that set this configuration (preset dropped)."""
+        return scan_changes(self.distance, self.angle, self.jet_diameter)
+
+
+@dataclass(frozen=True)
+class ScanResult:
+    """Step-1 results over a scan grid.
+
+    Attributes:
+        case: the scanned case (as in its file); case_path: its file.
+        points: (n, 3) of (R [m], Theta [deg], D_j [m]).
+        peak: [N] signed wind-induced mean reaction with the largest |.| over the event at
+            the tower of interest, (n, 3) for (Rx, Ry, Rz); NaN where the point failed.
+        time: [s] instant of that value, (n, 3).
+        v_ref: [m/s] running-mean speed at point p of each configuration, (n,).
+        errors: per point, None or its error message.
+        hold: ``"jet"`` (V_max held at ``v_max`` [m/s]) or ``"vref"`` (V_ref at p held).
+        elapsed: [s] wall time; executor: description of where it ran.
+    """
+
+    case: Case
+    case_path: Path
+    points: np.ndarray
+    peak: np.ndarray
+    time: np.ndarray
+    v_ref: np.ndarray
+    errors: tuple[str | None, ...]
+    hold: str = "jet"
+    v_max: float | None = None
+    elapsed: float = 0.0
+    executor: str = ""
+
+    @property
+    def n_failed(self) -> int:
+        return sum(e is not None for e in self.errors)
+
+    def critical(self, reaction: str | int) -> Critical | None:
+        """The point with the largest |peak| of ``reaction`` (``"Rx"``/0, ``"Ry"``/1, ``"Rz"``/2)."""
+        c = REACTIONS.index(reaction) if isinstance(reaction, str) else int(reaction)
+        mag = np.abs(self.peak[:, c])
+        if not np.any(np.isfinite(mag)):
+            return None
+        i = int(np.nanargmax(mag))  # first point on ties (grid order)
+        r, th, dj = self.points[i]
+        return Critical(REACTIONS[c], i, float(r), float(th), float(dj), float(self.peak[i, c]), float(self.time[i, c]),
+                        float(self.v_ref[i]))
+
+    def criticals(self, reactions: Sequence[str] = ("Rx", "Ry")) -> list[Critical]:
+        return [c for c in (self.critical(r) for r in reactions) if c is not None]
+
+
+def scan_csv_text(result: ScanResult) -> str:
+    """CSV of every scan point (SI units; empty cells where a point failed)."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(["jet_diameter_m", "distance_m", "distance_over_dj", "angle_deg", "v_ref_at_p_m_s",
+                "Rx_N", "Ry_N", "Rz_N", "t_Rx_s", "t_Ry_s", "t_Rz_s", "error"])
+
+    def f(x: float) -> str:
+        return "" if not math.isfinite(x) else repr(float(x))
+
+    for i, (r, th, dj) in enumerate(result.points):
+        w.writerow([repr(float(dj)), repr(float(r)), f(r / dj), repr(float(th)), f(result.v_ref[i]),
+                    *(f(v) for v in result.peak[i]), *(f(v) for v in result.time[i]), result.errors[i] or ""])
+    return buf.getvalue()
+
+
+def write_scan_csv(result: ScanResult, path: str | Path, *, force: bool = True) -> Path:
+    """Write :func:`scan_csv_text` atomically."""
+    from ..io.atomic import write_text_atomic
+
+    return write_text_atomic(path, scan_csv_text(result), force=force, what="CSV")
+
+
+# --------------------------------------------------------------------------- running
+def default_scan_chunk(n_points: int, workers: int) -> int:
+    """Points per task: about four tasks per worker, at most 25 points (results do not depend on it)."""
+    return max(1, min(25, math.ceil(n_points / (4 * max(1, workers)))))
+
+
+def _raise_failure(f: Failure) -> None:
+    if f.exit_code == 130:
+        raise Cancelled(f.message)
+    if f.exit_code == 2:
+        raise CaseError(f.message)
+    err = LinecheckError(f.message)
+    raise err
+
+
+def run_scan(
+    case_path: str | Path,
+    grid: ScanGrid,
+    *,
+    executor: Executor | None = None,
+    hold: str = "jet",
+    chunk_size: int | None = None,
+    progress: Callable[[str, int, int], None] | None = None,
+    cancel: threading.Event | None = None,
+) -> ScanResult:
+    """Step 1 at every grid point of ``grid`` for the case in ``case_path``.
+
+    Args:
+        hold: ``"jet"`` (default): one storm, V_max held at its value for the case's own
+            configuration; ``"vref"``: every configuration keeps the case's V_ref at p.
+        executor: where points run (default sequential, in this process); not closed here.
+        chunk_size: points per task (default :func:`default_scan_chunk`).
+        progress: ``progress("scan", points_done, points_total)``.
+        cancel: a threading.Event; when set the scan stops with :class:`Cancelled`.
+
+    Raises:
+        CaseError: the case is not a valid downburst case.  Cancelled.  LinecheckError
+            when a worker crashed.
+    """
+    t0 = time.perf_counter()
+    executor = executor or SequentialExecutor()
+    path = Path(case_path)
+    case = load_case(path)
+    if case.wind.type != "downburst" or case.wind.downburst is None:
+        raise CaseError('wind.type: a scan needs a downburst case (type = "downburst")', file=str(path))
+    if hold not in HOLDS:
+        raise CaseError(f"--hold: value {hold!r} is not allowed: expected one of {', '.join(HOLDS)}")
+    v_max = None
+    if hold == "jet":
+        from ..core.wind.mean import downburst_field
+
+        v_max = float(downburst_field(case).v_max)  # CaseError if the case's own configuration is invalid
+    digest = case_hash(path)
+    pts = grid.points()
+    n = pts.shape[0]
+    size = chunk_size or default_scan_chunk(n, executor.workers)
+    handles = []
+    for a in range(0, n, size):
+        chunk = [tuple(map(float, p)) for p in pts[a:a + size]]
+        kwargs = {"cancel": cancel} if executor.in_process and cancel is not None else {}
+        handles.append(executor.submit(scan_chunk, str(path), chunk, a, digest, v_max, **kwargs))
+    peak = np.full((n, 3), np.nan)
+    tt = np.full((n, 3), np.nan)
+    vref = np.full(n, np.nan)
+    errors: list[str | None] = [None] * n
+    done = 0
+    pending = list(range(len(handles)))
+    if progress is not None:
+        progress("scan", 0, n)
+    try:
+        while pending:
+            if cancel is not None and cancel.is_set():
+                raise Cancelled("scan cancelled")
+            idx = executor.wait([handles[i] for i in pending], timeout=0.2)
+            finished = [pending[i] for i in idx]
+            for h in finished:
+                value = executor.outcome(handles[h])
+                if isinstance(value, Failure):
+                    _raise_failure(value)
+                assert isinstance(value, ScanChunk)
+                m = value.peak.shape[0]
+                peak[value.start:value.start + m] = value.peak
+                tt[value.start:value.start + m] = value.time
+                vref[value.start:value.start + m] = value.v_ref
+                errors[value.start:value.start + m] = list(value.errors)
+                done += m
+                if progress is not None:
+                    progress("scan", done, n)
+            fs = set(finished)
+            pending = [i for i in pending if i not in fs]
+    except BaseException:
+        executor.abort([handles[i] for i in pending])
+        raise
+    return ScanResult(case, path, pts, peak, tt, vref, tuple(errors), hold, v_max,
+                      time.perf_counter() - t0, executor.describe())
+
+
+def critical_jobs(result: ScanResult, reactions: Sequence[str] = ("Rx", "Ry")) -> list[RunJob]:
+    """One run per distinct critical configuration (reactions sharing one are grouped)."""
+    groups: dict[tuple[float, float, float], list[str]] = {}
+    for c in result.criticals(reactions):
+        groups.setdefault((c.distance, c.angle, c.jet_diameter), []).append(c.reaction)
+    stem = result.case_path.stem
+    jobs = []
+    for (r, th, dj), names in groups.items():
+        tag = "-".join(names)
+        changes = {"name": f"{result.case.name} critical {', '.join(names)}", **scan_changes(r, th, dj)}
+        jobs.append(RunJob(result.case_path, label=changes["name"], changes=changes,
+                           json_name=f"{stem}-critical-{tag}.json"))
+    return jobs
+
+
+def run_critical(
+    result: ScanResult,
+    *,
+    reactions: Sequence[str] = ("Rx", "Ry"),
+    executor: Executor | None = None,
+    json_dir: str | Path | None = None,
+    keep_results: bool = False,
+    progress: BatchProgress | None = None,
+    cancel: threading.Event | None = None,
+) -> BatchReport:
+    """Full three-step analysis (all realizations) at the critical configurations of a scan.
+
+    Each run keeps the case's own V_ref at point p (the design speed, as the paper's
+    Db_x/Db_y cases do); only the geometry comes from the scan.
+    """
+    return run_batch(critical_jobs(result, reactions), executor=executor, json_dir=json_dir,
+                     keep_results=keep_results, progress=progress, cancel=cancel)

@@ -1,0 +1,158 @@
+"""Critical-downburst scan (issue 8): grid parsing, executors, the paper's Db_x / Db_y."""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from linecheck.batch import ScanGrid, SequentialExecutor, parse_values, run_scan, scan_csv_text
+from linecheck.batch.tasks import fixed_jet_case, scan_point
+from linecheck.cli.app import app
+from linecheck.core.case import load_case
+from linecheck.core.errors import CaseError
+from linecheck.core.wind.mean import downburst_field
+
+from .conftest import CASES
+from .test_batch import pool, write_short_case  # noqa: F401  (pool: shared session fixture)
+
+runner = CliRunner(env={"COLUMNS": "250"})
+
+
+def paper_line_case(tmp_path: Path, spans: str = "six", mean_states: int = 40) -> Path:
+    """The paper's line (L = 300 m, D_j = 2 L = 600 m, Db_x preset) with fewer step-1 instants."""
+    text = (CASES / "paper" / f"case01-{spans}.toml").read_text(encoding="utf-8")
+    text = text.replace("[analysis]", f"[analysis]\nmean_states = {mean_states}", 1)
+    p = tmp_path / f"paper-line-{spans}.toml"
+    p.write_text(text, encoding="utf-8")
+    return p
+
+
+# --------------------------------------------------------------------------- grid
+def test_parse_values_ranges_lists_and_dj():
+    assert parse_values("0:90:30", "--angle") == ((0.0, 30.0, 60.0, 90.0), False)
+    assert parse_values("1.0:1.6:0.2Dj", "--distance") == ((1.0, 1.2, 1.4, 1.6), True)
+    assert parse_values("600, 900", "--jet-diameter") == ((600.0, 900.0), False)
+    assert parse_values("1.2 Dj", "--distance") == ((1.2,), True)
+    assert parse_values("90:0:-45", "--angle")[0] == (90.0, 45.0, 0.0)
+    for bad in ("", "1:2", "a:b:c", "0:10:0", "0:10:-1", "nan"):
+        with pytest.raises(CaseError):
+            parse_values(bad, "--distance")
+
+
+def test_grid_points_relative_distance_and_defaults():
+    case = load_case(CASES / "paper" / "case01-single.toml")
+    g = ScanGrid.from_options(case, "1.2:1.6:0.4Dj", "0,30", "600,900")
+    pts = g.points()
+    assert pts.shape == (8, 3) and g.size == 8
+    np.testing.assert_allclose(pts[:4], [[720, 0, 600], [720, 30, 600], [960, 0, 600], [960, 30, 600]])
+    np.testing.assert_allclose(pts[4], [1080, 0, 900])
+    d = ScanGrid.from_options(case)  # defaults: 0.5..2.5 D_j, -80..80 deg, the case's D_j
+    assert d.distance_relative and len(d.distances) == 21 and d.angles[0] == -80 and d.jet_diameters == (600.0,)
+    synoptic = load_case(CASES / "paper" / "case09-single.toml")
+    with pytest.raises(CaseError, match="downburst"):
+        ScanGrid.from_options(synoptic)
+    with pytest.raises(CaseError, match="degrees"):
+        ScanGrid.from_options(case, angle="0:1:1Dj")
+
+
+def test_fixed_jet_case_holds_the_storm_strength():
+    case = load_case(CASES / "paper" / "case01-single.toml")  # Db_x, V_ref = 40 m/s at p
+    vmax = downburst_field(case).v_max
+    assert math.isclose(fixed_jet_case(case, vmax).wind.v_ref, 40.0, rel_tol=1e-12)
+    peak, _, v_ref = scan_point(case, 960.0, 30.0, 600.0, vmax)  # the preset's own geometry
+    assert math.isclose(v_ref, 40.0, rel_tol=1e-9)
+    peak_vref, _, v_ref2 = scan_point(case, 960.0, 30.0, 600.0, None)
+    assert v_ref2 == 40.0 and np.allclose(peak, peak_vref, rtol=1e-9)
+
+
+# --------------------------------------------------------------------------- the paper's line
+def test_scan_finds_paper_critical_configurations(tmp_path):
+    """Six spans, L = 300 m, D_j = 600 m: Ry critical at Db_y (1.2 D_j, 0 deg); Rx at Theta = 30 deg
+    (R = 1.4 D_j here against the paper's 1.6 D_j: see docs/validation.md)."""
+    path = paper_line_case(tmp_path)
+    case = load_case(path)
+    grid = ScanGrid.from_options(case, "1.0:1.6:0.2Dj", "0,30,60")
+    res = run_scan(path, grid)
+    assert res.n_failed == 0 and res.hold == "jet"
+    ry, rx = res.critical("Ry"), res.critical("Rx")
+    assert (ry.distance_over_dj, ry.angle, ry.jet_diameter) == pytest.approx((1.2, 0.0, 600.0))
+    assert (rx.distance_over_dj, rx.angle) == pytest.approx((1.4, 30.0))
+    assert ry.value > 0 and abs(ry.value) > 4 * abs(rx.value)
+    # the transverse reaction falls off away from the critical distance, the longitudinal one
+    # vanishes at Theta = 0 (symmetric loading of the spans next to the middle tower)
+    theta0 = res.points[:, 1] == 0.0
+    assert np.all(np.abs(res.peak[theta0, 0]) < 1e-3 * abs(rx.value))
+
+
+def test_scan_pool_equals_sequential_and_csv(tmp_path, pool):  # noqa: F811
+    path = tmp_path / "case01-single.toml"
+    path.write_bytes((CASES / "paper" / "case01-single.toml").read_bytes())
+    case = load_case(path)
+    grid = ScanGrid.from_options(case, "0.8:1.6:0.4Dj", "-30:30:30")
+    seq = run_scan(path, grid, executor=SequentialExecutor())
+    par = run_scan(path, grid, executor=pool, chunk_size=2)
+    assert np.array_equal(seq.peak, par.peak, equal_nan=True)
+    assert np.array_equal(seq.time, par.time, equal_nan=True)
+    rows = list(csv.DictReader(io.StringIO(scan_csv_text(par))))
+    assert len(rows) == grid.size
+    assert float(rows[0]["distance_over_dj"]) == pytest.approx(0.8) and float(rows[0]["angle_deg"]) == -30.0
+    crit = par.critical("Ry")
+    assert float(rows[crit.index]["Ry_N"]) == crit.value
+
+
+def test_scan_hold_vref_keeps_v_ref_at_p(tmp_path):
+    path = CASES / "paper" / "case01-single.toml"
+    case = load_case(path)
+    res = run_scan(path, ScanGrid.from_options(case, "1.2Dj", "0,30"), hold="vref")
+    assert np.all(res.v_ref == case.wind.v_ref) and res.v_max is None
+    with pytest.raises(CaseError, match="--hold"):
+        run_scan(path, ScanGrid.from_options(case, "1.2Dj", "0"), hold="storm")
+
+
+def test_scan_reports_points_that_cannot_be_analysed():
+    path = CASES / "paper" / "case01-single.toml"
+    case = load_case(path)
+    res = run_scan(path, ScanGrid.from_options(case, "1.2Dj", "0,90"))  # 90 deg: centre on the line
+    assert res.n_failed == 1 and res.errors[1] and "point p" in res.errors[1]
+    assert np.all(np.isnan(res.peak[1])) and res.critical("Ry").index == 0
+
+
+# --------------------------------------------------------------------------- CLI
+def test_cli_scan_table_csv_and_dynamic(tmp_path):
+    path = write_short_case(CASES / "paper" / "case01-single.toml", tmp_path, realizations=2, duration=30.0)
+    out = tmp_path / "scan.csv"
+    r = runner.invoke(app, ["scan", str(path), "--distance", "1.2:1.6:0.4Dj", "--angle", "0,30", "--csv", str(out),
+                            "--dynamic", "--jobs", "1", "--json-dir", str(tmp_path / "dyn")])
+    assert r.exit_code == 0, r.output
+    assert "critical downburst configurations" in r.output and "Db_x: R = 1.6 D_j" in r.output
+    assert "full analysis at the critical configurations" in r.output
+    assert len(out.read_text().splitlines()) == 1 + 4
+    assert list((tmp_path / "dyn").glob("*.json"))
+
+
+def test_cli_scan_usage_errors(tmp_path):
+    path = CASES / "paper" / "case01-single.toml"
+    r = runner.invoke(app, ["scan", str(path), "--distance", "1:2"])
+    assert r.exit_code == 2 and "START:STOP:STEP" in r.output
+    r = runner.invoke(app, ["scan", str(CASES / "paper" / "case09-single.toml")])
+    assert r.exit_code == 2 and "downburst" in r.output
+
+
+@pytest.mark.slow
+def test_scan_paper_line_full_grid(tmp_path):
+    """R = 0.8..2.0 D_j by 0.2, Theta = 0..90 deg by 15 on the paper's six-span line (all step-1 instants)."""
+    from linecheck.batch import ProcessPool
+
+    path = paper_line_case(tmp_path, mean_states=250)
+    case = load_case(path)
+    with ProcessPool(2) as ex:
+        res = run_scan(path, ScanGrid.from_options(case, "0.8:2.0:0.2Dj", "0:90:15"), executor=ex)
+    ry, rx = res.critical("Ry"), res.critical("Rx")
+    assert (ry.distance_over_dj, ry.angle) == pytest.approx((1.2, 0.0))
+    assert (rx.distance_over_dj, rx.angle) == pytest.approx((1.4, 30.0))

@@ -162,12 +162,12 @@ def integrate(
             for i0 in range(0, all_steps.size, chunk):
                 steps = all_steps[i0:i0 + chunk]
                 UT = _solve(c, loads_full(loads[steps].reshape(-1, n_free)).T).T
-                R_B[steps] = (UT @ GT).reshape(steps.size, n_real, n_r)
+                R_B[steps] = _rowdot(UT, GT).reshape(steps.size, n_real, n_r)
     else:
         for n in range(n_steps):
             Kb, _, _, G = mats(n)
             c = _factor(Kb, np.zeros(n_dof), f"stiffness at step {n}")
-            R_B[n] = _solve(c, loads_full(loads[n]).T).T @ G.T
+            R_B[n] = _rowdot(_solve(c, loads_full(loads[n]).T).T, G.T)
 
     # -------- step 2: Newmark, one factorisation per mean state
     Kb0, _, _, G0 = mats(0)
@@ -176,7 +176,7 @@ def integrate(
     V = np.zeros_like(U)
     A = np.zeros_like(U)  # M a0 = F0 - K u0 - C v0 = 0
     R_F = np.empty((n_steps, n_real, n_r))
-    R_F[0] = U @ G0.T
+    R_F[0] = _rowdot(U, G0.T)
     current = None
     report = max(1, n_steps // 100)
     a0, a1, a2 = nm.a0, nm.a1, nm.a2
@@ -205,7 +205,7 @@ def integrate(
         A_new = a0 * (U_new - U) - a2 * V - A
         V += half_dt * (A + A_new)
         U, A = U_new, A_new
-        R_F[n] = U @ GT
+        R_F[n] = _rowdot(U, GT)
         if progress is not None and n % report == 0:
             progress(n, n_steps)
             if cancel is not None and cancel.is_set():
@@ -236,6 +236,13 @@ def _axial_remover(model: LinearModel) -> Callable[[np.ndarray], None]:
         x[:, idx] = xs - np.einsum("rsd,sd->rs", xs, a)[..., None] * a[None]
 
     return drop
+
+
+def _rowdot(X: np.ndarray, BT: np.ndarray) -> np.ndarray:
+    """X @ BT computed row by row in a fixed order (no BLAS): every realization's reactions
+    are then bit-identical whichever other realizations share the call (batch chunking,
+    workers); a BLAS gemm rounds differently for different numbers of rows."""
+    return np.einsum("rd,dk->rk", X, BT, optimize=False)
 
 
 def _pair_multiplier(m_band: np.ndarray, c_band: np.ndarray) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:

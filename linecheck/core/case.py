@@ -573,15 +573,23 @@ def with_value(case: Case, dotted_key: str, value: Any) -> Case:
 
     The same validation and messages as the file loader (TUI editor, scans).
     """
+    return with_values(case, {dotted_key: value})
+
+
+def with_values(case: Case, changes: dict[str, Any]) -> Case:
+    """A validated copy of ``case`` with several keys changed (``None`` removes a key)."""
+    if not changes:
+        return case
     doc = case_to_dict(case)
-    *path, key = dotted_key.split(".")
-    table = doc
-    for p in path:
-        table = table.setdefault(p, {})
-    if value is None:
-        table.pop(key, None)
-    else:
-        table[key] = value
+    for dotted_key, value in changes.items():
+        *path, key = dotted_key.split(".")
+        table = doc
+        for p in path:
+            table = table.setdefault(p, {})
+        if value is None:
+            table.pop(key, None)
+        else:
+            table[key] = value
     base = case.source.parent if case.source else None
     return case_from_dict(doc, file=str(case.source) if case.source else None, default_name=case.name, base_dir=base)
 

@@ -127,16 +127,9 @@ def build_default_template() -> Workbook:
     ws["B6"].style = "lc_note"
     wb.defined_names[SUMMARY_ANCHOR] = DefinedName(SUMMARY_ANCHOR, attr_text="Summary!$A$8")
     ws.sheet_view.showGridLines = False
-    ws.page_setup.orientation = "landscape"
-    ws.page_setup.paperSize = ws.PAPERSIZE_A4
-    ws.sheet_properties.pageSetUpPr.fitToPage = True
-    ws.page_setup.fitToWidth = 1
-    ws.page_setup.fitToHeight = 0
-    ws.page_margins.left = ws.page_margins.right = 0.5
-    ws.page_margins.top = ws.page_margins.bottom = 0.75
-    ws.page_margins.header = ws.page_margins.footer = 0.3
-    ws.oddFooter.left.text = "linecheck design sheet"
-    ws.oddFooter.right.text = "page &P of &N"
+    from .cells import page_setup  # one page layout for the template and the written sheets
+
+    page_setup(ws, None)
     wb.properties.title = "linecheck design sheet"
     wb.properties.creator = "linecheck"
     return wb

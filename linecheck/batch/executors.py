@@ -245,6 +245,8 @@ class DaskExecutor(Executor):
     name = "dask"
 
     def __init__(self, address: str | None = None, *, client: Any = None, timeout: float = 10.0) -> None:
+        if client is None and address is not None:
+            check_scheduler_address(address)  # a usage error first, whether or not Dask is installed
         try:
             import distributed
         except ImportError:

@@ -3,16 +3,15 @@
 Contract:
 
 - Every case is split into chunks of at most ``chunk_size`` consecutive realizations
-  (:func:`chunk_ranges`, default :data:`DEFAULT_CHUNK`); each chunk is one task
+  (:func:`chunk_ranges`; default :func:`auto_chunk_size`: up to :data:`DEFAULT_CHUNK`,
+  fewer when there are fewer realizations than workers); each chunk is one task
   (:func:`~.tasks.run_chunk`, plain data in: case file path, hash, indices), so a
   large case also spreads over workers.  The chunks of a case are joined with
-  :func:`~.merge.merge_runs` in realization order.  The chunks depend on the case
-  only, never on the executor or the number of workers, so results are
-  bit-identical whatever ``--jobs`` or scheduler (realization r always gets the same
-  turbulence).  A case of at most ``chunk_size`` realizations is one task and equals
-  ``service.run_case(case)`` exactly; a different chunk size changes the resonant
-  part in the last bits only (the core's ``G @ U`` is a BLAS gemm for several
-  realizations and a gemv for one).
+  :func:`~.merge.merge_runs` in realization order.  Realization r always gets the same
+  turbulence, and the core computes each realization's response independently of the
+  others in its run (fixed-order products, no BLAS across realizations), so results are
+  bit-identical to ``service.run_case(case)`` whatever the chunking, ``--jobs`` or
+  scheduler.
 - A case whose chunks are all in is saved at once (``<json_dir>/<file stem>.json``,
   the :func:`~linecheck.io.jsonout.run_to_dict` document plus ``"case_file"`` and
   ``"case_hash"``, written atomically), so an interrupted batch loses only running
@@ -141,14 +140,19 @@ class RunJob:
 
 
 # --------------------------------------------------------------------------- helpers
-DEFAULT_CHUNK = 10  # realizations per task
+DEFAULT_CHUNK = 10  # realizations per task (each task repeats step 1 and the model set-up)
+
+
+def auto_chunk_size(total_realizations: int, workers: int) -> int:
+    """Realizations per task: :data:`DEFAULT_CHUNK`, or fewer so that every worker gets work
+    when the whole batch has fewer than ``DEFAULT_CHUNK`` realizations per worker."""
+    return max(1, min(DEFAULT_CHUNK, total_realizations // max(1, workers)))
 
 
 def chunk_ranges(n: int, size: int = DEFAULT_CHUNK) -> list[list[int]]:
     """Split ``range(n)`` into ceil(n/size) chunks of consecutive realizations, sizes within one.
 
-    The chunks depend only on ``n`` and ``size`` -- never on the executor or the number
-    of workers -- so a batch gives bit-identical results on any executor.
+    Results do not depend on the chunks (see the module docstring).
     """
     size = max(1, int(size))
     if n <= 0:
@@ -221,8 +225,8 @@ def run_batch(
         executor: where tasks run (default :class:`SequentialExecutor`); not closed here.
         json_dir: folder of the per-case JSON results (created if missing; ``None``: no files).
         resume: skip cases whose saved JSON carries the case file's current hash.
-        chunk_size: realizations per task (default :data:`DEFAULT_CHUNK`); chunks never
-            depend on the executor, so neither do the results.
+        chunk_size: realizations per task (default :func:`auto_chunk_size`); the
+            results do not depend on it.
         keep_results: keep the merged RunResult of each case in its outcome.
         progress: ``progress(BatchEvent)``; called in the calling thread.
         cancel: a threading.Event; when set the batch stops, finished cases stay saved.
@@ -315,8 +319,11 @@ def run_batch(
             emit("case_skipped", st, str(st.outcome.json_path))
 
     # ---- submit
-    size = DEFAULT_CHUNK if chunk_size is None else max(1, int(chunk_size))
     todo = [s for s in states if s.case is not None and s.outcome.status == "pending"]
+    if chunk_size is None:
+        size = auto_chunk_size(sum(s.outcome.realizations for s in todo), executor.workers)
+    else:
+        size = max(1, int(chunk_size))
 
     handles: list[Any] = []
     owner: list[tuple[_CaseState, int]] = []  # per handle: its case and chunk number

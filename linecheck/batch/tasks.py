@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.case import Case, case_from_dict, case_hash, case_to_dict, load_case
+from ..core.case import Case, case_hash, load_case, with_values
 from ..core.errors import Cancelled, CaseError, LinecheckError
 
 @dataclass(frozen=True)
@@ -50,24 +50,11 @@ class Failure:
 def apply_changes(case: Case, changes: Mapping[str, Any] | None) -> Case:
     """A validated copy of ``case`` with several dotted keys set at once (``None`` removes a key).
 
-    Same validation and messages as the file loader.  Setting them together matters
-    for downburst geometry: a ``preset`` must be removed in the same edit that sets
-    ``distance``/``angle``/``jet_diameter``.
+    :func:`linecheck.core.case.with_values`: same validation and messages as the file
+    loader.  Setting them together matters for downburst geometry: a ``preset`` must be
+    removed in the same edit that sets ``distance``/``angle``/``jet_diameter``.
     """
-    if not changes:
-        return case
-    doc = case_to_dict(case)
-    for dotted, value in changes.items():
-        *path, key = dotted.split(".")
-        table = doc
-        for p in path:
-            table = table.setdefault(p, {})
-        if value is None:
-            table.pop(key, None)
-        else:
-            table[key] = value
-    base = case.source.parent if case.source else None
-    return case_from_dict(doc, file=str(case.source) if case.source else None, default_name=case.name, base_dir=base)
+    return with_values(case, dict(changes)) if changes else case
 
 
 def scan_changes(distance: float, angle: float, jet_diameter: float) -> dict[str, Any]:

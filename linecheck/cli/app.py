@@ -48,7 +48,7 @@ def handle_errors(fn: F) -> F:
         try:
             return fn(*args, **kwargs)
         except LinecheckError as err:
-            err_console.print(f"[bold red]error:[/] {escape(str(err))}", highlight=False, soft_wrap=True)
+            err_console.print(f"[bold red]error:[/] {escape(str(err))}", highlight=False, soft_wrap=True, emoji=False)
             raise typer.Exit(err.exit_code) from None
         except KeyboardInterrupt:
             err_console.print("[bold red]interrupted[/]")
@@ -59,7 +59,7 @@ def handle_errors(fn: F) -> F:
             if os.environ.get("LINECHECK_DEBUG"):
                 raise
             err_console.print(f"[bold red]internal error:[/] {type(err).__name__}: {escape(str(err))} "
-                              "(set LINECHECK_DEBUG=1 for the traceback; please report it)", highlight=False)
+                              "(set LINECHECK_DEBUG=1 for the traceback; please report it)", highlight=False, emoji=False)
             raise typer.Exit(1) from None
 
     return wrapper  # type: ignore[return-value]

@@ -36,7 +36,8 @@ JsonDirOpt = Annotated[Path | None, typer.Option(
     "--json-dir", help="Folder of the per-case JSON results (default: results/ next to --excel, else ./results).",
     show_default=False)]
 ChunkOpt = Annotated[int | None, typer.Option(
-    "--chunk", help="Realizations per task (default 10). Results are identical on any executor for a given chunk.",
+    "--chunk", help="Realizations per task (default 10, fewer when there are fewer realizations than workers); "
+                    "results do not depend on it.",
     min=1, show_default=False)]
 
 

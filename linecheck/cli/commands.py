@@ -25,7 +25,7 @@ def check(cases: CasesArg) -> None:
         try:
             case = read_case(path)
         except CaseError as err:
-            err_console.print(f"[bold red]error:[/] {escape(str(err))}", highlight=False, soft_wrap=True)
+            err_console.print(f"[bold red]error:[/] {escape(str(err))}", highlight=False, soft_wrap=True, emoji=False)
             failed += 1
             continue
         console.print(f"[green]ok[/] {escape(str(path))}  [dim]{escape(case.name)}: {escape(case.description)}[/]",

@@ -331,7 +331,8 @@ def run_scan(
                 value = executor.outcome(handles[h])
                 if isinstance(value, Failure):
                     _raise_failure(value)
-                assert isinstance(value, ScanChunk)
+                if not isinstance(value, ScanChunk):  # pragma: no cover - an executor bug
+                    raise TypeError(f"scan task returned {type(value).__name__}, expected ScanChunk")
                 m = value.peak.shape[0]
                 peak[value.start:value.start + m] = value.peak
                 tt[value.start:value.start + m] = value.time

@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import math
-from pathlib import Path
 from typing import Annotated
 
 import typer
@@ -12,9 +10,9 @@ from rich.table import Table
 
 from .. import service
 from ..core.case import Case
-from ..core.errors import CaseError
 from ..core.results import REACTIONS
 from ..io.atomic import check_target
+from ..io.display import SUMMARY_STATS, stat_text
 from ..io.jsonout import _num, run_to_dict, write_json
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .export_cmd import ExcelOpt, ForceOpt, TemplateOpt
@@ -36,36 +34,17 @@ def override(case: Case, realizations: int | None, seed: int | None) -> Case:
     return dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, **changes))
 
 
-def _pm(stat: dict, scale: float = 1.0, fmt: str = "{:.3f}", n: int = 1) -> str:
-    m, s = stat["mean"], stat["std"]
-    if m is None:
-        return "**"
-    text = fmt.format(m * scale)
-    if n > 1 and s is not None:
-        text += " ± " + fmt.format(s * scale)
-    return text
-
-
 def results_table(doc: dict) -> Table:
     """Rich table of the statistics at the tower of interest (kN, %)."""
     n = doc["realizations"]
     t = Table(title=f"{doc['case']}: reactions at tower {doc['tower_of_interest']} "
                     f"({doc['wind']}, V_ref = {doc['v_ref']:g} m/s, {n} realization{'s' if n > 1 else ''})",
               title_justify="left")
-    cols = [("reaction", None, None), ("mean max kN", "mean_max", 1e-3), ("rms B kN", "rms_background", 1e-3),
-            ("rms R kN", "rms_resonant", 1e-3), ("peak QS kN", "peak_quasi_static", 1e-3),
-            ("peak Dy kN", "peak_dynamic", 1e-3), ("GF_Dy", "GF_Dy", 1.0), ("GF_QS", "GF_QS", 1.0),
-            ("Cont_M %", "Cont_M", 100.0), ("Cont_BG %", "Cont_BG", 100.0), ("Cont_R %", "Cont_R", 100.0),
-            ("peak/g*L", "peak_normalised", 1.0)]
-    for name, _, _ in cols:
-        t.add_column(name, justify="right")
+    t.add_column("reaction", justify="right")
+    for st in SUMMARY_STATS:
+        t.add_column(f"{st.label} {st.unit}" if st.unit != "-" else st.label, justify="right")
     for r in REACTIONS:
-        block = doc["reactions"][r]
-        row = [r]
-        for _, key, scale in cols[1:]:
-            fmt = "{:.1f}" if key.startswith("Cont") else "{:.3f}"
-            row.append(_pm(block[key], scale, fmt, n))
-        t.add_row(*row)
+        t.add_row(r, *(stat_text(doc["reactions"][r][st.key], st, n) for st in SUMMARY_STATS))
     return t
 
 

@@ -473,24 +473,29 @@ def _build_downburst(d: dict[str, Any], line: Line, ctx: _Ctx, base_dir: Path | 
     return Downburst(field_path=path, **d)
 
 
+def read_text_file(path: str | Path, expected: str) -> str:
+    """UTF-8 text of a user file; one-line :class:`CaseError` naming the file and ``expected``
+    (e.g. "a TOML case file") when it is missing, a folder, unreadable or not UTF-8."""
+    p = Path(path)
+    try:
+        return p.read_bytes().decode("utf-8")
+    except FileNotFoundError:
+        raise CaseError(f"file not found (expected {expected})", file=str(p)) from None
+    except IsADirectoryError:
+        raise CaseError(f"is a directory, expected {expected}", file=str(p)) from None
+    except UnicodeDecodeError:
+        raise CaseError(f"not a UTF-8 text file (expected {expected})", file=str(p)) from None
+    except OSError as exc:
+        raise CaseError(f"cannot read: {exc.strerror}", file=str(p)) from None
+
+
 def load_case(path: str | Path) -> Case:
     """Read and validate a TOML case file.
 
     Raises :class:`CaseError` (one line: file, key, line, value, what is allowed).
     """
     p = Path(path)
-    try:
-        raw = p.read_bytes()
-    except FileNotFoundError:
-        raise CaseError("file not found", file=str(p)) from None
-    except IsADirectoryError:
-        raise CaseError("is a directory, expected a .toml case file", file=str(p)) from None
-    except OSError as exc:
-        raise CaseError(f"cannot read: {exc.strerror}", file=str(p)) from None
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError:
-        raise CaseError("not a UTF-8 text file (expected a TOML case file)", file=str(p)) from None
+    text = read_text_file(p, "a .toml case file")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

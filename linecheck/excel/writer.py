@@ -33,6 +33,7 @@ from typing import Any
 
 from openpyxl import Workbook
 
+from ..core.case import read_text_file
 from ..core.errors import CaseError
 from ..io.atomic import atomic_path, check_target
 from . import template as tpl
@@ -183,16 +184,7 @@ def load_result_docs(paths: Iterable[str | Path]) -> list[dict[str, Any]]:
     docs: list[dict[str, Any]] = []
     for path in paths:
         p = Path(path)
-        try:
-            text = p.read_text(encoding="utf-8")
-        except FileNotFoundError:
-            raise CaseError("file not found (expected a JSON result of `linecheck run --json`)", file=str(p)) from None
-        except IsADirectoryError:
-            raise CaseError("is a directory, expected a JSON result file", file=str(p)) from None
-        except UnicodeDecodeError:
-            raise CaseError("not a UTF-8 text file (expected a JSON result)", file=str(p)) from None
-        except OSError as exc:
-            raise CaseError(f"cannot read: {exc.strerror}", file=str(p)) from None
+        text = read_text_file(p, "a JSON result of `linecheck run --json`")
         try:
             data = json.loads(text)
         except json.JSONDecodeError as exc:

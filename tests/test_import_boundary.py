@@ -21,6 +21,7 @@ CORE_MODULES = [
     "linecheck.core.wind.point",
     "linecheck.service",
     "linecheck.io.jsonout",
+    "linecheck.io.display",
 ]
 
 

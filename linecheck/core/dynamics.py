@@ -26,7 +26,7 @@ import numpy as np
 from scipy.linalg import lapack
 
 from .errors import Cancelled, NumericalError
-from .model import LinearModel
+from .model import LinearModel, band_blocks, band_to_sparse, rotate_band
 
 _dpbtrf = lapack.dpbtrf
 _dpbtrs = lapack.dpbtrs
@@ -140,11 +140,6 @@ def integrate(
         k = int(state_of_step[n])
         return models[k], damping[k]
 
-    def mats(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """K band, damping band, mass band and reaction map in force at step n."""
-        m, c = model_of(n)
-        return m.K_band, c, m.M_band, m.G
-
     def loads_full(f: np.ndarray) -> np.ndarray:
         """y-loads (m, n_free) -> full transposed right-hand sides (m, n_dof)."""
         out = np.zeros((f.shape[0], n_dof))
@@ -157,57 +152,80 @@ def integrate(
     if model_at is None:
         for k in np.unique(state_of_step):
             c = _factor(models[k].K_band, np.zeros(n_dof), f"stiffness of mean state {k + 1}")
+            # static transfer from the y-loads to the reactions, (G K^-1 P)^T = (K^-1 G^T)[y]
+            TB = np.ascontiguousarray(_solve(c, np.asfortranarray(models[k].G.T))[ydof])  # (n_free, n_r)
             all_steps = np.flatnonzero(state_of_step == k)
-            GT = models[k].G.T
             for i0 in range(0, all_steps.size, chunk):
                 steps = all_steps[i0:i0 + chunk]
-                UT = _solve(c, loads_full(loads[steps].reshape(-1, n_free)).T).T
-                R_B[steps] = _rowdot(UT, GT).reshape(steps.size, n_real, n_r)
+                R_B[steps] = _rowdot(loads[steps].reshape(-1, n_free), TB).reshape(steps.size, n_real, n_r)
     else:
         for n in range(n_steps):
-            Kb, _, _, G = mats(n)
-            c = _factor(Kb, np.zeros(n_dof), f"stiffness at step {n}")
-            R_B[n] = _rowdot(_solve(c, loads_full(loads[n]).T).T, G.T)
+            m, _ = model_of(n)
+            c = _factor(m.K_band, np.zeros(n_dof), f"stiffness at step {n}")
+            R_B[n] = _rowdot(_solve(c, loads_full(loads[n]).T).T, m.G.T)
 
-    # -------- step 2: Newmark, one factorisation per mean state
-    Kb0, _, _, G0 = mats(0)
-    chol = _factor(Kb0, np.zeros(n_dof), "stiffness at t = 0")
-    U = _solve(chol, loads_full(loads[0]).T).T  # quasi-static start, (n_real, n_dof)
-    V = np.zeros_like(U)
-    A = np.zeros_like(U)  # M a0 = F0 - K u0 - C v0 = 0
+    # -------- step 2: Newmark, one factorisation per mean state, in node bases that make
+    # M and C diagonal (so that the per-step products are elementwise; see _Stepper)
+    m0, _ = model_of(0)
+    chol = _factor(m0.K_band, np.zeros(n_dof), "stiffness at t = 0")
+    U = _solve(chol, loads_full(loads[0]).T).T  # quasi-static start, (n_real, n_dof), global
     R_F = np.empty((n_steps, n_real, n_r))
-    R_F[0] = _rowdot(U, G0.T)
-    current = None
+    R_F[0] = _rowdot(U, m0.G.T)
+    block = max(1, min(512, 2_000_000 // max(n_real * n_dof, 1)))  # steps per block
+    buf = np.empty((block, n_real, n_dof))
+    # segments: runs of steps under one linear model (one mean state), cut into blocks
+    keys = np.arange(n_steps) if model_at is not None else np.asarray(state_of_step)
+    starts = np.concatenate([[1], 2 + np.flatnonzero(keys[2:] != keys[1:-1])]) if n_steps > 1 else np.zeros(0, int)
+    ends = np.append(starts[1:], n_steps)
     report = max(1, n_steps // 100)
-    a0, a1, a2 = nm.a0, nm.a1, nm.a2
-    half_dt = 0.5 * dt
-    for n in range(1, n_steps):
-        key = int(state_of_step[n]) if model_at is None else n
-        if key != current:
+    st: _Stepper | None = None
+    V = A = None
+    for s0, s1 in zip(starts, ends):
+        new = _Stepper.build(*model_of(int(s0)), nm)
+        if st is None:
+            U = st_rotate(U, None, new)
+            V = np.zeros_like(U)
+            A = np.zeros_like(U)  # M a0 = F0 - K u0 - C v0 = 0
+        else:
             # A rigid insulator: the attachment node has no velocity or acceleration along
             # the insulator axis (its axial displacement is the static one).  M and C have no
-            # axial part, so the (-1)^n Newmark residue of that algebraic direction is
+            # axial part, so the (-1)^n Newmark residue of that algebraic coordinate is
             # harmless while the axis stays put; it is removed when the mean state (and the
             # axis) changes, before it could leak into the tangential motion.
-            if current is not None:
-                drop_axial(V)
-                drop_axial(A)
-            Kb, cd, Mb, G = mats(n)
-            chat = _factor(Kb, np.zeros(n_dof), f"effective stiffness at step {n}", band_add=a1 * cd + a0 * Mb)
-            mcmul = _pair_multiplier(Mb, cd)
-            drop_axial = _axial_remover(model_of(n)[0])
-            GT = G.T
-            current = key
-        # K_hat u_{n+1} = F_{n+1} + M (a0 u + a2 v + a) + C (a1 u + v)   (Bathe Table 9.3)
-        rhs = mcmul(a0 * U + a2 * V + A, a1 * U + V)
-        rhs[:, ydof] += loads[n]
-        U_new = _solve(chat, rhs.T).T
-        A_new = a0 * (U_new - U) - a2 * V - A
-        V += half_dt * (A + A_new)
-        U, A = U_new, A_new
-        R_F[n] = _rowdot(U, GT)
-        if progress is not None and n % report == 0:
-            progress(n, n_steps)
+            V[:, st.axial] = 0.0
+            A[:, st.axial] = 0.0
+            U, V, A = (st_rotate(X, st, new) for X in (U, V, A))
+        st = new
+        cu, cv, dm = (x.reshape(1, -1) for x in (st.cu, st.cv, st.dm))  # (1, n): no broadcast set-up per op
+        r2, chat, rest, a1 = st.r2, st.chat, st.rest, st.a1
+        for b0 in range(int(s0), int(s1), block):
+            b1 = min(b0 + block, int(s1))
+            Fb = (loads[b0:b1][..., None] * st.ycoef).reshape(b1 - b0, n_real, n_dof)
+            for k in range(b1 - b0):
+                # K_hat u_{n+1} = F_{n+1} + M (a0 u + a2 v + a) + C (a1 u + v)   (Bathe Table 9.3)
+                rhs = cu * U
+                rhs += cv * V
+                rhs += dm * A
+                rhs += Fb[k]
+                if rest is not None:
+                    rhs += (rest @ (a1 * U + V).T).T
+                U_new, info = _dpbtrs(chat, rhs.T, lower=0, overwrite_b=1)
+                if info != 0:  # pragma: no cover - only for malformed input
+                    raise NumericalError(f"banded solve failed (LAPACK dpbtrs info {info})")
+                U_new = U_new.T
+                # trapezoidal relations of average acceleration: v' = 2/dt (u' - u) - v,
+                # a' = 2/dt (v' - v) - a  (= a0 (u' - u) - a2 v - a, Bathe Table 9.3)
+                V_new = U_new - U
+                V_new *= r2
+                V_new -= V
+                dA = V_new - V
+                dA *= r2
+                dA -= A
+                U, V, A = U_new, V_new, dA
+                buf[k] = U
+            R_F[b0:b1] = st.reactions(buf[: b1 - b0])
+            if progress is not None and b1 // report != b0 // report:
+                progress(b1, n_steps)
             if cancel is not None and cancel.is_set():
                 raise Cancelled("step 2 cancelled")
     if not (np.all(np.isfinite(R_F)) and np.all(np.isfinite(R_B))):
@@ -224,20 +242,6 @@ def integrate(
     )
 
 
-def _axial_remover(model: LinearModel) -> Callable[[np.ndarray], None]:
-    """In-place removal of the insulator-axial components of transposed vectors (n_real, n_dof)."""
-    if model.axial_dof.size == 0:
-        return lambda x: None
-    idx = model.axial_dof[:, None] + np.arange(3)[None, :]  # (n_s, 3)
-    a = model.axes  # (n_s, 3)
-
-    def drop(x: np.ndarray) -> None:
-        xs = x[:, idx]  # (n_real, n_s, 3)
-        x[:, idx] = xs - np.einsum("rsd,sd->rs", xs, a)[..., None] * a[None]
-
-    return drop
-
-
 def _rowdot(X: np.ndarray, BT: np.ndarray) -> np.ndarray:
     """X @ BT computed row by row in a fixed order (no BLAS): every realization's reactions
     are then bit-identical whichever other realizations share the call (batch chunking,
@@ -245,15 +249,94 @@ def _rowdot(X: np.ndarray, BT: np.ndarray) -> np.ndarray:
     return np.einsum("rd,dk->rk", X, BT, optimize=False)
 
 
-def _pair_multiplier(m_band: np.ndarray, c_band: np.ndarray) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
-    """(x, y) -> x M + y C for transposed vectors: elementwise when both are diagonal, else
-    one sparse product with [M C] (one call per step instead of two)."""
-    if not np.any(m_band[:-1]) and not np.any(c_band[:-1]):
-        dm, dc = m_band[-1][None, :], c_band[-1][None, :]
-        return lambda x, y: dm * x + dc * y
-    from scipy.sparse import hstack
+def node_bases(model: LinearModel, c_band: np.ndarray) -> np.ndarray:
+    """Per-node orthonormal bases in which M and the node blocks of C are diagonal.
 
-    from .model import band_to_sparse
+    A free node's mass is isotropic (m I), so the eigenvectors of its 3x3 damping block
+    diagonalise both.  At a suspension attachment node the mass and damping are projected
+    normal to the insulator axis a (rigid insulator): the basis is (t1, t2, a) with t1, t2
+    the eigenvectors of the in-plane 2x2 damping block.
 
-    MC = hstack([band_to_sparse(m_band), band_to_sparse(c_band)]).tocsr()  # (n, 2n)
-    return lambda x, y: (MC @ np.hstack([x, y]).T).T
+    Returns: [-] bases as columns (local axes in global coordinates), shape (n_nodes, 3, 3).
+    """
+    D, _ = band_blocks(c_band)
+    _, T = np.linalg.eigh(D)
+    if model.axial_dof.size:
+        k = model.axial_dof // 3
+        a = model.axes / np.linalg.norm(model.axes, axis=1)[:, None]
+        h = np.where(np.abs(a[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+        t1 = np.cross(a, h)
+        t1 /= np.linalg.norm(t1, axis=1)[:, None]
+        t2 = np.cross(a, t1)
+        Q = np.stack([t1, t2], axis=2)  # (n_s, 3, 2) orthonormal basis of the plane
+        _, W = np.linalg.eigh(np.einsum("sai,sab,sbj->sij", Q, D[k], Q))
+        T[k] = np.concatenate([np.einsum("sai,sij->saj", Q, W), a[:, :, None]], axis=2)
+    return T
+
+
+@dataclass(frozen=True)
+class _Stepper:
+    """One mean state's Newmark operator in the node bases of :func:`node_bases`.
+
+    u = T u~ node by node (T orthonormal), so K~ = T^T K T keeps the band, M~ is diagonal
+    (dm) and C~ is diagonal (dc) plus, with structural damping, an inter-node remainder
+    (``rest``, sparse).  The per-step products M~ x and C~ y are then elementwise.
+    Attributes are SI; vectors are (n_real, n_dof) in the rotated coordinates.
+    """
+
+    T: np.ndarray  # (n_nodes, 3, 3)
+    chat: np.ndarray  # Cholesky factor of K~ + a1 C~ + a0 M~ (band)
+    dm: np.ndarray  # [kg] diagonal of M~, (n_dof,)
+    cu: np.ndarray  # a0 dm + a1 dc
+    cv: np.ndarray  # a2 dm + dc
+    rest: object  # off-diagonal part of C~ (scipy CSR) or None
+    a1: float
+    r2: float  # 2/dt
+    ycoef: np.ndarray  # local components of a unit global y-load, (n_nodes, 3)
+    axial: np.ndarray  # rotated coordinates along the insulator axes, (n_susp,)
+    nz: np.ndarray  # coordinates that enter the reactions, (n_nz,)
+    GT: np.ndarray  # [N/m] (G T)^T rows nz, (n_nz, n_r)
+
+    @staticmethod
+    def build(model: LinearModel, c_band: np.ndarray, nm: Newmark) -> "_Stepper":
+        T = node_bases(model, c_band)
+        Kr = rotate_band(model.K_band, T)
+        Cr = rotate_band(c_band, T)
+        axial = model.axial_dof + 2  # (t1, t2, a): the axis is the third local coordinate
+        dm = model.mass.copy()
+        dm[axial] = 0.0  # rigid insulator: no inertia along its axis (model.M_band)
+        dc = Cr[-1].copy()
+        dc[axial] = 0.0  # nor damping (project_axial)
+        off = Cr.copy()
+        off[-1] = 0.0
+        scale = float(np.abs(dc).max()) if dc.size else 0.0
+        if np.abs(off).max() <= 1e-12 * scale:  # only rounding of the rotation
+            off[:] = 0.0
+            rest = None
+        else:
+            rest = band_to_sparse(off)
+        used = off.copy()
+        used[-1] = dc
+        chat = _factor(Kr, nm.a0 * dm, "effective stiffness", band_add=nm.a1 * used)
+        Gr = np.einsum("rna,naj->rnj", model.G.reshape(model.G.shape[0], -1, 3), T).reshape(model.G.shape)
+        nz = np.flatnonzero(np.any(Gr != 0.0, axis=0))
+        return _Stepper(T, chat, dm, nm.a0 * dm + nm.a1 * dc, nm.a2 * dm + dc, rest, nm.a1, 2.0 / nm.dt,
+                        np.ascontiguousarray(T[:, 1, :]), axial, nz, np.ascontiguousarray(Gr.T[nz]))
+
+    def reactions(self, U: np.ndarray) -> np.ndarray:
+        """[N] G u for rotated vectors U (..., n_dof) -> (..., n_r), accumulated coordinate
+        by coordinate in a fixed order: elementwise only, so every realization's reactions
+        are bit-identical whatever else shares the array (no BLAS blocking)."""
+        out = np.zeros(U.shape[:-1] + (self.GT.shape[1],))
+        for d, g in zip(self.nz, self.GT):
+            out += U[..., d, None] * g
+        return out
+
+
+def st_rotate(X: np.ndarray, old: _Stepper | None, new: _Stepper) -> np.ndarray:
+    """Vectors (n_real, n_dof) from ``old``'s node bases (global if None) to ``new``'s."""
+    shape = X.shape
+    Xn = X.reshape(shape[0], -1, 3)
+    if old is not None:
+        Xn = np.einsum("rnj,naj->rna", Xn, old.T)  # u = T u~
+    return np.ascontiguousarray(np.einsum("rna,naj->rnj", Xn, new.T).reshape(shape))  # u~ = T^T u

@@ -329,3 +329,50 @@ def reaction_matrix_direct(system: LineSystem) -> np.ndarray:
     for j in np.flatnonzero(~system.suspension):
         D[3 * j + 1, system.tower_nodes[j]] = 1.0
     return D
+
+
+def band_blocks(ab: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Node blocks of a symmetric node-major matrix in upper band storage (half-bandwidth 5).
+
+    With three DOFs per node and two-node elements the band is exactly block tridiagonal.
+
+    Returns:
+        D: diagonal blocks A[node i, node i], shape (n_nodes, 3, 3);
+        E: coupling blocks A[node i, node i+1], shape (n_nodes - 1, 3, 3).
+    """
+    u = ab.shape[0] - 1
+    n_nodes = ab.shape[1] // 3
+    a = np.arange(3)[:, None]
+    b = np.arange(3)[None, :]
+    first = 3 * np.arange(n_nodes)[:, None, None]
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    D = ab[u + lo - hi, first + hi]  # A[3i+lo, 3i+hi] (upper triangle, symmetric)
+    E = ab[u - 3 + a - b, first[:-1] + 3 + b]  # A[3i+a, 3i+3+b]
+    return D, E
+
+
+def blocks_to_band(D: np.ndarray, E: np.ndarray, u: int = BANDWIDTH) -> np.ndarray:
+    """Inverse of :func:`band_blocks` (upper band storage, shape (u + 1, 3 n_nodes))."""
+    n_nodes = D.shape[0]
+    ab = np.zeros((u + 1, 3 * n_nodes))
+    first = 3 * np.arange(n_nodes)
+    for a in range(3):
+        for b in range(3):
+            if b >= a:
+                ab[u + a - b, first + b] = D[:, a, b]
+            ab[u - 3 + a - b, first[:-1] + 3 + b] = E[:, a, b]
+    return ab
+
+
+def rotate_band(ab: np.ndarray, T: np.ndarray) -> np.ndarray:
+    """T^T A T for a node-major symmetric band matrix and a block-diagonal rotation.
+
+    Args:
+        ab: upper band storage, shape (BANDWIDTH + 1, 3 n_nodes).
+        T: [-] per-node orthonormal bases (columns: local axes in global coordinates),
+            shape (n_nodes, 3, 3).
+    """
+    D, E = band_blocks(ab)
+    Dr = np.einsum("nai,nab,nbj->nij", T, D, T, optimize=False)
+    Er = np.einsum("nai,nab,nbj->nij", T[:-1], E, T[1:], optimize=False)
+    return blocks_to_band(0.5 * (Dr + Dr.transpose(0, 2, 1)), Er, ab.shape[0] - 1)

@@ -193,7 +193,8 @@ class SynopticModel:
 
 def synoptic_model(case: Case, st: StaticResult, *, vectors: bool = True) -> SynopticModel:
     """Model, damping, load per unit turbulence (Eq. 5) and complex modes of the synoptic state
-    (with eigenvectors when ``vectors``: the burn-in needs them, the frequency grid does not)."""
+    (with eigenvectors when ``vectors``: the burn-in and the modal superposition of the
+    frequency-domain check need them)."""
     from .core.spectral import complex_modes
 
     system = st.system
@@ -214,7 +215,8 @@ def burn_in(case: Case, sm: SynopticModel) -> BurnIn:
 
     duration = case.analysis.duration if case.analysis.duration is not None else 600.0
     f_top = 0.5 / case.analysis.time_step
-    if sm.modes.right is not None:
+    # the paper's damping gets no burn-in, and its verdict counts every mode in the band
+    if sm.modes.right is not None and case.analysis.damping != "paper":
         mc = modal_contributions(
             sm.model, sm.modes, sm.load_per_v, case.line.tower_of_interest - 1,
             sigma=case.wind.turbulence_intensity * case.wind.v_ref, length_scale=length_scale(case),
@@ -222,7 +224,7 @@ def burn_in(case: Case, sm: SynopticModel) -> BurnIn:
         )
         freq, zeta, rate_all = mc.frequencies_hz, mc.damping_ratio, mc.decay_rate
         sig = np.flatnonzero(mc.significant(SIGNIFICANT_FRACTION))
-    else:  # no eigenvectors (paper damping): every mode in the band counts (conservative)
+    else:  # paper damping (or no eigenvectors): every mode in the band counts (conservative)
         cm = sm.modes
         freq, zeta, rate_all = cm.frequencies_hz, cm.damping_ratio, -cm.poles.real
         sig = np.flatnonzero(freq <= f_top)
@@ -323,10 +325,9 @@ def run_case(
     models = [build_model(system, mean.state(k)) for k in range(mean.time.size)]
     vn_states = to_global_nodes(system, st.wind.normal)  # (n_k, n_nodes)
     damping = damping_matrices(case, st, models)
-    # eigenvectors only where the burn-in must tell significant modes apart (issue 10): the
-    # paper's damping gets no burn-in, and its verdict needs only the least-damped mode
-    needs_vectors = case.analysis.damping != "paper" and case.analysis.burn_in is None
-    sm = synoptic_model(case, st, vectors=needs_vectors) if wind.type == "synoptic" else None
+    # complex modes with eigenvectors: the burn-in tells significant modes apart with them
+    # (issue 10) and the frequency-domain check sums them (modal superposition)
+    sm = synoptic_model(case, st) if wind.type == "synoptic" else None
     burn = burn_in(case, sm) if sm is not None else BurnIn(
         0.0, 0.0, float("nan"), float("nan"), True, "none: a downburst starts from a weak running mean")
     if burn.seconds > 0:
@@ -481,7 +482,7 @@ def spectral_analysis(case: Case, *, static: StaticResult | None = None,
                         file=str(case.source) if case.source else None, key="wind.type")
     st = static if static is not None else static_analysis(case)
     mean = st.mean
-    sm = synoptic if synoptic is not None else synoptic_model(case, st, vectors=False)  # same model as the time domain
+    sm = synoptic if synoptic is not None else synoptic_model(case, st)  # same model as the time domain
     line, wind = case.line, case.wind
     t = record_time(case)
     j = case.line.tower_of_interest - 1

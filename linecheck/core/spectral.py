@@ -39,7 +39,7 @@ import numpy as np
 from scipy.linalg import eig, lapack, solve_banded
 
 from .errors import NumericalError
-from .model import BANDWIDTH, LinearModel, condensed, reaction_matrix_direct
+from .model import BANDWIDTH, LinearModel, band_blocks, blocks_to_band, condensed, reaction_matrix_direct
 from .wind.turbulence import von_karman_cumulative, von_karman_psd
 
 EULER_GAMMA = 0.5772156649
@@ -71,6 +71,8 @@ class ComplexModes:
             condensed coordinates t of :func:`~linecheck.core.model.condensed` (u = S t).
         S: [-] condensed-to-full DOF map (n_dof, n_t), or None.
         mass: [kg] condensed (diagonal) mass, (n_t,), or None.
+        expansion: every eigenpair of the state matrix, unfiltered (for the modal
+            superposition of :func:`modal_transfer`), or None.
     """
 
     frequencies_hz: np.ndarray
@@ -80,6 +82,25 @@ class ComplexModes:
     left: np.ndarray | None = None
     S: np.ndarray | None = None
     mass: np.ndarray | None = None
+    expansion: "StateEigen | None" = None
+
+
+@dataclass(frozen=True)
+class StateEigen:
+    """All 2 n_t eigenpairs of the state matrix A (complex modes with Im(lambda) >= 0 and,
+    implicitly, their conjugates).
+
+    Attributes:
+        poles: eigenvalues lambda with Im(lambda) >= 0, (n_e,).
+        right, left: psi_k, chi_k as columns (A psi = lambda psi, chi^H A = lambda chi^H),
+            (2 n_t, n_e).
+        condition: [-] eigenvalue condition numbers ||psi|| ||chi|| / |chi^H psi|, (n_e,).
+    """
+
+    poles: np.ndarray
+    right: np.ndarray
+    left: np.ndarray
+    condition: np.ndarray
 
 
 def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None = None,
@@ -110,6 +131,12 @@ def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None 
         vl = np.conj(np.vstack([w_top, cd.M @ phi]))
     else:
         lam, vl, vr = eig(A, right=False), None, None
+    expansion = None
+    if vectors:
+        upper = lam.imag >= 0.0  # LAPACK returns exact conjugate pairs for a real matrix
+        nrm = np.einsum("ik,ik->k", vl[:, upper].conj(), vr[:, upper])
+        cond = np.linalg.norm(vr[:, upper], axis=0) * np.linalg.norm(vl[:, upper], axis=0) / np.abs(nrm)
+        expansion = StateEigen(lam[upper], vr[:, upper], vl[:, upper], cond)
     keep = lam.imag > 1e-12
     if max_hz is not None:
         keep &= np.abs(lam) / (2 * np.pi) <= max_hz
@@ -119,7 +146,7 @@ def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None 
     w = np.abs(lam)
     return ComplexModes(w / (2 * np.pi), -lam.real / w, lam,
                         None if vr is None else vr[:, idx], None if vl is None else vl[:, idx],
-                        cd.S if vectors else None, np.diag(cd.M).copy() if vectors else None)
+                        cd.S if vectors else None, np.diag(cd.M).copy() if vectors else None, expansion)
 
 
 LARGE_SYSTEM_DOF = 600  # above this the dense state-space eigenproblem (O((2n)^3)) is too slow
@@ -200,6 +227,205 @@ def _quad_kms(w: np.ndarray, rho: np.ndarray) -> np.ndarray:
     return total + 2.0 * cross
 
 
+MODAL_CONDITION_LIMIT = 1e8  # eigenvalue condition number above which the modal sum is not trusted
+MODAL_CHECK_RTOL = 1e-7  # modal vs direct transfer at the check frequencies
+
+
+class ModalTransfer:
+    """Reaction transfer functions by complex modal superposition (exact with all modes).
+
+    With the state form of :func:`modal_contributions`, the reactions at one tower per unit
+    y-load at free node i are
+
+        T(w) = sum_k A_k / (i w - lambda_k),   A_k = (G S psi_k^u)(chi_k^v,H M*^-1 S^T e_y,i) / (chi_k^H psi_k),
+
+    summed over all 2 n_t eigenvalues (Meirovitch 1980, section 9.3; Tisseur & Meerbergen
+    2001).  A real system's eigenpairs come in conjugate pairs, so each pair contributes
+
+        (i w 2 Re A_k - 2 Re(A_k conj(lambda_k))) / (|lambda_k|^2 - w^2 - 2 i w Re lambda_k),
+
+    and the whole sum is two real matrix products per block of frequencies -- far cheaper
+    than solving the dynamic stiffness at every frequency of the pole-refined grid.
+
+    The state form lives in the condensed coordinates (u = S t), which miss the static
+    response of the insulator-axial directions to their own load: a load along a rigid
+    insulator goes straight into the tower.  That feed-through is frequency independent,
+    so it is the difference between the exact static transfer G K^-1 P and the modal sum
+    at w = 0, added at every frequency.
+    """
+
+    def __init__(self, model: LinearModel, modes: ComplexModes, tower: int, static: np.ndarray):
+        """``static``: [-] exact quasi-static transfer G K^-1 P at the free nodes, (3, n_free_nodes)."""
+        ex, S = modes.expansion, modes.S
+        n_t = S.shape[1]
+        free = model.dofs.free_nodes
+        ydof = model.dofs.node_dof[free] + 1
+        G = model.G[3 * tower:3 * tower + 3]
+        r = G @ (S @ ex.right[:n_t])  # (3, n_e)
+        c = ex.left[n_t:].conj().T @ (S[ydof].T / modes.mass[:, None])  # (n_e, n_free)
+        norm = np.einsum("ik,ik->k", ex.left.conj(), ex.right)
+        A = r.T[:, :, None] * (c / norm[:, None])[:, None, :]  # (n_e, 3, n_free)
+        lam = ex.poles
+        pair = lam.imag > 0.0
+        self.lam_pair, self.lam_real = lam[pair], lam[~pair].real
+        Ap = A[pair]
+        self.P = (2.0 * Ap.real).reshape(Ap.shape[0], -1)  # (n_p, 3 n_free)
+        self.Q = (2.0 * (Ap * lam[pair].conj()[:, None, None]).real).reshape(Ap.shape[0], -1)
+        self.R = A[~pair].real.reshape(-1, self.P.shape[1])  # real poles: A_k real
+        self.PQT = np.ascontiguousarray(np.concatenate([self.P, self.Q], axis=1).T)  # (2 m, n_p)
+        self.shape = (3, free.size)
+        self.feedthrough = np.zeros(self.shape)
+        self.feedthrough = static - self(np.zeros(1))[..., 0].real
+
+    def __call__(self, omega: np.ndarray) -> np.ndarray:
+        """Transfer functions at [rad/s] ``omega`` (n_f,), shape (3, n_free_nodes, n_f)."""
+        w = omega[None, :]
+        lam = self.lam_pair[:, None]
+        a = np.abs(lam) ** 2 - w**2  # D = a + i c = |lambda|^2 - w^2 - 2 i w Re(lambda)
+        c = -2.0 * w * lam.real
+        den = a * a + c * c
+        Yr = self.PQT @ (a / den)  # (2 m, n_f): rows P then Q; 1/D = (a - i c)/den
+        Yi = self.PQT @ (-c / den)
+        m = self.P.shape[1]
+        out = np.empty((m, omega.size), dtype=complex)
+        # T = i w (U P) - U Q
+        out.real = -w * Yi[:m] - Yr[m:] + self.feedthrough.reshape(-1, 1)
+        out.imag = w * Yr[:m] - Yi[m:]
+        if self.R.size:
+            out += self.R.T @ (1.0 / (1j * w - self.lam_real[:, None]))
+        return out.reshape(self.shape + (omega.size,))
+
+def _inv3(A: np.ndarray) -> np.ndarray:
+    """Inverses of 3x3 matrices by the adjugate (Cramer), frequency last: shape (3, 3, n)."""
+    a = A
+    out = np.empty_like(A)
+    out[0, 0] = a[1, 1] * a[2, 2] - a[1, 2] * a[2, 1]
+    out[1, 0] = a[1, 2] * a[2, 0] - a[1, 0] * a[2, 2]
+    out[2, 0] = a[1, 0] * a[2, 1] - a[1, 1] * a[2, 0]
+    out[0, 1] = a[0, 2] * a[2, 1] - a[0, 1] * a[2, 2]
+    out[1, 1] = a[0, 0] * a[2, 2] - a[0, 2] * a[2, 0]
+    out[2, 1] = a[0, 1] * a[2, 0] - a[0, 0] * a[2, 1]
+    out[0, 2] = a[0, 1] * a[1, 2] - a[0, 2] * a[1, 1]
+    out[1, 2] = a[0, 2] * a[1, 0] - a[0, 0] * a[1, 2]
+    out[2, 2] = a[0, 0] * a[1, 1] - a[0, 1] * a[1, 0]
+    det = a[0, 0] * out[0, 0] + a[0, 1] * out[1, 0] + a[0, 2] * out[2, 0]
+    out /= det
+    return out
+
+
+def _mm(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """Products of small matrices stored frequency last: (p, q, n) @ (q, r, n) -> (p, r, n)."""
+    out = A[:, 0, None, :] * B[None, 0, :, :]
+    for j in range(1, A.shape[1]):
+        out += A[:, j, None, :] * B[None, j, :, :]
+    return out
+
+
+BACKWARD_ERROR_TOL = 1e-11  # normwise backward error above which a frequency is re-solved with pivoting
+
+
+def dynamic_solve(blocks, omega: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """x = (K - w^2 M + i w C)^-1 b at many circular frequencies at once.
+
+    The dynamic stiffness is complex symmetric and block tridiagonal (3x3 node blocks), so
+    block Gaussian elimination (the block Thomas algorithm; Golub & Van Loan 2013, section
+    4.5.1) runs node by node, vectorised over the frequencies.  It does not pivot between
+    nodes, so every solution is checked by its normwise backward error
+    ||Z x - b|| / (||Z|| ||x|| + ||b||) (infinity norms; Higham 2002, Thm 7.1); a frequency
+    above :data:`BACKWARD_ERROR_TOL` is solved again by LAPACK zgbsv (partial pivoting).
+
+    Args:
+        blocks: ``band_blocks`` (D, E) of K [N/m], C [N s/m] and M [kg], in that order.
+        omega: [rad/s] circular frequencies, shape (n_f,).
+        rhs: right-hand sides by node, shape (n_nodes, 3, n_rhs).
+
+    Returns:
+        x, shape (n_nodes, 3, n_rhs, n_f) (frequency last).
+    """
+    (DK, EK), (DC, EC), (DM, EM) = blocks
+    iw, w2 = 1j * omega, omega**2
+    n_nodes = DK.shape[0]
+    nf = omega.size
+    n_rhs = rhs.shape[-1]
+    # blocks of Z = K - w^2 M + i w C, frequency last: D_i (3, 3, n_f), E_i = Z[node i, node i+1]
+    Dz = DK[..., None] + DC[..., None] * iw - DM[..., None] * w2  # (n_nodes, 3, 3, n_f)
+    Ez = EK[..., None] + EC[..., None] * iw - EM[..., None] * w2  # (n_nodes - 1, 3, 3, n_f)
+    Et = Ez.transpose(0, 2, 1, 3)
+    b = rhs.astype(complex)[..., None]  # (n_nodes, 3, n_rhs, 1)
+    Wz = np.empty((n_nodes, 3, 3 + n_rhs, nf), dtype=complex)  # [S_i^-1 E_i | S_i^-1 y_i]
+    S, y = Dz[0], np.broadcast_to(b[0], (3, n_rhs, nf))
+    for i in range(n_nodes):
+        Si = _inv3(S)
+        if i + 1 < n_nodes:
+            Wz[i] = _mm(Si, np.concatenate([Ez[i], y], axis=1))
+            P = _mm(Et[i], Wz[i])
+            S = Dz[i + 1] - P[:, :3]
+            y = b[i + 1] - P[:, 3:]
+        else:
+            Wz[i, :, 3:] = _mm(Si, y)
+    x = np.empty((n_nodes, 3, n_rhs, nf), dtype=complex)
+    x[-1] = Wz[-1, :, 3:]
+    for i in range(n_nodes - 2, -1, -1):
+        x[i] = Wz[i, :, 3:] - _mm(Wz[i, :, :3], x[i + 1])
+    # normwise backward error of one combination of the right-hand sides (cheaper than all)
+    c = np.linspace(1.0, 2.0, n_rhs)
+    xc = np.einsum("nark,r->nak", x, c)[:, :, None, :]  # (n_nodes, 3, 1, n_f)
+    r = np.einsum("narj,r->naj", b, c)[:, :, None, :] - _mm4(Dz, xc)
+    r[:-1] -= _mm4(Ez, xc[1:])
+    r[1:] -= _mm4(Et, xc[:-1])
+    row = np.abs(Dz).sum(axis=2)  # (n_nodes, 3, n_f) row sums of |Z|
+    row[:-1] += np.abs(Ez).sum(axis=2)
+    row[1:] += np.abs(Et).sum(axis=2)
+    eta = np.abs(r).max(axis=(0, 1, 2)) / (row.max(axis=(0, 1)) * np.abs(xc).max(axis=(0, 1, 2))
+                                            + np.abs(rhs @ c).max())
+    bad = np.flatnonzero(~(eta <= BACKWARD_ERROR_TOL))
+    if bad.size:
+        x[..., bad] = _banded_solve(blocks, omega[bad], rhs).transpose(1, 2, 3, 0)
+    return x
+
+
+def _mm4(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """:func:`_mm` over a leading node axis: (n, p, q, f) @ (n, q, r, f) -> (n, p, r, f)."""
+    out = A[:, :, 0, None, :] * B[:, None, 0, :, :]
+    for j in range(1, A.shape[2]):
+        out += A[:, :, j, None, :] * B[:, None, j, :, :]
+    return out
+
+
+def _banded_solve(blocks, omega: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """LAPACK zgbsv (partial pivoting) at each frequency: the fallback of :func:`dynamic_solve`."""
+    (DK, EK), (DC, EC), (DM, EM) = blocks
+    kl = BANDWIDTH
+    n_dof = 3 * DK.shape[0]
+    parts = []
+    for D, E in ((DK, EK), (DC, EC), (DM, EM)):
+        g = np.zeros((2 * kl + 1 + kl, n_dof), dtype=complex)
+        g[kl:] = _general_band(blocks_to_band(D, E))
+        parts.append(g)
+    base, cbase, mbase = parts
+    b = np.asfortranarray(rhs.reshape(n_dof, -1).astype(complex))
+    out = np.empty((omega.size,) + rhs.shape, dtype=complex)
+    for k, w in enumerate(omega):
+        _, _, x, info = lapack.zgbsv(kl, kl, base + (1j * w) * cbase - w**2 * mbase, b)
+        if info != 0:
+            raise NumericalError(f"dynamic stiffness singular at {w / (2 * np.pi):.6g} Hz (LAPACK zgbsv info {info})")
+        out[k] = x.reshape(rhs.shape)
+    return out
+
+
+def _quad_kms_nodes(w: np.ndarray, rho: np.ndarray) -> np.ndarray:
+    """:func:`_quad_kms` with the node axis second to last and frequency last:
+    w (..., N, n_f) complex, rho (n_f,) -> (..., n_f) real."""
+    h = np.zeros(w.shape[:-2] + w.shape[-1:], dtype=complex)
+    total = np.sum(w.real**2 + w.imag**2, axis=-2)
+    cross = np.zeros(total.shape)
+    for j in range(1, w.shape[-2]):
+        h += w[..., j - 1, :]
+        h *= rho  # h_j = sum_{i<j} rho^(j-i) w_i
+        cross += w[..., j, :].real * h.real + w[..., j, :].imag * h.imag
+    return total + 2.0 * cross
+
+
 @dataclass(frozen=True)
 class SpectralEstimate:
     """Frequency-domain statistics of the reactions at the tower of interest.
@@ -222,6 +448,7 @@ class SpectralEstimate:
     duration: float
     band: tuple[float, float]
     n_frequencies: int
+    method: str = "direct"  # "modal" (complex modal superposition) or "direct" (solves)
 
 
 def random_vibration(
@@ -273,18 +500,7 @@ def random_vibration(
     if modes is None:
         modes = complex_modes(model, damping, max_hz=band[1] * 1.5)
     f = frequency_grid(band[0], band[1], modes)
-    # LAPACK zgbsv storage: kl extra rows on top of the general band (rows kl .. 2kl+ku)
-    kl = BANDWIDTH
-    base = np.zeros((kl + K_gen.shape[0], n_dof), dtype=complex)
-    base[kl:] = K_gen
-    cbase = np.zeros_like(base)
-    cbase[kl:] = _general_band(damping)
-    mbase = np.zeros_like(base)
-    mbase[kl:] = _general_band(model.M_band)
-    rhs0 = np.asfortranarray(Gt.T.astype(complex))
-    zgbsv = lapack.zgbsv
     dx = system.line.span_length / system.ne
-    a = load_per_v[None, None, :]
     # the synthesis scales the spectrum to unit variance below its top frequency
     # (linecheck.core.wind.turbulence.spectral_grid); do the same here
     Sv = von_karman(f, sigma, length_scale, v_mean) / float(von_karman_cumulative(band[1], length_scale, v_mean))
@@ -292,24 +508,31 @@ def random_vibration(
     SB = np.empty((f.size, 3))
     SF = np.empty((f.size, 3))
     SR = np.empty((f.size, 3))
-    tBa = tB[None] * a
-    chunk = 256  # frequencies per block: bounded memory for long lines
+    aT = load_per_v[None, :, None]
+    tBaT = (tB * load_per_v[None, :])[..., None]
+    blocks = [band_blocks(m) for m in (model.K_band, damping, model.M_band)]
+    rhs = Gt.T.reshape(-1, 3, 3)  # (n_free_nodes, 3 dofs, 3 reactions): K symmetric, solve with G^T
+
+    def direct(omega: np.ndarray) -> np.ndarray:  # (3, n_free, n_f)
+        return dynamic_solve(blocks, omega, rhs)[:, 1].transpose(1, 0, 2)  # y DOF of every free node
+
+    transfer, method = direct, "direct"
+    if modes.expansion is not None and modes.expansion.condition.max() < MODAL_CONDITION_LIMIT:
+        modal = ModalTransfer(model, modes, tower, xB[ydof].T)
+        check = 2 * np.pi * f[:: max(1, f.size // 40)]
+        ref = direct(check)
+        if np.abs(modal(check) - ref).max() <= MODAL_CHECK_RTOL * np.abs(ref).max():
+            transfer, method = modal, "modal"
+    chunk = max(64, 60_000 // max(system.n_nodes, 1))  # frequencies per block: memory, cache
     for c0 in range(0, f.size, chunk):
         fc = f[c0:c0 + chunk]
-        tF = np.empty((fc.size, 3, system.n_nodes), dtype=complex)
-        tF[:] = Dt[None]
-        for k, fk in enumerate(fc):
-            w = 2 * np.pi * fk
-            ab = base + (1j * w) * cbase - w**2 * mbase  # K - w^2 M + i w C
-            _, _, x, info = zgbsv(kl, kl, ab, rhs0, overwrite_ab=1)
-            if info != 0:
-                raise NumericalError(f"dynamic stiffness singular at {fk:.6g} Hz (LAPACK zgbsv info {info})")
-            tF[k][:, free] += x[ydof].T
+        tF = np.empty((3, system.n_nodes, fc.size), dtype=complex)  # reaction, node, frequency
+        tF[:] = Dt[..., None]
+        tF[:, free] += transfer(2 * np.pi * fc)
         sl = slice(c0, c0 + fc.size)
-        tFa = tF * a
-        SB[sl] = Sv[sl, None] * _quad_kms(np.broadcast_to(tBa, tF.shape), rho[sl])
-        SF[sl] = Sv[sl, None] * _quad_kms(tFa, rho[sl])
-        SR[sl] = Sv[sl, None] * _quad_kms(tFa - tBa, rho[sl])
+        tFa = tF * aT
+        q = _quad_kms_nodes(np.concatenate([np.broadcast_to(tBaT, tF.shape), tFa, tFa - tBaT]), rho[sl])
+        SB[sl], SF[sl], SR[sl] = (Sv[sl, None] * q[3 * i:3 * i + 3].T for i in range(3))
 
     def integ(y: np.ndarray) -> np.ndarray:
         return np.trapezoid(y, f, axis=0)
@@ -330,6 +553,7 @@ def random_vibration(
         mean=np.asarray(mean_reaction, dtype=float), rms_background=sB, rms_resonant=sR, rms_fluctuating=sF,
         nu_background=nuB, nu_fluctuating=nuF, peak_quasi_static=pk_qs, peak_dynamic=pk_dy,
         GF_Dy=gf_dy, GF_QS=gf_qs, Cont_R=cont_r, duration=duration, band=band, n_frequencies=int(f.size),
+        method=method,
     )
 
 

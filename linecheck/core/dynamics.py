@@ -6,11 +6,13 @@ and C(t) taken from the step-1 mean state in force at each time step.  Step 3
 (paper Eq. 14): K(t) u = F_w(t) gives the background B; the resonant part is
 R = F - B.
 
-Structure exploited (issue 4): K, C and M are banded (half-bandwidth 5; M is diagonal
-but for the 3x3 blocks of the insulator attachment nodes, projected normal to the
-insulator axis); K_hat = K + 2/dt C + 4/dt^2 M is factorised once per mean state
-(banded Cholesky, LAPACK dpbtrf), never per step; all realizations are columns of
-one right-hand side.  For downbursts K(t), C(t) are piecewise constant between
+Structure exploited (issue 4): K, C and M are banded (half-bandwidth 5, 3x3 node
+blocks); the recurrence is stepped in per-node bases in which M and the aerodynamic C
+are diagonal (:func:`node_bases`), so that the per-step products are elementwise;
+K_hat = K + 2/dt C + 4/dt^2 M is factorised once per mean state (banded Cholesky,
+LAPACK dpbtrf), never per step; all realizations are columns of one right-hand side;
+step 3 applies the static transfer matrix G K^-1 P.  For downbursts K(t), C(t) are
+piecewise constant between
 the mean-state instants (default), or linearly interpolated at every step
 (``interpolate=True``, one factorisation per step) to show that the difference
 is negligible (docs/validation.md).
@@ -103,8 +105,7 @@ def integrate(
     Args:
         models: linear models of the mean states, length n_k (all with the same DOF map).
         damping: [N s/m] damping matrix of every mean state in upper band storage, shape
-            (n_k, BANDWIDTH + 1, n_dof) (see :mod:`linecheck.core.damping`); when it is
-            diagonal (paper Eq. 9) the product C u' is a vector multiply.
+            (n_k, BANDWIDTH + 1, n_dof) (see :mod:`linecheck.core.damping`).
         state_of_step: index into ``models`` in force at every step, shape (n_steps,).
         loads: [N] fluctuating transverse (y) loads on the free nodes, shape
             (n_steps, n_real, n_free_nodes) (paper Eq. 5).
@@ -115,7 +116,7 @@ def integrate(
             step n itself (reference scheme: the step-1 state interpolated in time and the
             model rebuilt and factorised at every step); default: ``models[state_of_step[n]]``
             held piecewise constant.
-        progress: ``progress(done, total)`` every few hundred steps.
+        progress: ``progress(done, total)`` about every 1 % of the steps (per block).
         cancel: stop early (raises :class:`Cancelled`).
 
     Returns:

@@ -237,41 +237,20 @@ def project_axial(model: LinearModel, ab: np.ndarray) -> np.ndarray:
     """P^T A P for a symmetric upper-band matrix A, P = I - a a^T at every suspension
     attachment node (identity elsewhere): removes the components along the insulator axes.
 
-    Suspension nodes are at least two FE nodes (6 DOFs) apart, beyond the half-bandwidth,
-    so each node's rows/columns can be transformed in a small dense window.
+    The band is block tridiagonal (:func:`band_blocks`): the node's diagonal block becomes
+    P D P and its coupling blocks E P (from the left neighbour) and P E (to the right one).
     """
-    out = ab.copy()
-    n = ab.shape[1]
-    u = ab.shape[0] - 1
-    for first, a in zip(model.axial_dof, model.axes):
-        lo, hi = max(0, first - u), min(n, first + 3 + u)
-        W = band_window(out, lo, hi)
-        P = np.eye(hi - lo)
-        k = first - lo
-        P[k:k + 3, k:k + 3] -= np.outer(a, a)
-        set_band_window(out, lo, hi, P.T @ W @ P)
-    return out
-
-
-def band_window(ab: np.ndarray, lo: int, hi: int) -> np.ndarray:
-    """Dense copy of rows/columns lo..hi-1 of a symmetric upper-band matrix (entries outside
-    the band are zero)."""
-    u = ab.shape[0] - 1
-    m = hi - lo
-    W = np.zeros((m, m))
-    for i in range(m):
-        for j in range(i, min(m, i + u + 1)):
-            W[i, j] = W[j, i] = ab[u + i - j, lo + j]
-    return W
-
-
-def set_band_window(ab: np.ndarray, lo: int, hi: int, W: np.ndarray) -> None:
-    """Write a dense symmetric window back into upper band storage (within the band)."""
-    u = ab.shape[0] - 1
-    m = hi - lo
-    for i in range(m):
-        for j in range(i, min(m, i + u + 1)):
-            ab[u + i - j, lo + j] = W[i, j]
+    if model.axial_dof.size == 0:
+        return ab.copy()
+    D, E = band_blocks(ab)
+    k = model.axial_dof // 3
+    P = np.eye(3)[None] - model.axes[:, :, None] * model.axes[:, None, :]  # (n_s, 3, 3)
+    D[k] = P @ D[k] @ P
+    left = k > 0
+    E[k[left] - 1] = E[k[left] - 1] @ P[left]
+    right = k < D.shape[0] - 1
+    E[k[right]] = P[right] @ E[k[right]]
+    return blocks_to_band(D, E, ab.shape[0] - 1)
 
 
 @dataclass(frozen=True)

@@ -168,19 +168,24 @@ def _approximate_complex_modes(cd, max_hz: float | None, vectors: bool) -> Compl
         w2, psi = _eigh(A, subset_by_value=[-np.inf, (2 * np.pi * max_hz) ** 2])
     phi = psi * s[:, None]  # mass-normalised
     w = np.sqrt(np.clip(w2, 1e-30, None))
-    zeta = np.einsum("ik,ij,jk->k", phi, cd.C, phi) / (2 * w)
+    Cphi = cd.C @ phi
+    zeta = np.sum(phi * Cphi, axis=0) / (2 * w)  # phi_k^T C phi_k / (2 omega_k)
     zc = np.clip(zeta, 0.0, 0.999999)
     lam = -zc * w + 1j * w * np.sqrt(1 - zc**2)
     right = left = None
     if vectors:
-        phi_c = phi.astype(complex)
-        right = np.vstack([phi_c, lam[None, :] * phi_c])
-        left = np.conj(np.vstack([lam[None, :] * (cd.M @ phi_c) + cd.C @ phi_c, cd.M @ phi_c]))
+        right = np.vstack([phi * (1.0 + 0j), lam[None, :] * phi])
+        Mphi = m[:, None] * phi  # the condensed mass is diagonal
+        left = np.conj(np.vstack([lam[None, :] * Mphi + Cphi, Mphi * (1.0 + 0j)]))
     return ComplexModes(w / (2 * np.pi), zc, lam, right, left, cd.S if vectors else None, m.copy() if vectors else None)
 
 
+GRID_SIGNIFICANCE = 1e-3  # direct path: refine poles whose single-mode r.m.s. exceeds this x the background's
+EXCLUSION_RATIO = 1e3  # a coarse point may over-count an unrefined pole by at most this x its own variance
+
+
 def frequency_grid(f_lo: float, f_hi: float, modes: ComplexModes, *, n_log: int = 300, n_peak: int = 17,
-                   n_tail: int = 12, zeta_resolved: float = 0.05) -> np.ndarray:
+                   n_tail: int = 12, zeta_resolved: float = 0.05, refine: np.ndarray | None = None) -> np.ndarray:
     """Integration grid [Hz]: log-spaced plus points around every lightly damped pole.
 
     Around a pole of half-power half-width b = zeta f: the core f + b tan(theta), theta
@@ -188,16 +193,32 @@ def frequency_grid(f_lo: float, f_hi: float, modes: ComplexModes, *, n_log: int 
     theta), and geometric tails f +- b 10^(1 .. 4).  Without the tails the trapezoid rule
     bridges a very narrow peak's flanks with one chord and overestimates them badly (the
     paper-damping modes have b ~ 1e-8 f, far below the log grid's 3 % spacing).
+
+    ``refine`` (bool per mode, default all): poles left unrefined (modes that do not matter
+    at the tower of interest, :func:`modal_contributions`) get an exclusion zone instead: a
+    grid point at kappa half-widths from a Lorentzian peak of width b, on a panel of width
+    Delta, over-counts that mode's variance by about Delta / (pi b kappa^2), so points closer
+    than kappa = sqrt(Delta / (pi b) / EXCLUSION_RATIO) half-widths are dropped (the
+    trapezoid then bridges the peak and under-counts an insignificant mode instead).
     """
     parts = [np.geomspace(f_lo, f_hi, n_log)]
+    spacing = (f_hi / f_lo) ** (1.0 / (n_log - 1)) - 1.0  # relative spacing of the log grid
     core = np.tan(np.linspace(-1.45, 1.45, n_peak))  # |tan| <= 8.2
     tail = np.geomspace(10.0, 1e4, n_tail)
     offsets = np.concatenate([-tail[::-1], core, tail])
-    for f, z in zip(modes.frequencies_hz, modes.damping_ratio):
+    excluded = []
+    for k, (f, z) in enumerate(zip(modes.frequencies_hz, modes.damping_ratio)):
         if f_lo < f < f_hi and z < zeta_resolved:
             b = max(z * f, 1e-12 * f)
-            parts.append(f + b * offsets)
+            if refine is None or refine[k]:
+                parts.append(f + b * offsets)
+            else:
+                ratio = spacing * f / (np.pi * b)
+                if ratio > EXCLUSION_RATIO:
+                    excluded.append((f, b * np.sqrt(ratio / EXCLUSION_RATIO)))
     grid = np.unique(np.concatenate(parts))
+    for f, r in excluded:
+        grid = grid[np.abs(grid - f) >= r]
     return grid[(grid >= f_lo) & (grid <= f_hi)]
 
 
@@ -239,7 +260,7 @@ class ModalTransfer:
 
         T(w) = sum_k A_k / (i w - lambda_k),   A_k = (G S psi_k^u)(chi_k^v,H M*^-1 S^T e_y,i) / (chi_k^H psi_k),
 
-    summed over all 2 n_t eigenvalues (Meirovitch 1980, section 9.3; Tisseur & Meerbergen
+    summed over all 2 n_t eigenvalues (Veletsos & Ventura 1986; Tisseur & Meerbergen
     2001).  A real system's eigenpairs come in conjugate pairs, so each pair contributes
 
         (i w 2 Re A_k - 2 Re(A_k conj(lambda_k))) / (|lambda_k|^2 - w^2 - 2 i w Re lambda_k),
@@ -499,7 +520,14 @@ def random_vibration(
 
     if modes is None:
         modes = complex_modes(model, damping, max_hz=band[1] * 1.5)
-    f = frequency_grid(band[0], band[1], modes)
+    modal_ok = modes.expansion is not None and modes.expansion.condition.max() < MODAL_CONDITION_LIMIT
+    refine = None
+    if not modal_ok and modes.right is not None:
+        # direct solves cost per frequency: refine only the poles that matter at this tower
+        mc = modal_contributions(model, modes, load_per_v, tower, sigma=sigma, length_scale=length_scale,
+                                 v_mean=v_mean, coherence_decay=coherence_decay, max_hz=np.inf)
+        refine = mc.significant(GRID_SIGNIFICANCE)
+    f = frequency_grid(band[0], band[1], modes, refine=refine)
     dx = system.line.span_length / system.ne
     # the synthesis scales the spectrum to unit variance below its top frequency
     # (linecheck.core.wind.turbulence.spectral_grid); do the same here
@@ -517,7 +545,7 @@ def random_vibration(
         return dynamic_solve(blocks, omega, rhs)[:, 1].transpose(1, 0, 2)  # y DOF of every free node
 
     transfer, method = direct, "direct"
-    if modes.expansion is not None and modes.expansion.condition.max() < MODAL_CONDITION_LIMIT:
+    if modal_ok:
         modal = ModalTransfer(model, modes, tower, xB[ydof].T)
         check = 2 * np.pi * f[:: max(1, f.size // 40)]
         ref = direct(check)
@@ -695,7 +723,7 @@ def modal_contributions(
     ydof = model.dofs.node_dof[free] + 1
     rows = slice(3 * tower, 3 * tower + 3)
     norm = np.abs(np.einsum("ik,ik->k", vl.conj(), vr))  # |chi^H psi|
-    r = model.G[rows] @ (S @ vr[:n])  # (3, n_modes) reaction per unit modal amplitude
+    r = (model.G[rows] @ S) @ vr[:n]  # (3, n_modes) reaction per unit modal amplitude
     L = S[ydof].T / modes.mass[:, None]  # M*^-1 S^T maps a y-load at free node i to b
     cvec = np.zeros((lam.size, system.n_nodes), dtype=complex)
     cvec[:, free] = (vl[n:].conj().T @ L) * load_per_v[free][None, :]

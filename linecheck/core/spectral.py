@@ -67,8 +67,12 @@ class ComplexModes:
         frequencies_hz: [Hz] undamped-equivalent natural frequency |lambda|/(2 pi), (n,).
         damping_ratio: [-] zeta = -Re(lambda)/|lambda|, (n,).
         poles: complex eigenvalues lambda, (n,).
-        right, left: state eigenvectors psi_k, chi_k as columns, (2 n_t, n), or None, in the
-            condensed coordinates t of :func:`~linecheck.core.model.condensed` (u = S t).
+        right: displacement half of the state eigenvectors psi_k (psi = [phi; lambda phi]),
+            (n_t, n), or None, in the condensed coordinates t of
+            :func:`~linecheck.core.model.condensed` (u = S t).
+        left: velocity half of the left state eigenvectors chi_k (chi^H A = lambda chi^H,
+            chi = conj([(lambda M + C) phi; M phi])), (n_t, n), or None.
+        norm: chi_k^H psi_k, (n,), or None (the modal projections divide by it).
         S: [-] condensed-to-full DOF map (n_dof, n_t), or None.
         mass: [kg] condensed (diagonal) mass, (n_t,), or None.
         expansion: every eigenpair of the state matrix, unfiltered (for the modal
@@ -83,6 +87,7 @@ class ComplexModes:
     S: np.ndarray | None = None
     mass: np.ndarray | None = None
     expansion: "StateEigen | None" = None
+    norm: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -131,11 +136,11 @@ def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None 
         vl = np.conj(np.vstack([w_top, cd.M @ phi]))
     else:
         lam, vl, vr = eig(A, right=False), None, None
-    expansion = None
+    expansion = nrm = None
     if vectors:
+        nrm = np.einsum("ik,ik->k", vl.conj(), vr)  # chi^H psi
         upper = lam.imag >= 0.0  # LAPACK returns exact conjugate pairs for a real matrix
-        nrm = np.einsum("ik,ik->k", vl[:, upper].conj(), vr[:, upper])
-        cond = np.linalg.norm(vr[:, upper], axis=0) * np.linalg.norm(vl[:, upper], axis=0) / np.abs(nrm)
+        cond = np.linalg.norm(vr[:, upper], axis=0) * np.linalg.norm(vl[:, upper], axis=0) / np.abs(nrm[upper])
         expansion = StateEigen(lam[upper], vr[:, upper], vl[:, upper], cond)
     keep = lam.imag > 1e-12
     if max_hz is not None:
@@ -144,9 +149,10 @@ def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None 
     idx = idx[np.argsort(np.abs(lam[idx]))]
     lam = lam[idx]
     w = np.abs(lam)
-    return ComplexModes(w / (2 * np.pi), -lam.real / w, lam,
-                        None if vr is None else vr[:, idx], None if vl is None else vl[:, idx],
-                        cd.S if vectors else None, np.diag(cd.M).copy() if vectors else None, expansion)
+    if not vectors:
+        return ComplexModes(w / (2 * np.pi), -lam.real / w, lam)
+    return ComplexModes(w / (2 * np.pi), -lam.real / w, lam, vr[:n, idx], vl[n:, idx],
+                        cd.S, np.diag(cd.M).copy(), expansion, nrm[idx])
 
 
 LARGE_SYSTEM_DOF = 600  # above this the dense state-space eigenproblem (O((2n)^3)) is too slow
@@ -172,12 +178,12 @@ def _approximate_complex_modes(cd, max_hz: float | None, vectors: bool) -> Compl
     zeta = np.sum(phi * Cphi, axis=0) / (2 * w)  # phi_k^T C phi_k / (2 omega_k)
     zc = np.clip(zeta, 0.0, 0.999999)
     lam = -zc * w + 1j * w * np.sqrt(1 - zc**2)
-    right = left = None
-    if vectors:
-        right = np.vstack([phi * (1.0 + 0j), lam[None, :] * phi])
-        Mphi = m[:, None] * phi  # the condensed mass is diagonal
-        left = np.conj(np.vstack([lam[None, :] * Mphi + Cphi, Mphi * (1.0 + 0j)]))
-    return ComplexModes(w / (2 * np.pi), zc, lam, right, left, cd.S if vectors else None, m.copy() if vectors else None)
+    if not vectors:
+        return ComplexModes(w / (2 * np.pi), zc, lam)
+    # psi = [phi; lambda phi], chi = conj([(lambda M + C) phi; M phi]) with real phi:
+    # chi^H psi = 2 lambda phi^T M phi + phi^T C phi = 2 lambda + 2 zeta omega (mass-normalised)
+    return ComplexModes(w / (2 * np.pi), zc, lam, phi, m[:, None] * phi, cd.S, m.copy(), None,
+                        2 * lam + 2 * zc * w)
 
 
 GRID_SIGNIFICANCE = 1e-3  # direct path: refine poles whose single-mode r.m.s. exceeds this x the background's
@@ -711,22 +717,21 @@ def modal_contributions(
     Args:
         modes: complex modes of ``model`` with its damping, computed with ``vectors=True``.
     """
-    if modes.right is None or modes.left is None or modes.S is None:
+    if modes.right is None or modes.left is None or modes.S is None or modes.norm is None:
         raise ValueError("modal_contributions needs complex modes computed with vectors=True")
     system = model.system
     S = modes.S
-    n = S.shape[1]
     sel = modes.frequencies_hz <= max_hz
     lam, vl, vr = modes.poles[sel], modes.left[:, sel], modes.right[:, sel]
     f = modes.frequencies_hz[sel]
     free = model.dofs.free_nodes
     ydof = model.dofs.node_dof[free] + 1
     rows = slice(3 * tower, 3 * tower + 3)
-    norm = np.abs(np.einsum("ik,ik->k", vl.conj(), vr))  # |chi^H psi|
-    r = (model.G[rows] @ S) @ vr[:n]  # (3, n_modes) reaction per unit modal amplitude
+    norm = np.abs(modes.norm[sel])  # |chi^H psi|
+    r = (model.G[rows] @ S) @ vr  # (3, n_modes) reaction per unit modal amplitude
     L = S[ydof].T / modes.mass[:, None]  # M*^-1 S^T maps a y-load at free node i to b
     cvec = np.zeros((lam.size, system.n_nodes), dtype=complex)
-    cvec[:, free] = (vl[n:].conj().T @ L) * load_per_v[free][None, :]
+    cvec[:, free] = (vl.conj().T @ L) * load_per_v[free][None, :]
     dx = system.line.span_length / system.ne
     rho = np.exp(-coherence_decay * f * dx / v_mean)
     SQ = von_karman(f, sigma, length_scale, v_mean) * _quad_kms(cvec, rho)

@@ -294,6 +294,7 @@ def run_case(
     *,
     realizations: list[int] | np.ndarray | None = None,
     interpolate_states: bool = False,
+    spectral_check: bool = True,
     progress: Progress | None = None,
     cancel: threading.Event | None = None,
 ) -> RunResult:
@@ -305,6 +306,9 @@ def run_case(
         interpolate_states: reference scheme: interpolate the step-1 state linearly in time
             and rebuild and factorise the model at every step, instead of holding the
             nearest of the ``analysis.mean_states`` states (slow; validation only).
+        spectral_check: run the frequency-domain check of a synoptic case (estimates 1 and 2,
+            :func:`spectral_analysis`); its cost grows faster than the number of spans, the
+            time-domain steps' only linearly (docs/performance.md).
         progress: ``progress(stage, done, total)``.
         cancel: a :class:`threading.Event`; when set the run stops with ``Cancelled``.
     """
@@ -383,7 +387,7 @@ def run_case(
     Bk, Rk = resp.background[:, keep], resp.resonant[:, keep]
     stats = compute_statistics(M[keep], Bk, Rk, mean.still_air.reactions, case.g_yp_L)
     j = case.line.tower_of_interest - 1
-    spectral = spectral_analysis(case, static=st, synoptic=sm) if sm is not None else None
+    spectral = spectral_analysis(case, static=st, synoptic=sm) if sm is not None and spectral_check else None
     return RunResult(
         case=case, system=system, static=st, realizations=real, time=t[keep], mean=M[keep],
         background=Bk[:, :, j, :].copy(), resonant=Rk[:, :, j, :].copy(), stats=stats,

@@ -133,3 +133,22 @@ def test_davenport_peak_factor_bias_on_a_gaussian_process():
     X[:, 1:] = np.sqrt(S * df / 2) * np.exp(1j * rng.uniform(0, 2 * np.pi, (400, f.size))) * n
     peaks = np.fft.irfft(X, n, axis=1).max(axis=1) / np.sqrt(m0)
     assert 0.85 * g < peaks.mean() < 0.95 * g
+
+
+def test_run_no_check_skips_the_frequency_domain_and_changes_nothing_else(tmp_path):
+    """``linecheck run --no-check``: no "spectral" block, the time-domain results identical."""
+    from typer.testing import CliRunner
+
+    from linecheck.cli.app import app
+
+    src = (CASES / "paper" / "case10-single.toml").read_text()
+    case_file = tmp_path / "short.toml"
+    case_file.write_text(src.replace("duration = 600.0", "duration = 60.0").replace("realizations = 10", "realizations = 2"))
+    docs = {}
+    for flag in ([], ["--no-check"]):
+        out = tmp_path / f"r{len(flag)}.json"
+        r = CliRunner().invoke(app, ["run", str(case_file), "--json", str(out), *flag])
+        assert r.exit_code == 0, r.output
+        docs[len(flag)] = json.loads(out.read_text())
+    assert "spectral" in docs[0] and "spectral" not in docs[1]
+    assert docs[0]["reactions"] == docs[1]["reactions"]

@@ -76,6 +76,7 @@ def run(
     excel: ExcelOpt = None,
     template: TemplateOpt = None,
     force: ForceOpt = False,
+    no_check: Annotated[bool, typer.Option("--no-check", help="Skip the frequency-domain sanity check of a synoptic case (long lines: its cost grows faster than the number of spans).")] = False,
 ) -> None:
     """Steps 1-3: mean, background and resonant reactions, gust factors and contributions."""
     case = override(read_case(case_file), realizations, seed)
@@ -86,7 +87,7 @@ def run(
 
         check_excel_target(excel, force=force, template=template)
     with progress_bar() as cb:
-        res = service.run_case(case, progress=cb)
+        res = service.run_case(case, progress=cb, spectral_check=not no_check)
     doc = run_to_dict(res, full_histories=full_histories)
     console.print(results_table(doc))
     console.print("[dim]GF ** : mean reaction zero by symmetry (or < 1 % of the largest mean); "
@@ -95,6 +96,8 @@ def run(
 
     print_burn_in(doc)
     print_sanity(doc)
+    if no_check and case.wind.type == "synoptic":
+        console.print("[dim]frequency-domain check skipped (--no-check): no \"spectral\" block, no sanity check.[/]")
     if json_out is not None:
         write_json(json_out, doc)
         console.print(f"wrote {json_out}")

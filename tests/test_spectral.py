@@ -24,18 +24,43 @@ def synoptic(name: str, **analysis):
     return dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, **analysis))
 
 
+def gaussian_mean_gust_factor(f: np.ndarray, S: np.ndarray, mean: float, T: float, dt: float,
+                              records: int = 400, seed: int = 7) -> float:
+    """Mean over Gaussian records of max_t |M + x(t)| / |M|, x with the one-sided spectrum S(f).
+
+    Independent of Davenport's formula: x is synthesised by the spectral representation on
+    the FFT grid k/T, each bin carrying the variance of S over [f_k - 1/2T, f_k + 1/2T]
+    (cumulative trapezoid on the estimate's own grid, so narrow peaks keep their area)."""
+    n = int(round(T / dt))
+    fk = np.fft.rfftfreq(n, dt)[1:]
+    cum = np.concatenate([[0.0], np.cumsum(0.5 * (S[1:] + S[:-1]) * np.diff(f))])
+    edges = np.concatenate([fk - 0.5 / T, [fk[-1] + 0.5 / T]])
+    var = np.diff(np.interp(edges, f, cum))
+    rng = np.random.default_rng(seed)
+    X = np.zeros((records, n // 2 + 1), complex)
+    X[:, 1:] = 0.5 * np.sqrt(2.0 * var) * np.exp(2j * np.pi * rng.random((records, fk.size))) * n
+    x = np.fft.irfft(X, n, axis=1)
+    return float(np.mean(np.abs(mean + x).max(axis=1)) / abs(mean))
+
+
 def compare(name: str) -> None:
     """Time domain (20 realizations of 600 s after the burn-in) against estimate 1.
 
     Tolerances: the issue's 5 % on r.m.s.  The sampling error of a 20-realization mean of
     an r.m.s. is std/sqrt(20) <= 1.6 % here (std over realizations <= 7 %), the frequency
-    grid adds < 1 %.  Gust factors: Davenport's asymptotic peak factor overestimates the mean
-    600-s maximum of these low-frequency-dominated responses (nu T ~ 40-200); a pure Gaussian
-    process with the same kind of spectrum shows the same 5-12 % bias
-    (:func:`test_davenport_peak_factor_bias_on_a_gaussian_process`), so the time-domain GF
-    must lie 0-12 % below the frequency-domain GF (docs/validation.md).
+    grid adds < 1 %.
+
+    Gust factors, twice.  (1) Against the mean peak of Gaussian records with estimate 1's own
+    spectra (:func:`gaussian_mean_gust_factor`): the like-for-like comparison of the two
+    methods, within the issue's 5 %.  (2) Against estimate 1's GF with Davenport's asymptotic
+    peak factor (the issue's formula), which overestimates the mean 600-s maximum of these
+    low-frequency-dominated responses: a pure Gaussian process with a span's background
+    spectrum shows a 5-15 % bias (:func:`test_davenport_peak_factor_bias_on_a_gaussian_process`)
+    and the six-span transverse background up to 22 % on GF - 1, so the time-domain GF - 1 lies
+    0.75-1.02 x Davenport's (docs/validation.md).
     """
-    res = service.run_case(synoptic(name, realizations=20))
+    case = synoptic(name, realizations=20)
+    res = service.run_case(case)
     assert res.burn_in.sufficient
     j = res.tower_index
     ex = res.spectral.exact
@@ -45,12 +70,15 @@ def compare(name: str) -> None:
         for c in range(3):
             if fd[c] > 0.01 * scale:
                 assert td[c] == pytest.approx(fd[c], rel=0.05), (q, c, td[c], fd[c])
-    for q in ("GF_QS", "GF_Dy"):
+    T = float(res.time[-1] - res.time[0]) + case.analysis.time_step
+    for q, psd in (("GF_QS", ex.psd_background), ("GF_Dy", ex.psd_fluctuating)):
         td, fd = res.stats.mean(q)[j], getattr(ex, q)
         for c in range(2):
             if np.isfinite(fd[c]):
-                # gust-factor excess over 1 carries the bias: compare GF - 1
-                assert 0.80 * (fd[c] - 1) <= td[c] - 1 <= 1.02 * (fd[c] - 1), (q, c, td[c], fd[c])
+                gauss = gaussian_mean_gust_factor(ex.frequencies, psd[:, c], ex.mean[c], T, case.analysis.time_step)
+                assert td[c] == pytest.approx(gauss, rel=0.05), (q, c, td[c], gauss)
+                # gust-factor excess over 1 carries Davenport's bias: compare GF - 1
+                assert 0.75 * (fd[c] - 1) <= td[c] - 1 <= 1.02 * (fd[c] - 1), (q, c, td[c], fd[c])
     # the run's own sanity check agrees
     assert all(item.ok for item in service.sanity_check(res))
 

@@ -457,8 +457,10 @@ def _quad_kms_nodes(w: np.ndarray, rho: np.ndarray) -> np.ndarray:
 class SpectralEstimate:
     """Frequency-domain statistics of the reactions at the tower of interest.
 
-    Every array has shape (3,) for (R_x, R_y, R_z); forces [N], frequencies [Hz].
-    GF_* are NaN where the mean vanishes (as in the time domain).
+    Every statistic has shape (3,) for (R_x, R_y, R_z); forces [N], frequencies [Hz].
+    GF_* are NaN where the mean vanishes (as in the time domain).  The spectra of the
+    background and total fluctuating reactions on the integration grid are kept (e.g. to
+    simulate Gaussian records with them).
     """
 
     mean: np.ndarray
@@ -476,6 +478,9 @@ class SpectralEstimate:
     band: tuple[float, float]
     n_frequencies: int
     method: str = "direct"  # "modal" (complex modal superposition) or "direct" (solves)
+    frequencies: np.ndarray | None = None  # [Hz] the integration grid, (n_f,)
+    psd_background: np.ndarray | None = None  # [N^2/Hz] one-sided spectra on the grid, (n_f, 3)
+    psd_fluctuating: np.ndarray | None = None  # [N^2/Hz] (n_f, 3)
 
 
 def random_vibration(
@@ -587,7 +592,7 @@ def random_vibration(
         mean=np.asarray(mean_reaction, dtype=float), rms_background=sB, rms_resonant=sR, rms_fluctuating=sF,
         nu_background=nuB, nu_fluctuating=nuF, peak_quasi_static=pk_qs, peak_dynamic=pk_dy,
         GF_Dy=gf_dy, GF_QS=gf_qs, Cont_R=cont_r, duration=duration, band=band, n_frequencies=int(f.size),
-        method=method,
+        method=method, frequencies=f, psd_background=SB, psd_fluctuating=SF,
     )
 
 

@@ -13,7 +13,9 @@ t_i(n) the reaction per unit load at node i:
     t_B    = G K^-1 P + D                                   (quasi-static background)
     t_R    = t_F - t_B                                       (resonant, R = F - B)
 
-(G, D: reaction maps of :mod:`linecheck.core.model`; P: y-DOF loading).  The
+(G, D: reaction maps of :mod:`linecheck.core.model`; P: y-DOF loading), evaluated by
+complex modal superposition (:class:`ModalTransfer`) or, for large systems and as the
+cross-check, by direct block-tridiagonal solves (:func:`dynamic_solve`).  The
 variances integrate S_r over the band that the time-domain synthesis contains
 (1/T_record .. 1/(2 dt)), on a logarithmic grid refined around every lightly damped
 complex pole (tan-spaced points, exact for Lorentzian peaks).  Expected peaks use

@@ -324,6 +324,7 @@ class ModalTransfer:
             out += self.R.T @ (1.0 / (1j * w - self.lam_real[:, None]))
         return out.reshape(self.shape + (omega.size,))
 
+
 def _inv3(A: np.ndarray) -> np.ndarray:
     """Inverses of 3x3 matrices by the adjugate (Cramer), frequency last: shape (3, 3, n)."""
     a = A

@@ -352,6 +352,7 @@ def rotate_band(ab: np.ndarray, T: np.ndarray) -> np.ndarray:
             shape (n_nodes, 3, 3).
     """
     D, E = band_blocks(ab)
-    Dr = np.einsum("nai,nab,nbj->nij", T, D, T, optimize=False)
-    Er = np.einsum("nai,nab,nbj->nij", T[:-1], E, T[1:], optimize=False)
+    Tt = T.transpose(0, 2, 1)
+    Dr = Tt @ D @ T
+    Er = Tt[:-1] @ E @ T[1:]
     return blocks_to_band(0.5 * (Dr + Dr.transpose(0, 2, 1)), Er, ab.shape[0] - 1)

@@ -161,16 +161,17 @@ class _Spans:
         y' = dy/l + L_u Q_y(s)/H, z' = dz/l - L_u Q_z(s)/H  (docs/method.md, "Elastic
         span relation"; shallow-cable shape, Irvine 1981 ch. 2, exact length integral).
 
-        Args: l, dy, dz [m] chord projections per span, shape (n_spans,); H0 [N] start.
+        Args: l, dy, dz [m] chord projections per span, shape (n_spans,) or (n_states, n_spans)
+            (the load case then has the same leading axis); H0 [N] start.
         Returns: H [N] and C = dH/dl [N/m] (the elastic form of the paper's C_n).
         """
         Lu, EA = self.Lu, self.EA
         w = self.w_gp
-        ay, az = (dy / l)[:, None], (dz / l)[:, None]
+        ay, az = (dy / l)[..., None], (dz / l)[..., None]
         by, bz = Lu * self.qy_gp, -Lu * self.qz_gp  # (n_spans, n_gp) and (n_gp,)
         H = np.array(H0, dtype=float)
         for _ in range(60):
-            Hc = H[:, None]
+            Hc = H[..., None]
             py, pz = ay + by / Hc, az + bz / Hc
             u = np.sqrt(1.0 + py**2 + pz**2)
             den = 1.0 + Hc * u / EA
@@ -187,29 +188,29 @@ class _Spans:
                 break
         else:
             raise ConvergenceError("span tension iteration did not converge (non-finite loads?)")
-        Hc = H[:, None]
+        Hc = H[..., None]
         py, pz = ay + by / Hc, az + bz / Hc
         u = np.sqrt(1.0 + py**2 + pz**2)
         den = 1.0 + Hc * u / EA
         fu = 1.0 / den**2
         dF_dH = l * ((-(u**2) / EA / den**2 + fu * (-(py * by + pz * bz) / Hc**2) / u) @ w)
-        dF_dl = (u / den) @ w + l * ((fu * (-(py * ay + pz * az) / l[:, None]) / u) @ w)
+        dF_dl = (u / den) @ w + l * ((fu * (-(py * ay + pz * az) / l[..., None]) / u) @ w)
         self.u_last = u
         return H, -dF_dl / dF_dH
 
 
 def _reactions(sp: _Spans, H, l, dy, dz, n_towers) -> np.ndarray:
     """Conductor forces on every attachment point (paper Eq. 2 incl. the P-delta term K_yz d)."""
-    R = np.zeros((n_towers, 3))
-    Ddy, Ddz = np.diff(dy), np.diff(dz)
+    R = np.zeros(H.shape[:-1] + (n_towers, 3))
+    Ddy, Ddz = np.diff(dy, axis=-1), np.diff(dz, axis=-1)
     # left end A of each span
-    R[:-1, 0] += H
-    R[:-1, 1] += H * Ddy / l + sp.Lu * sp.vAy
-    R[:-1, 2] += sp.Lu * sp.vAz - H * Ddz / l
+    R[..., :-1, 0] += H
+    R[..., :-1, 1] += H * Ddy / l + sp.Lu * sp.vAy
+    R[..., :-1, 2] += sp.Lu * sp.vAz - H * Ddz / l
     # right end B
-    R[1:, 0] -= H
-    R[1:, 1] += -H * Ddy / l + sp.Lu * sp.vBy
-    R[1:, 2] += sp.Lu * sp.vBz + H * Ddz / l
+    R[..., 1:, 0] -= H
+    R[..., 1:, 1] += -H * Ddy / l + sp.Lu * sp.vBy
+    R[..., 1:, 2] += sp.Lu * sp.vBz + H * Ddz / l
     return R
 
 
@@ -322,21 +323,28 @@ def solve_static(
             f"(last displacement change {change:.3g} m, out-of-balance force {residual:.3g} N)"
         )
 
+    return _final_state(system, sp.Lu, sp.my_hat, sp.mz_hat, d, H, R, Rres, it, residual, label)
+
+
+def _final_state(system: LineSystem, Lu: float, my_hat: np.ndarray, mz_hat: np.ndarray, d: np.ndarray,
+                 H: np.ndarray, R: np.ndarray, Rres: np.ndarray, it: int, residual: float, label: str) -> StaticState:
+    """Strain check and deformed shape of one converged equilibrium (shallow cable:
+    y = chord + M_y/H, z = chord - M_z/H; element tension T = H ds/dx)."""
+    line = system.line
+    L = line.span_length
     strain = H.max() / line.ea
     if strain > MAX_STRAIN or not np.isfinite(strain):
         raise ConvergenceError(
             f"{label}: no admissible equilibrium: conductor strain {strain:.3g} exceeds {MAX_STRAIN:g} "
             f"(horizontal tension {H.max():.4g} N, out-of-balance force {residual:.3g} N); check the loads"
         )
-
-    # ---- deformed shape at the FE nodes (shallow cable: y = chord + M_y/H, z = chord - M_z/H)
     l = L + np.diff(d[:, 0])
     s = system.node_s
     xA = system.tower_x[:-1] + d[:-1, 0]
     X = xA[:, None] + s[None, :] * l[:, None]
-    scale = (sp.Lu * l / H)[:, None]
-    Y = d[:-1, 1][:, None] + s * np.diff(d[:, 1])[:, None] + scale * sp.my_hat
-    Z = d[:-1, 2][:, None] + s * np.diff(d[:, 2])[:, None] - scale * sp.mz_hat[None, :]
+    scale = (Lu * l / H)[:, None]
+    Y = d[:-1, 1][:, None] + s * np.diff(d[:, 1])[:, None] + scale * my_hat
+    Z = d[:-1, 2][:, None] + s * np.diff(d[:, 2])[:, None] - scale * mz_hat[None, :]
     ne = system.ne
     nodes = np.empty((system.n_nodes, 3))
     for c, A in enumerate((X, Y, Z)):
@@ -356,6 +364,145 @@ def solve_static(
         iterations=it,
         residual=residual,
     )
+
+
+def _tridiag_solve(sub: np.ndarray, diag: np.ndarray, sup: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Thomas algorithm vectorised over a leading axis: (n_b, k-1), (n_b, k), (n_b, k-1), (n_b, k).
+
+    Used for the longitudinal tangent K_x (paper Eq. 3), which is symmetric and diagonally
+    dominant (-K_x: diagonal R_res/v + C_left + C_right, off-diagonal C), so elimination
+    without pivoting is stable (Golub & Van Loan 2013, section 4.3.5)."""
+    k = diag.shape[1]
+    c = np.empty_like(diag)
+    y = np.empty_like(b)
+    c_prev = np.zeros(diag.shape[0])
+    y_prev = np.zeros(diag.shape[0])
+    piv = diag[:, 0].copy()
+    for i in range(k):
+        if i:
+            piv = diag[:, i] - sub[:, i - 1] * c_prev
+        c[:, i] = sup[:, i] / piv if i < k - 1 else 0.0
+        y[:, i] = (b[:, i] - (sub[:, i - 1] * y_prev if i else 0.0)) / piv
+        c_prev, y_prev = c[:, i], y[:, i]
+    x = np.empty_like(b)
+    x[:, -1] = y[:, -1]
+    for i in range(k - 2, -1, -1):
+        x[:, i] = y[:, i] - c[:, i] * x[:, i + 1]
+    return x
+
+
+def solve_static_batch(
+    system: LineSystem,
+    gy: np.ndarray,
+    *,
+    labels: list[str],
+    tol: float = 1e-8,
+    max_iter: int = 500,
+    progress: Callable[[int, int], None] | None = None,
+    cancel: threading.Event | None = None,
+) -> list[StaticState]:
+    """:func:`solve_static` for many load cases at once (the downburst's mean states).
+
+    The same Fig. 6 iteration -- inner Newton on d_x (Eq. 3) with R_res fixed, then the
+    insulator update (Eq. 4) -- run on all states together, every array with a leading state
+    axis, each state frozen at its own convergence.  Every state starts from the still-air
+    equilibrium (no warm start from its neighbour in time), so a state's result does not
+    depend on the others; it agrees with the sequential solver to the tolerance ``tol``.
+
+    Args:
+        gy: [N/m] transverse loads, shape (n_states, n_spans, ne+1).
+        labels: names of the states for error messages, length n_states.
+        progress: ``progress(converged, n_states)`` once per outer iteration.
+    """
+    line = system.line
+    nt = system.n_towers
+    v = line.insulator_length
+    L = line.span_length
+    gy = np.asarray(gy, dtype=float)
+    n_s = gy.shape[0]
+    if gy.shape[1:] != (system.n_spans, system.ne + 1):
+        raise ValueError(f"gy must have shape (n, {system.n_spans}, {system.ne + 1}), got {gy.shape}")
+    bad = np.flatnonzero(~np.all(np.isfinite(gy.reshape(n_s, -1)), axis=1))
+    if bad.size:
+        raise ConvergenceError(f"{labels[bad[0]]}: non-finite mean-wind load")
+    still = still_air_state(system)
+    sp = _Spans(system, gy)
+    d = np.broadcast_to(still.displacement, (n_s, nt, 3)).copy()
+    H = np.broadcast_to(still.tension, (n_s, system.n_spans)).copy()
+    Rres = np.broadcast_to(still.insulator_force, (n_s, nt)).copy()
+    idx = np.flatnonzero(system.suspension)
+    k = idx.size
+    adj = np.flatnonzero(np.diff(idx) == 1)
+    tol_d = tol * max(v, 1.0)
+    active = np.ones(n_s, dtype=bool)
+    out_d, out_H, out_R = np.empty_like(d), np.empty_like(H), np.empty((n_s, nt, 3))
+    out_Rres, out_res = np.empty_like(Rres), np.zeros(n_s)
+    out_it = np.zeros(n_s, dtype=int)
+    change = np.full(n_s, np.inf)
+    residual = np.full(n_s, np.inf)
+    for it in range(1, max_iter + 1):
+        if cancel is not None and cancel.is_set():
+            raise Cancelled("step 1 cancelled")
+        d_old = d.copy()
+        # ---- inner Newton on d_x (paper Eq. 3), R_res fixed; converged states frozen
+        inner = active.copy()
+        for _inner in range(50):
+            l = L + np.diff(d[..., 0], axis=-1)
+            H, C = sp.tension(l, np.diff(d[..., 1], axis=-1), np.diff(d[..., 2], axis=-1), H)
+            if k == 0 or not inner.any():
+                break
+            fx = np.zeros((n_s, nt))
+            fx[:, :-1] += H
+            fx[:, 1:] -= H
+            fx = fx - d[..., 0] * Rres / v
+            diag = -Rres / v
+            diag = diag.copy()
+            diag[:, :-1] -= C
+            diag[:, 1:] -= C
+            off = np.zeros((n_s, max(k - 1, 0)))
+            off[:, adj] = C[:, idx[adj]]
+            step = _tridiag_solve(off, diag[:, idx], off, -fx[:, idx])
+            step[~inner] = 0.0
+            d[:, idx, 0] += step
+            inner &= ~(np.max(np.abs(step), axis=1) <= 1e-3 * tol_d)
+        l = L + np.diff(d[..., 0], axis=-1)
+        H, _ = sp.tension(l, np.diff(d[..., 1], axis=-1), np.diff(d[..., 2], axis=-1), H)
+        R = _reactions(sp, H, l, d[..., 1], d[..., 2], nt)
+        Rn = np.linalg.norm(R, axis=-1)
+        Rres = np.where(active[:, None], Rn, Rres)
+        finite = np.all(np.isfinite(R.reshape(n_s, -1)), axis=1) & np.all(np.isfinite(d.reshape(n_s, -1)), axis=1)
+        if not np.all(finite | ~active):
+            j = int(np.flatnonzero(~finite & active)[0])
+            raise ConvergenceError(f"{labels[j]}: non-finite values after {it} iterations")
+        # ---- insulator equilibrium (paper Eq. 4)
+        if k:
+            a = active
+            dn = np.stack([v * R[:, idx, 0] / Rres[:, idx], v * R[:, idx, 1] / Rres[:, idx],
+                           v - v * R[:, idx, 2] / Rres[:, idx]], axis=-1)
+            d[:, idx] = np.where(a[:, None, None], dn, d[:, idx])
+            change = np.where(a, np.max(np.abs(d - d_old).reshape(n_s, -1), axis=1), change)
+            axis = np.stack([d_old[:, idx, 0], d_old[:, idx, 1], v - d_old[:, idx, 2]], axis=-1) / v
+            res = np.max(np.linalg.norm(R[:, idx] - Rn[:, idx, None] * axis, axis=-1), axis=1)
+            residual = np.where(a, res, residual)
+        else:
+            change = np.where(active, 0.0, change)
+            residual = np.where(active, 0.0, residual)
+        done = active & (change <= tol_d)
+        out_d[done], out_H[done], out_R[done] = d[done], H[done], R[done]
+        out_Rres[done], out_res[done], out_it[done] = Rres[done], residual[done], it
+        active &= ~done
+        if progress is not None:
+            progress(int(n_s - active.sum()), n_s)
+        if not active.any():
+            break
+    else:
+        j = int(np.flatnonzero(active)[0])
+        raise ConvergenceError(
+            f"{labels[j]}: step-1 static solver did not converge in {max_iter} iterations "
+            f"(last displacement change {change[j]:.3g} m, out-of-balance force {residual[j]:.3g} N)"
+        )
+    return [_final_state(system, sp.Lu, sp.my_hat[j], sp.mz_hat, out_d[j], out_H[j], out_R[j], out_Rres[j],
+                         int(out_it[j]), float(out_res[j]), labels[j]) for j in range(n_s)]
 
 
 @dataclass(frozen=True)
@@ -407,7 +554,7 @@ def solve_mean_states(
     progress: Callable[[int, int], None] | None = None,
     cancel: threading.Event | None = None,
 ) -> MeanStates:
-    """Step 1 at every instant of ``time`` (warm-started from the previous instant).
+    """Step 1 at every instant of ``time`` (several instants: :func:`solve_static_batch`).
 
     Args:
         time: [s] shape (n_t,).
@@ -417,16 +564,15 @@ def solve_mean_states(
     """
     still = still_air_state(system)
     n_t = len(time)
-    states = []
-    prev = still
-    for k in range(n_t):
+    labels = [f"mean state {k + 1} of {n_t} (t = {time[k]:.1f} s)" for k in range(n_t)]
+    if n_t > 1:  # all states at once (same iteration, vectorised over the states)
+        states = solve_static_batch(system, gy, labels=labels, progress=progress, cancel=cancel)
+    else:
         if cancel is not None and cancel.is_set():
             raise Cancelled("step 1 cancelled")
-        st = solve_static(system, gy[k], initial=prev, label=f"mean state {k + 1} of {n_t} (t = {time[k]:.1f} s)")
-        states.append(st)
-        prev = st
+        states = [solve_static(system, gy[0], initial=still, label=labels[0])]
         if progress is not None:
-            progress(k + 1, n_t)
+            progress(1, 1)
     return MeanStates(
         time=np.asarray(time, dtype=float),
         displacement=np.stack([s.displacement for s in states]),

@@ -456,7 +456,6 @@ def solve_static_batch(
             fx[:, 1:] -= H
             fx = fx - d[..., 0] * Rres / v
             diag = -Rres / v
-            diag = diag.copy()
             diag[:, :-1] -= C
             diag[:, 1:] -= C
             off = np.zeros((n_s, max(k - 1, 0)))

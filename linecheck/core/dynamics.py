@@ -199,30 +199,41 @@ def integrate(
         st = new
         cu, cv, dm = (x.reshape(1, -1) for x in (st.cu, st.cv, st.dm))  # (1, n): no broadcast set-up per op
         r2, chat, rest, a1 = st.r2, st.chat, st.rest, st.a1
+        # work arrays, reused every step (the step loop allocates nothing): the new state is
+        # written into U_new, V_new, A_new and the names are swapped with the old ones
+        U, V, A = (np.ascontiguousarray(X) for X in (U, V, A))
+        U_new, V_new, A_new, tmp = (np.empty_like(U) for _ in range(4))
+        probe = np.zeros_like(U)
+        in_place = np.shares_memory(_dpbtrs(chat, probe.T, lower=0, overwrite_b=1)[0], probe)
         for b0 in range(int(s0), int(s1), block):
             b1 = min(b0 + block, int(s1))
             Fb = (loads[b0:b1][..., None] * st.ycoef).reshape(b1 - b0, n_real, n_dof)
             for k in range(b1 - b0):
                 # K_hat u_{n+1} = F_{n+1} + M (a0 u + a2 v + a) + C (a1 u + v)   (Bathe Table 9.3)
-                rhs = cu * U
-                rhs += cv * V
-                rhs += dm * A
-                rhs += Fb[k]
+                np.multiply(cu, U, out=U_new)
+                np.multiply(cv, V, out=tmp)
+                U_new += tmp
+                np.multiply(dm, A, out=tmp)
+                U_new += tmp
+                U_new += Fb[k]
                 if rest is not None:
-                    rhs += (rest @ (a1 * U + V).T).T
-                U_new, info = _dpbtrs(chat, rhs.T, lower=0, overwrite_b=1)
+                    U_new += (rest @ (a1 * U + V).T).T
+                x, info = _dpbtrs(chat, U_new.T, lower=0, overwrite_b=1)  # solved in place
                 if info != 0:  # pragma: no cover - only for malformed input
                     raise NumericalError(f"banded solve failed (LAPACK dpbtrs info {info})")
-                U_new = U_new.T
+                if not in_place:  # pragma: no cover - the LAPACK wrapper copies
+                    U_new[...] = x.T
                 # trapezoidal relations of average acceleration: v' = 2/dt (u' - u) - v,
                 # a' = 2/dt (v' - v) - a  (= a0 (u' - u) - a2 v - a, Bathe Table 9.3)
-                V_new = U_new - U
+                np.subtract(U_new, U, out=V_new)
                 V_new *= r2
                 V_new -= V
-                dA = V_new - V
-                dA *= r2
-                dA -= A
-                U, V, A = U_new, V_new, dA
+                np.subtract(V_new, V, out=A_new)
+                A_new *= r2
+                A_new -= A
+                U, U_new = U_new, U
+                V, V_new = V_new, V
+                A, A_new = A_new, A
                 buf[k] = U
             R_F[b0:b1] = st.reactions(buf[: b1 - b0])
             if progress is not None and b1 // report != b0 // report:

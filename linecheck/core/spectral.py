@@ -101,12 +101,14 @@ class StateEigen:
         poles: eigenvalues lambda with Im(lambda) >= 0, (n_e,).
         right, left: psi_k, chi_k as columns (A psi = lambda psi, chi^H A = lambda chi^H),
             (2 n_t, n_e).
+        norm: chi_k^H psi_k, (n_e,).
         condition: [-] eigenvalue condition numbers ||psi|| ||chi|| / |chi^H psi|, (n_e,).
     """
 
     poles: np.ndarray
     right: np.ndarray
     left: np.ndarray
+    norm: np.ndarray
     condition: np.ndarray
 
 
@@ -143,7 +145,7 @@ def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None 
         nrm = np.einsum("ik,ik->k", vl.conj(), vr)  # chi^H psi
         upper = lam.imag >= 0.0  # LAPACK returns exact conjugate pairs for a real matrix
         cond = np.linalg.norm(vr[:, upper], axis=0) * np.linalg.norm(vl[:, upper], axis=0) / np.abs(nrm[upper])
-        expansion = StateEigen(lam[upper], vr[:, upper], vl[:, upper], cond)
+        expansion = StateEigen(lam[upper], vr[:, upper], vl[:, upper], nrm[upper], cond)
     keep = lam.imag > 1e-12
     if max_hz is not None:
         keep &= np.abs(lam) / (2 * np.pi) <= max_hz
@@ -292,8 +294,7 @@ class ModalTransfer:
         G = model.G[3 * tower:3 * tower + 3]
         r = G @ (S @ ex.right[:n_t])  # (3, n_e)
         c = ex.left[n_t:].conj().T @ (S[ydof].T / modes.mass[:, None])  # (n_e, n_free)
-        norm = np.einsum("ik,ik->k", ex.left.conj(), ex.right)
-        A = r.T[:, :, None] * (c / norm[:, None])[:, None, :]  # (n_e, 3, n_free)
+        A = r.T[:, :, None] * (c / ex.norm[:, None])[:, None, :]  # (n_e, 3, n_free)
         lam = ex.poles
         pair = lam.imag > 0.0
         self.lam_pair, self.lam_real = lam[pair], lam[~pair].real

@@ -240,3 +240,23 @@ def test_with_values_keeps_large_legal_case_refused_by_the_guard_not_the_schema(
     # 27 DOF (33 less the 6 of the two pinned strain towers) + 7 dense 27 x 27 matrices
     expect = 4 * 8 * 1e4 * 12001 * 11 + 8 * 8 * 12001 * 11 + 100e6 + (20 * 8 * 27 + 3e3) + 7 * 27**2 * 8
     assert est.memory == pytest.approx(expect, rel=1e-12)
+
+
+def test_check_warns_between_half_the_limit_and_the_limit(monkeypatch):
+    case = load_case(PAPER / "case01-six.toml")
+    est = budget.estimate(case)
+    monkeypatch.setenv(budget.ENV_MAX_MEMORY, f"{est.memory * 1.2:.0f}")
+    r = cli("check", str(PAPER / "case01-six.toml"))
+    out = " ".join(r.output.split())
+    assert r.exit_code == 0 and "warning: run needs about" in out and "ok " in out
+    monkeypatch.setenv(budget.ENV_MAX_MEMORY, f"{est.memory * 0.8:.0f}")
+    r = cli("check", str(PAPER / "case01-six.toml"))
+    assert r.exit_code == 2 and "above the memory limit" in r.output
+
+
+def test_batch_task_above_the_limit_fails_only_that_case(tmp_path, monkeypatch):
+    monkeypatch.setenv(budget.ENV_MAX_MEMORY, "1MB")  # restored after the test (the option sets it too)
+    r = cli("batch", str(PAPER / "case01-single.toml"), "-j", "1", "--json-dir", str(tmp_path / "res"),
+            "--max-memory", "1MB")
+    assert r.exit_code == 1 and "above the memory limit of 1 MB" in " ".join(r.output.split())
+    assert not list((tmp_path / "res").glob("*.json"))

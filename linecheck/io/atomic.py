@@ -8,6 +8,7 @@ true.
 from __future__ import annotations
 
 import contextlib
+import glob
 import os
 import stat
 import tempfile
@@ -30,7 +31,7 @@ def clean_stale_temporaries(path: str | Path) -> list[Path]:
     parent = p.parent if str(p.parent) else Path(".")
     removed = []
     try:
-        candidates = list(parent.glob(f".{glob_escape(p.name)}.*.tmp"))
+        candidates = list(parent.glob(f".{glob.escape(p.name)}.*.tmp"))
     except OSError:
         return removed
     for tmp in candidates:
@@ -41,13 +42,6 @@ def clean_stale_temporaries(path: str | Path) -> list[Path]:
                 tmp.unlink()
                 removed.append(tmp)
     return removed
-
-
-def glob_escape(name: str) -> str:
-    """``name`` with glob metacharacters escaped (``[``, ``*``, ``?``)."""
-    import glob
-
-    return glob.escape(name)
 
 
 def check_target(path: str | Path, *, force: bool = True, what: str = "output") -> Path:

@@ -69,9 +69,12 @@ class Estimate:
     dominant: str  # what drives the memory
 
     def text(self) -> str:
+        sizes = [f"{self.n_dof} DOF", f"{self.mean_states} mean state(s)"]
+        if self.n_steps:
+            sizes[1:1] = [f"{self.realizations} realization(s)"] if self.job == "run" else []
+            sizes.insert(0, f"{self.n_steps} steps")
         return (f"{self.job} needs about {fmt_bytes(self.memory)} of memory and {fmt_seconds(self.seconds)} "
-                f"({self.dominant}; {self.n_steps} steps, {self.n_dof} DOF, {self.realizations} realization(s), "
-                f"{self.mean_states} mean state(s))")
+                f"({self.dominant}; {', '.join(sizes)})")
 
 
 def fmt_bytes(n: float) -> str:

@@ -15,6 +15,7 @@ CORE_MODULES = [
     "linecheck.core.damping",
     "linecheck.core.results",
     "linecheck.core.modes",
+    "linecheck.core.budget",
     "linecheck.core.spectral",
     "linecheck.core.wind.mean",
     "linecheck.core.wind.turbulence",

@@ -47,25 +47,34 @@ def cont_r_flags(doc: dict[str, Any]) -> list[str]:
 
 
 # --------------------------------------------------------------------------- compare
+# Relative differences only from a pinned value of this many of the table's last shown digits
+# (0.1 kN for forces, 0.1 for ratios); below it the relative change of a value about zero
+# (e.g. Rx of a symmetric case, 1e-12 kN) is meaningless and Δ is the absolute difference.
+REL_FLOOR_DIGITS = 100
+
+
 def _delta(a: float | None, b: float | None, stat: Stat) -> str:
-    """Change from ``a`` to ``b``: relative (%), or in percentage points for Cont_*;
-    empty when undefined or when both values show as zero at the table's precision."""
+    """Change from ``a`` to ``b``: relative (%) when ``|a|`` is at least the floor, else
+    absolute in the row's unit ("+0.012 kN"); in percentage points for Cont_*; empty when
+    undefined or when both values show as zero at the table's precision."""
     if a is None or b is None:
         return ""
     if stat.unit == "%":  # contributions: difference in percentage points
         return f"{(b - a) * stat.scale:+.1f} pp"
-    shown_zero = 0.5 * 10.0 ** -int(stat.fmt[-3])  # "{:.3f}" -> 0.0005
-    if abs(a * stat.scale) < shown_zero and abs(b * stat.scale) < shown_zero:
+    digit = 10.0 ** -int(stat.fmt[-3])  # "{:.3f}" -> 0.001, in display units
+    if abs(a * stat.scale) < 0.5 * digit and abs(b * stat.scale) < 0.5 * digit:
         return ""
-    if a == 0:
-        return "new"
+    if abs(a * stat.scale) < REL_FLOOR_DIGITS * digit:
+        unit = "" if stat.unit in ("-", "") else f" {stat.unit}"
+        return stat.fmt.replace("{:", "{:+").format((b - a) * stat.scale) + unit
     return f"{(b - a) / abs(a) * 100:+.1f} %"
 
 
 def compare_rows(pinned: dict[str, Any], current: dict[str, Any]) -> list[tuple[str, ...]]:
     """Rows ``(reaction, statistic, unit, pinned, current, Δ)``, grouped by reaction.
 
-    Δ is relative (%) for forces and ratios, in percentage points for Cont_*.
+    Δ is relative (%) for forces and ratios, absolute below :data:`REL_FLOOR_DIGITS`
+    of the shown precision, in percentage points for Cont_*.
     """
     na, nb = int(pinned.get("realizations", 1)), int(current.get("realizations", 1))
     rows = []

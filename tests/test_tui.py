@@ -31,6 +31,8 @@ from linecheck.tui import messages as msg  # noqa: E402
 from linecheck.tui.app import LinecheckApp  # noqa: E402
 from linecheck.tui.commands import LinecheckCommands  # noqa: E402
 from linecheck.tui.plotting import PlotView  # noqa: E402
+from linecheck.tui.widgets.browser import CaseBrowser  # noqa: E402
+from linecheck.tui.screens.confirm import ConfirmScreen  # noqa: E402
 from linecheck.tui.screens.error import ErrorScreen  # noqa: E402
 from linecheck.tui.screens.help import HelpScreen  # noqa: E402
 from linecheck.tui.screens.prompt import PathPrompt  # noqa: E402
@@ -415,3 +417,137 @@ async def test_run_errors_open_a_dialog_not_a_crash(short_case: Path, monkeypatc
             assert not app.running
         assert [m.title for m in of_type(messages, msg.RunFailed)] == ["Numerical failure", "Unexpected error"]
         assert "non-finite" in of_type(messages, msg.RunFailed)[0].message
+
+
+# --------------------------------------------------------------------------- issue 14
+async def test_switching_case_with_unsaved_edits_asks(short_case: Path) -> None:
+    other = write_case(short_case.parent, "case09-single.toml", "other", **{"analysis.duration": 20.0})
+    messages = Recorder()
+    app = LinecheckApp([short_case.parent])
+    async with app.run_test(size=SIZE, message_hook=messages) as pilot:
+        app.open_case(short_case)
+        await wait_for(pilot, lambda: app.case is not None, "the case", messages)
+        await edit(pilot, app, "wind.v_ref", "31")
+        edited = app.case
+        assert edited.wind.v_ref == 31.0 and app.edited
+
+        def asking() -> bool:  # the dialog on screen, composed
+            return isinstance(app.screen, ConfirmScreen) and bool(app.screen.query("#confirm-message"))
+
+        # from the browser (tab 1, enter on the other case) and from the palette: a question
+        for how in ("browser", "palette"):
+            if how == "browser":
+                await pilot.press("1")
+                app.query_one(CaseBrowser).select_path(other)
+                await pilot.press("enter")
+            else:
+                dict((c.name, c) for c in LinecheckCommands(app.screen)._commands())["case: open other"].callback()
+            await wait_for(pilot, asking, f"the question ({how})", messages)
+            assert "wind.v_ref" in str(app.screen.query_one("#confirm-message", Static).render())
+            await pilot.press("enter")  # the focus starts on "keep editing": enter alone keeps the edits
+            await wait_for(pilot, lambda: not isinstance(app.screen, ConfirmScreen), "the dialog closed", messages)
+            assert app.case is edited and app.case.name == "short" and app.edited
+        assert not [m for m in of_type(messages, msg.CaseOpened) if m.case.name == "other"]
+
+        # y discards them and opens the other case; the last run's status is not kept either
+        await pilot.press("1")
+        app.query_one(CaseBrowser).select_path(other)
+        await pilot.press("enter")
+        await wait_for(pilot, asking, "the question", messages)
+        await pilot.press("y")
+        await wait_for(pilot, lambda: app.case is not None and app.case.name == "other", "the other case", messages)
+        assert not app.edited and app.sub_title == "other"
+        assert "opened other" in str(app.query_one("#run-status", Static).render())
+
+        # without edits: no question
+        app.open_case(short_case)
+        await wait_for(pilot, lambda: app.case.name == "short", "the case, unasked", messages)
+        assert not isinstance(app.screen, ConfirmScreen)
+
+
+async def test_compare_with_a_zero_pinned_value_shows_the_absolute_difference(short_case: Path) -> None:
+    import copy
+    import dataclasses
+
+    messages = Recorder()
+    app = LinecheckApp([short_case])
+    async with app.run_test(size=SIZE, message_hook=messages) as pilot:
+        await wait_for(pilot, lambda: app.case is not None, "the case", messages)
+        await pilot.press("r")
+        await wait_for(pilot, lambda: of_type(messages, msg.RunFinished), "RunFinished", messages)
+        first = app.output
+        # a pinned peak about zero (as a symmetric case gives: 1e-13 N), beside a real one
+        doc = copy.deepcopy(first.doc)
+        doc["reactions"]["Ry"]["peak_dynamic"]["mean"] = 1e-13
+        app.output = dataclasses.replace(first, doc=doc)
+        await pilot.press("p")
+        await edit(pilot, app, "wind.v_ref", "25")
+        await pilot.press("r")
+        await wait_for(pilot, lambda: len(of_type(messages, msg.RunFinished)) == 2, "second RunFinished", messages)
+        await pilot.pause()
+        current = app.output.doc["reactions"]
+        table = app.query_one("#compare-table", DataTable)
+        rows = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
+        reaction = ""
+        by_key = {}
+        for row in rows:
+            reaction = row[0] or reaction
+            by_key[reaction, row[1]] = row
+        # the absolute difference in kN, not (0.14 kN - 1e-13 N) / 1e-13 N = +1e17 %
+        b = current["Ry"]["peak_dynamic"]["mean"]
+        assert b > 10.0  # a real peak [N]: a relative change would be astronomically large
+        assert by_key["Ry", "peak dynamic M+B+R"][5] == f"{(b - 1e-13) / 1e3:+.3f} kN"
+        # a value well above the floor keeps the relative difference, computed here from the JSON
+        a, b = first.doc["reactions"]["Rx"]["mean_max"]["mean"], current["Rx"]["mean_max"]["mean"]
+        assert by_key["Rx", "mean max"][5] == f"{(b - a) / abs(a) * 100:+.1f} %"
+        assert not any("e+" in row[5] for row in rows)
+
+
+async def test_save_as_never_proposes_a_shipped_case_folder(tmp_path: Path, monkeypatch) -> None:
+    shipped = ROOT / "cases" / "paper"
+    before = sorted(p.name for p in shipped.iterdir())
+    messages = Recorder()
+    app = LinecheckApp([shipped / "case10-single.toml"])
+    async with app.run_test(size=SIZE, message_hook=messages) as pilot:
+        await wait_for(pilot, lambda: app.case is not None, "the case", messages)
+        await edit(pilot, app, "wind.v_ref", "30")
+        for cwd in (tmp_path, shipped):  # even when started inside cases/paper/
+            monkeypatch.chdir(cwd)
+            await pilot.press("s")
+            await wait_for(pilot, lambda: isinstance(app.screen, PathPrompt), "the save dialog", messages)
+            proposed = Path(app.screen.query_one(Input).value).resolve()
+            assert not proposed.is_relative_to(ROOT / "cases"), proposed
+            if cwd == tmp_path:
+                assert proposed.parent == tmp_path
+            await pilot.press("escape")
+            await wait_for(pilot, lambda: not isinstance(app.screen, PathPrompt), "the dialog closed", messages)
+
+        # typed into cases/paper/: a warning and a second enter needed; esc writes nothing
+        await pilot.press("s")
+        await wait_for(pilot, lambda: isinstance(app.screen, PathPrompt), "the save dialog", messages)
+        prompt = app.screen
+        prompt.query_one(Input).value = str(shipped / "case10-single-edited.toml")
+        await pilot.press("enter")
+        await pilot.pause()
+        assert app.screen is prompt
+        assert "shipped case folder" in str(prompt.query_one("#prompt-message", Static).render())
+        await pilot.press("escape")
+        await wait_for(pilot, lambda: not isinstance(app.screen, PathPrompt), "the dialog closed", messages)
+        assert not of_type(messages, msg.Exported)
+    assert sorted(p.name for p in shipped.iterdir()) == before
+
+
+async def test_replace_checkbox_shows_x_only_when_ticked(short_case: Path) -> None:
+    from linecheck.tui.screens.prompt import TickBox
+
+    app = LinecheckApp([short_case])
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_for(pilot, lambda: app.case is not None, "the case")
+        await pilot.press("s")
+        await wait_for(pilot, lambda: isinstance(app.screen, PathPrompt) and bool(app.screen.query(TickBox)),
+                       "the save dialog")
+        box = app.screen.query_one(TickBox)
+        assert not box.value and box._button.plain == "▐ ▌"
+        await pilot.press("tab", "space")  # as a user ticks it
+        await pilot.pause()
+        assert box.value and box._button.plain == "▐X▌"

@@ -236,8 +236,7 @@ class LinecheckApp(App[None]):
         case = self.case
         if case is None:
             return
-        folder = case.source.parent if case.source is not None else Path.cwd()
-        default = files.free_path(folder / f"{case.name}-edited.toml")
+        default = files.save_as_default(case.name)  # the working directory, not cases/paper/
 
         def done(answer: tuple[Path, bool] | None) -> None:
             if answer is None or self.case is None:
@@ -257,7 +256,8 @@ class LinecheckApp(App[None]):
             self.query_one(CaseBrowser).reload(self.catalog)
             self.open_case(path, discard=True)  # the edits are in the saved file
 
-        self.push_screen(PathPrompt("Save the case as a new TOML file", default, ".toml"), done)
+        self.push_screen(PathPrompt("Save the case as a new TOML file", default, ".toml",
+                                    caution=files.in_shipped_folder), done)
 
     # ------------------------------------------------------------------ run
     def action_run(self) -> None:

@@ -13,6 +13,31 @@ from ..io.atomic import write_text_atomic
 from .formatting import case_differences
 
 
+def shipped_case_folders() -> list[Path]:
+    """The case folders shipped with linecheck (``cases/`` of the checkout the package runs
+    from): ``linecheck batch cases/paper/*.toml`` must find only the shipped cases there."""
+    folder = Path(__file__).resolve().parents[2] / "cases"
+    return [folder] if folder.is_dir() else []
+
+
+def in_shipped_folder(path: Path) -> str | None:
+    """A warning when ``path`` lies in a shipped case folder, else None."""
+    p = Path(path).expanduser().resolve()
+    for folder in shipped_case_folders():
+        if p.is_relative_to(folder):
+            return f"{p.parent} is a shipped case folder (batch cases/paper/*.toml would run this file)"
+    return None
+
+
+def save_as_default(name: str) -> Path:
+    """Where "save as" proposes to write an edited case: the working directory, never a shipped
+    case folder (the home directory when the working directory is one)."""
+    folder = Path.cwd()
+    if in_shipped_folder(folder / "x.toml"):
+        folder = Path.home()
+    return free_path(folder / f"{name}-edited.toml")
+
+
 def free_path(path: Path) -> Path:
     """``path``, or ``stem-2.ext``, ``stem-3.ext``... the first that does not exist."""
     if not path.exists():

@@ -16,6 +16,7 @@ class ConfirmScreen(ModalScreen[bool]):
     The focus starts on ``no``: enter alone never discards anything.
     """
 
+    AUTO_FOCUS = "#confirm-no"
     BINDINGS = [Binding("escape,n", "answer(False)", "No"), Binding("y", "answer(True)", "Yes")]
 
     def __init__(self, title: str, message: str, yes: str, no: str) -> None:
@@ -29,9 +30,6 @@ class ConfirmScreen(ModalScreen[bool]):
             with Horizontal(id="confirm-buttons"):
                 yield Button(f"{self.yes} (y)", variant="warning", id="confirm-yes")
                 yield Button(f"{self.no} (n, esc)", variant="primary", id="confirm-no")
-
-    def on_mount(self) -> None:
-        self.query_one("#confirm-no", Button).focus()
 
     def on_button_pressed(self, event: Button.Pressed) -> None:
         event.stop()

@@ -207,6 +207,9 @@ async def test_session_open_edit_run_tabs_export_compare(short_case: Path, tmp_p
 
         wb = openpyxl.load_workbook(xlsx)
         assert len(wb.sheetnames) >= 2
+        # the file's description speaks of Vref = 40 m/s: exported with the edit marked
+        marked = "Vref = 40 m/s, single span (paper case 9) (edited: wind.v_ref 40 → 30)"
+        assert any(marked in str(c.value) for ws in wb for row in ws.iter_rows() for c in row if c.value)
 
         out_json = tmp_path / "out" / "short.json"
         await pilot.press("j")
@@ -215,6 +218,7 @@ async def test_session_open_edit_run_tabs_export_compare(short_case: Path, tmp_p
         await pilot.press("enter")
         await wait_for(pilot, lambda: any(m.kind == "json" for m in of_type(messages, msg.Exported)), "json", messages)
         assert json.loads(out_json.read_text())["reactions"] == json.loads(json.dumps(expected["reactions"]))
+        assert json.loads(out_json.read_text())["description"].endswith(marked)
 
         # ---- compare: pin, change V_ref, run the variant
         await pilot.press("p")

@@ -75,6 +75,8 @@ class LinecheckApp(App[None]):
         self.case: Case | None = None
         self.original: Case | None = None
         self.output: runner.RunOutput | None = None
+        self.output_original: Case | None = None  # the file's case the output's case was edited from
+        self._run_original: Case | None = None
         self.pinned: runner.RunOutput | None = None
         self.running = False
         self._cancel: threading.Event | None = None
@@ -273,6 +275,7 @@ class LinecheckApp(App[None]):
             self.notify("Unapplied edit discarded (enter applies an edit).", severity="warning")
         self._cancel = threading.Event()
         self.running = True
+        self._run_original = self.original
         self.query_one(RunPanel).start(self.case)
         self.post_message(RunStarted(self.case))
         self.run_job(self.case, self._cancel)
@@ -331,7 +334,7 @@ class LinecheckApp(App[None]):
     def _finished(self, event: RunFinished) -> None:
         self._run_ended()
         out = event.output
-        self.output = out
+        self.output, self.output_original = out, self._run_original
         self.query_one(RunPanel).finish(f"done: {out.case.name} in {out.seconds:.1f} s - "
                                         "tab 3 Results ([ ] steps through its views), p pins for compare, x/j export")
         try:
@@ -372,7 +375,9 @@ class LinecheckApp(App[None]):
         if self.output is None:
             self.notify("Nothing to export yet: run a case first (r).", severity="warning")
             return
-        doc = self.output.doc
+        out = self.output
+        # an edited case's description is marked with the edits (it describes the file's values)
+        doc = files.doc_for_export(out.doc, out.case, self.output_original)
         default = files.free_path(Path(f"{doc['case']}{suffix}"))
 
         def done(answer: tuple[Path, bool] | None) -> None:

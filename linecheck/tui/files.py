@@ -68,6 +68,32 @@ def case_for_saving(case: Case, original: Case | None, path: Path) -> Case:
     return out
 
 
+def edit_note(case: Case, original: Case | None) -> str | None:
+    """``"edited: wind.v_ref 40 → 30, ..."`` for the value keys of ``case`` that differ from the
+    file it was opened from (None when none differ)."""
+    if original is None:
+        return None
+    edits = [f"{k} {a} → {b}" for k, a, b in case_differences(original, case) if k not in ("name", "description")]
+    return "edited: " + ", ".join(edits) if edits else None
+
+
+def doc_for_export(doc: dict[str, Any], case: Case, original: Case | None) -> dict[str, Any]:
+    """The run document as exported (Excel, JSON) from the TUI.
+
+    A case's description is free text written for the values of its file ("Vref = 40 m/s");
+    the TUI cannot re-derive it from new values.  So when value keys were edited and the
+    description was not, the exported description is marked with the edits
+    ("Vref = 40 m/s (edited: wind.v_ref 40 → 30)"); a description the user edited is theirs.
+    """
+    if original is None or case.description != original.description:
+        return doc
+    note = edit_note(case, original)
+    if note is None:
+        return doc
+    text = doc.get("description") or ""
+    return {**doc, "description": f"{text} ({note})" if text else note}
+
+
 def save_case(case: Case, path: Path, *, replace: bool) -> Path:
     """Write ``case`` as TOML (units as comments)."""
     return write_text_atomic(path, case_to_toml(case), force=replace, what="case")

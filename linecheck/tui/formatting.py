@@ -103,6 +103,18 @@ def iter_fields() -> list[tuple[str, FieldSpec]]:
     return out
 
 
+# keys that mean something for one wind type only (the other type's table hides them)
+ONLY_FOR = {"downburst": ("wind.downburst.", "analysis.mean_states"),
+            "synoptic": ("wind.span_speeds", "analysis.burn_in")}
+
+
+def fields_for(wind_type: str) -> list[tuple[str, FieldSpec]]:
+    """:func:`iter_fields` without the keys of the other wind type (a synoptic case does not
+    list the downburst keys)."""
+    hidden = tuple(p for t, prefixes in ONLY_FOR.items() if t != wind_type for p in prefixes)
+    return [(k, spec) for k, spec in iter_fields() if not k.startswith(hidden)]
+
+
 def get_value(case: Case, dotted: str) -> Any:
     """The value of ``dotted`` in ``case`` (``None`` when unset or derived)."""
     *path, key = dotted.split(".")

@@ -555,3 +555,22 @@ async def test_replace_checkbox_shows_x_only_when_ticked(short_case: Path) -> No
         await pilot.press("tab", "space")  # as a user ticks it
         await pilot.pause()
         assert box.value and box._button.plain == "▐X▌"
+
+
+async def test_parameter_table_lists_the_wind_types_keys_uncut(short_case: Path, tmp_path: Path) -> None:
+    six = write_case(tmp_path, "case01-six.toml", "six")
+    app = LinecheckApp([short_case.parent])
+    async with app.run_test(size=SIZE) as pilot:
+        table = app.query_one("#params-table", DataTable)
+        for path, shown, hidden in [(short_case, "wind.span_speeds", "wind.downburst.translation_direction"),
+                                    (six, "wind.downburst.translation_direction", "wind.span_speeds")]:
+            app.open_case(path, discard=True)
+            await wait_for(pilot, lambda: app.case is not None and app.case.source == path, "the case")
+            await pilot.pause()
+            keys = [table.coordinate_to_cell_key((i, 0)).row_key.value for i in range(table.row_count)]
+            assert shown in keys and hidden not in keys
+            if app.case.wind.type == "synoptic":
+                assert not [k for k in keys if k.startswith("wind.downburst.")]
+            # the longest key fits its column: the whole name is drawn
+            column = table.columns["parameter"]
+            assert column.width >= len("wind.downburst.translation_direction") >= max(len(k) for k in keys)

@@ -61,8 +61,9 @@ def short_case(tmp_path: Path) -> Path:
 
 
 # A bound that only guards against a hung test, never a verdict: the waits below end on a
-# message or a state change, however busy the machine.  600 s is ~100x the slowest wait seen on a
-# 2-core machine with both cores hogged by busy loops (tools/stress_tests.sh); reaching it means
+# message or a state change, however busy the machine.  The longest wait (a 20 s synoptic run)
+# takes about 1 s on an idle 2-core machine; this whole file took 440 s (12 tests) with both
+# cores hogged by tools/stress_tests.sh at load average 14: reaching 600 s in ONE wait means
 # the app is stuck, not slow.
 HANG_GUARD_S = 600.0
 

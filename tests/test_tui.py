@@ -575,3 +575,18 @@ async def test_parameter_table_lists_the_wind_types_keys_uncut(short_case: Path,
             # the longest key fits its column: the whole name is drawn
             column = table.columns["parameter"]
             assert column.width >= len("wind.downburst.translation_direction") >= max(len(k) for k in keys)
+
+
+def test_export_description_marks_edits_unless_the_user_rewrote_it() -> None:
+    from linecheck.tui.files import doc_for_export
+
+    original = load_case(ROOT / "cases" / "paper" / "case09-single.toml")
+    assert "Vref = 40 m/s" in original.description
+    doc = {"case": original.name, "description": original.description}
+    assert doc_for_export(doc, original, original) is doc  # not edited: as it is
+    edited = with_value(with_value(original, "wind.v_ref", 30.0), "line.sag", 12.0)
+    assert doc_for_export(doc, edited, original)["description"] == (
+        f"{original.description} (edited: line.sag {original.line.sag:g} → 12, wind.v_ref 40 → 30)")
+    rewritten = with_value(edited, "description", "my variant at 30 m/s")
+    own = {**doc, "description": rewritten.description}
+    assert doc_for_export(own, rewritten, original) is own  # the user's own words stay

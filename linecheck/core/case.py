@@ -95,7 +95,7 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         _f("span_length", "m", "span length L_x (equal spans)", required=True, low=10.0, high=3000.0),
         _f("sag", "m", "still-air mid-span sag S", required=True, low=0.0, high=None, low_open=True),
         _f("weight", "N/m", "conductor weight per unit length W", required=True, low=0.0, high=1000.0, low_open=True),
-        _f("diameter", "m", "projected area per unit length D (m2/m)", required=True, low=0.0, high=1.0, low_open=True),
+        _f("diameter", "m", "projected area per unit length D, i.e. the diameter of a single conductor (paper Table 1)", required=True, low=0.0, high=1.0, low_open=True),
         _f("drag_coefficient", "-", "drag coefficient C_d", default=1.0, low=0.0, high=3.0, low_open=True),
         _f("area", "m2", "conductor cross-section A", required=True, low=0.0, high=0.1, low_open=True),
         _f("elastic_modulus", "Pa", "elastic modulus E", required=True, low=1e8, high=1e12),
@@ -158,7 +158,7 @@ class Line:
     span_length: float  # [m]
     sag: float  # [m]
     weight: float  # [N/m]
-    diameter: float  # [m2/m]
+    diameter: float  # [m] (projected area per unit length, m2/m = m)
     drag_coefficient: float  # [-]
     area: float  # [m2]
     elastic_modulus: float  # [Pa]

@@ -10,7 +10,7 @@ from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.widgets import DataTable, RadioButton, RadioSet, Static, TabbedContent, TabPane
 
 from .. import figures
-from ..formatting import (REACTIONS, cont_r_flags, davenport_lines, sanity_rows, spectral_compare_rows, spectral_rows,
+from ..formatting import (CONT_R_FLAG, REACTIONS, cont_r_flags, davenport_lines, sanity_rows, spectral_compare_rows, spectral_rows,
                           summary_rows, summary_title)
 from ..plotting import PlotView
 from ..runner import RunOutput
@@ -125,16 +125,17 @@ class ResultsView(Vertical):
         for row in summary_rows(doc):
             cells = list(row)
             if row[0] == "Cont_R":
-                cells = [cells[0], cells[1]] + [Text(c, style="bold yellow") if r in flagged else c
-                                                for r, c in zip(REACTIONS, cells[2:])]
+                # flagged cells in reverse video: visible on the cursor row and the zebra stripes
+                cells = [Text(cells[0], style="bold yellow") if flagged else cells[0], cells[1]] + [
+                    Text(c, style="bold black on yellow") if r in flagged else c for r, c in zip(REACTIONS, cells[2:])]
             t.add_row(*cells, key=row[0])
         notes = Text()
         notes.append("Wind-induced reactions (still air removed) at the tower of interest; "
                      "** : GF undefined, mean zero by symmetry or < 1 % of the largest mean. "
                      "Cont_R: share of the peak a quasi-static analysis misses.", style="dim")
         if flagged:
-            notes.append(f"\nCont_R above 10 % for {', '.join(flagged)}: dynamic analysis recommended.",
-                         style="bold yellow")
+            notes.append(f"\nCont_R above {CONT_R_FLAG:.0%} for {', '.join(flagged)} (highlighted): "
+                         "dynamic analysis recommended.", style="bold yellow")
         sa = doc.get("still_air", {}).get("reactions", {})
         if sa:
             notes.append("\nstill air: " + ", ".join(f"{r} {v / 1e3:.3f} kN" for r, v in sa.items() if v is not None),

@@ -15,7 +15,17 @@ from ..io.atomic import check_target
 from ..io.display import SUMMARY_STATS, stat_text
 from ..io.jsonout import _num, run_to_dict, write_json
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
-from .export_cmd import ExcelOpt, ForceOpt, TemplateOpt
+from .export_cmd import (
+    EngineerOpt,
+    ExcelOpt,
+    ForceOpt,
+    LineOpt,
+    ProjectOpt,
+    RevisionOpt,
+    TemplateOpt,
+    TitleOpt,
+    title_block,
+)
 from .progress import progress_bar
 
 RealOpt = Annotated[int | None, typer.Option("--realizations", "-n", help="Number of realizations (overrides the case).", min=1)]
@@ -77,8 +87,14 @@ def run(
     template: TemplateOpt = None,
     force: ForceOpt = False,
     no_check: Annotated[bool, typer.Option("--no-check", help="Skip the frequency-domain sanity check of a synoptic case (long lines: its cost grows faster than the number of spans).")] = False,
+    project: ProjectOpt = None,
+    line: LineOpt = None,
+    engineer: EngineerOpt = None,
+    revision: RevisionOpt = None,
+    title: TitleOpt = None,
 ) -> None:
     """Steps 1-3: mean, background and resonant reactions, gust factors and contributions."""
+    fields = title_block(project, line, engineer, revision, title, excel=excel)
     case = override(read_case(case_file), realizations, seed)
     if json_out is not None:
         check_target(json_out, what="JSON")
@@ -104,7 +120,7 @@ def run(
     if excel is not None:
         from ..excel.writer import write_workbook
 
-        write_workbook([doc], excel, template=template, force=force)
+        write_workbook([doc], excel, template=template, force=force, title=fields or None)
         console.print(f"wrote {excel}")
 
 

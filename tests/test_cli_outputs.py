@@ -285,3 +285,100 @@ def test_title_options_are_the_same_on_all_three_and_checked_first(short_case, t
             assert res.exit_code == 2, (cmd, args, res.output)
             assert msg in _one_error_line(res)
     assert not called and not list(tmp_path.iterdir())
+
+
+# --------------------------------------------------------------------------- help and usage
+NEEDS_ARGUMENT = ["run", "batch", "export", "static", "check", "modes", "spectral", "wind", "scan"]
+
+
+@pytest.mark.parametrize("cmd", NEEDS_ARGUMENT + ["validate", "tui"])
+def test_missing_or_bad_arguments_are_one_line_exit_2(cmd):
+    # validate and tui need no argument (they would start working): only the unknown option for them
+    for args in ([cmd], [cmd, "--no-such-option"]) if cmd in NEEDS_ARGUMENT else ([cmd, "--no-such-option"],):
+        res = runner.invoke(app, args)
+        lines = [ln for ln in res.output.splitlines() if ln.strip()]
+        assert res.exit_code == 2, (args, res.output)
+        assert len(lines) == 1 and lines[0].startswith("error: "), (args, res.output)
+        assert f"linecheck {cmd} --help" in lines[0]
+        assert "╭" not in res.output and "Traceback" not in res.output
+
+
+def test_run_without_argument_names_it():
+    res = runner.invoke(app, ["run"])
+    assert res.exit_code == 2
+    assert res.output.strip() == ("error: Missing argument 'CASE_FILE'; usage: linecheck run [OPTIONS] {CASE_FILE} "
+                                  "(see linecheck run --help)")
+
+
+def test_flags_are_shown_without_a_value():
+    res = runner.invoke(app, ["run", "--help"], terminal_width=200)
+    for flag in ("--force", "--full-histories", "--no-check", "--help"):
+        line = next(ln for ln in res.output.splitlines() if f"{flag} " in ln)
+        assert "<bool>" not in line, line
+    line = next(ln for ln in res.output.splitlines() if "--json " in ln)
+    assert "<path>" in line  # an option with a value keeps its type
+    res = runner.invoke(app, ["export", "x.json", "--excel", "x.xlsx", "--force", "true"])
+    assert res.exit_code == 2  # --force takes no value: "true" is an extra argument, not a value
+
+
+def test_check_help_says_every_file_is_reported(tmp_path):
+    res = runner.invoke(app, ["check", "--help"], terminal_width=200)
+    assert "first bad file" not in res.output and "every bad file is reported" in res.output
+    bad1, bad2 = tmp_path / "a.toml", tmp_path / "b.toml"
+    bad1.write_text("name = 1\n")
+    bad2.write_text("[line\n")
+    res = runner.invoke(app, ["check", str(bad1), str(CASES / "paper" / "case10-single.toml"), str(bad2)])
+    assert res.exit_code == 2
+    assert str(bad1) in res.output and str(bad2) in res.output and "ok " in res.output
+
+
+def test_static_explains_the_star():
+    res = runner.invoke(app, ["static", str(CASES / "paper" / "case10-single.toml")])
+    assert res.exit_code == 0, res.output
+    assert "│   1 * │" in res.output
+    assert "* tower of interest (line.tower_of_interest = 1)" in res.output
+
+
+# --------------------------------------------------------------------------- run table, flags, burn-in note
+def test_run_table_fits_120_columns_and_flags_cont_r(doc):
+    from rich.console import Console
+
+    from linecheck.cli.run_cmd import CONT_R_FLAG, results_table
+
+    d = copy.deepcopy(doc)
+    d["realizations"] = 2  # two lines per row: mean and ± std
+    for r in ("Rx", "Ry", "Rz"):
+        for st in d["reactions"][r].values():
+            if isinstance(st, dict) and st.get("mean") is not None:
+                st["std"] = 0.1 * abs(st["mean"])
+    d["reactions"]["Rx"]["Cont_R"]["mean"] = CONT_R_FLAG + 0.05
+    d["reactions"]["Ry"]["Cont_R"]["mean"] = CONT_R_FLAG - 0.05
+    d["reactions"]["Rz"]["Cont_R"]["mean"] = 0.999  # Rz is not flagged (as in the Excel Summary)
+    con = Console(width=120, record=True, color_system="truecolor", force_terminal=True)
+    con.print(results_table(d))
+    text = con.export_text(clear=False)
+    assert "…" not in text
+    assert max(len(ln) for ln in text.splitlines()) <= 120
+    for header in ("peak QS", "peak Dy", "Cont_R", "GF_Dy", "rms R"):
+        assert header in text
+    styled = con.export_text(styles=True)
+    red_cells = [c.strip() for c in re.findall(r"\x1b\[1;31m([^\x1b]*)\x1b\[0m", styled)]
+    assert len(red_cells) == 2 and red_cells[0] == "15.0" and red_cells[1].startswith("±"), red_cells  # Rx only
+
+
+def test_run_output_legend_flag_and_burn_in_note_once(short_case):
+    res = runner.invoke(app, ["run", str(short_case)])
+    assert res.exit_code == 0, res.output
+    out = res.output
+    assert "Cont_R: share of the peak that a quasi-static analysis misses" in out
+    d = json.loads(json.dumps(run_to_dict(service.run_case(load_case(short_case)))))
+    from linecheck.cli.run_cmd import burn_in_note, cont_r_flagged
+
+    assert ("Cont_R above 10 %" in out) == any(cont_r_flagged(d, r) for r in ("Rx", "Ry"))
+    # the paper's damping: the burn-in is never reached; one line says what it means and what to do
+    assert d["damping"] == "paper" and not d["burn_in"]["sufficient"]
+    notes = [ln for ln in out.splitlines() if "burn-in" in ln]
+    assert len(notes) == 1, out
+    assert notes[0].startswith("note: damping = \"paper\" leaves the") and "use damping = \"quasi-steady\"" in notes[0]
+    assert "A flagged resonant component" not in out  # the note already says why, not twice
+    assert burn_in_note({**d, "burn_in": {**d["burn_in"], "sufficient": True}}) is None

@@ -317,8 +317,9 @@ def test_flags_are_shown_without_a_value():
         assert "<bool>" not in line, line
     line = next(ln for ln in res.output.splitlines() if "--json " in ln)
     assert "<path>" in line  # an option with a value keeps its type
-    res = runner.invoke(app, ["export", "x.json", "--excel", "x.xlsx", "--force", "true"])
-    assert res.exit_code == 2  # --force takes no value: "true" is an extra argument, not a value
+    res = runner.invoke(app, ["run", "case.toml", "--force", "true"])
+    assert res.exit_code == 2  # --force takes no value: "true" is a second (extra) argument
+    assert "unexpected extra argument(s) (true)" in res.output
 
 
 def test_check_help_says_every_file_is_reported(tmp_path):

@@ -9,6 +9,7 @@ import errno
 import json
 import os
 import re
+import sys
 import zipfile
 from pathlib import Path
 
@@ -144,22 +145,48 @@ def test_export_on_full_disk_is_exit_2_without_zipfile_traceback(doc, tmp_path, 
     xl.write_bytes(b"previous workbook")
     real_open = open
 
+    class FullDisk:
+        """A file that takes 1000 bytes, then fails every write with ENOSPC (as a full disk does)."""
+
+        def __init__(self, fh):
+            self._fh, self._n = fh, 0
+
+        def write(self, data):
+            self._n += len(data)
+            if self._n > 1000:
+                _enospc()
+            return self._fh.write(data)
+
+        def __getattr__(self, name):
+            return getattr(self._fh, name)
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            self._fh.close()
+
     def full_disk_open(file, mode="r", *a, **k):
         fh = real_open(file, mode, *a, **k)
         if "w" in mode and str(file).endswith(".tmp"):
-            fh.close()
-            _enospc()
+            return FullDisk(fh)
         return fh
 
+    unraisable = []  # what Python would print as "Exception ignored in: <ZipFile.__del__ ...>"
+    monkeypatch.setattr(sys, "unraisablehook", unraisable.append)
     monkeypatch.setattr("builtins.open", full_disk_open)
+    monkeypatch.setattr("io.open", full_disk_open)  # zipfile opens through io.open
     res = runner.invoke(app, ["export", str(js), "--excel", str(xl), "--force"])
-    monkeypatch.undo()
+    monkeypatch.setattr("builtins.open", real_open)
+    monkeypatch.setattr("io.open", real_open)
+    assert res.exit_code == 2, res.output
+    assert "no space left on device" in _one_error_line(res)
+    del res  # its exc_info keeps the failed frames (and any half-closed ZipFile) alive
     import gc
 
     gc.collect()  # a half-closed ZipFile would complain in its __del__ now
+    assert not unraisable, [(u.object, u.exc_value) for u in unraisable]
     err = capfd.readouterr().err
-    assert res.exit_code == 2, res.output
-    assert "no space left on device" in _one_error_line(res)
     assert "ZipFile" not in err and "Exception ignored" not in err
     assert xl.read_bytes() == b"previous workbook"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.xlsx", "r.json"]

@@ -337,12 +337,13 @@ def test_write_failure_leaves_nothing_half_written(light, tmp_path, monkeypatch)
     path = tmp_path / "keep.xlsx"
     path.write_bytes(b"old workbook")
 
-    def boom(self, filename):
-        Path(filename).write_bytes(b"partial")
+
+    def boom(src, dst):  # the disk fills up as the finished file is moved into place
+        Path(src).write_bytes(b"partial")
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(Workbook, "save", boom)
-    with pytest.raises(CaseError, match="cannot write Excel file: No space left on device"):
+    monkeypatch.setattr("linecheck.io.atomic.os.replace", boom)
+    with pytest.raises(CaseError, match="cannot write Excel file: no space left on device"):
         write_workbook(light, path, force=True)
     assert path.read_bytes() == b"old workbook"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.xlsx"]

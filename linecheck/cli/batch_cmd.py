@@ -21,6 +21,7 @@ from rich.table import Table
 from ..core.errors import CaseError
 from .app import CaseArg, app, console, err_console, handle_errors, read_case
 from .limits import MaxMemoryOpt, apply_max_memory
+from .export_cmd import EngineerOpt, LineOpt, ProjectOpt, RevisionOpt, TitleOpt, title_block
 
 JobsOpt = Annotated[int | None, typer.Option(
     "--jobs", "-j", help="Local worker processes (default: the number of cores; 1 runs in this process).",
@@ -72,12 +73,13 @@ def _check_excel(excel: Path | None, force: bool, template: Path | None) -> None
     check_excel_target(excel, force=force, template=template)
 
 
-def _write_excel(docs: list[dict[str, Any]], excel: Path, force: bool, template: Path | None) -> None:
+def _write_excel(docs: list[dict[str, Any]], excel: Path, force: bool, template: Path | None,
+                 title: dict[str, str] | None = None) -> None:
     try:
         from ..excel.writer import write_workbook
     except ImportError:
         raise CaseError("Excel output is not available in this installation (linecheck.excel missing)") from None
-    kwargs: dict[str, Any] = {"force": force}
+    kwargs: dict[str, Any] = {"force": force, "title": title or None}
     if template is not None:
         kwargs["template"] = template
     write_workbook(docs, excel, **kwargs)
@@ -172,12 +174,18 @@ def batch(
     template: BatchTemplateOpt = None,
     chunk: ChunkOpt = None,
     max_memory: MaxMemoryOpt = None,
+    project: ProjectOpt = None,
+    line: LineOpt = None,
+    engineer: EngineerOpt = None,
+    revision: RevisionOpt = None,
+    title: TitleOpt = None,
 ) -> None:
     """Run many cases (all realizations) in parallel, saving each result as it completes."""
     from ..batch import make_executor, run_batch
 
     apply_max_memory(max_memory)  # each task checks its memory estimate (workers inherit the limit)
 
+    fields = title_block(project, line, engineer, revision, title, excel=excel)
     paths = expand_cases(cases)
     _check_excel(excel, force, template)
     out_dir = json_dir if json_dir is not None else ((excel.parent if excel is not None else Path.cwd()) / "results")
@@ -195,7 +203,7 @@ def batch(
                           "run again with --resume to do the rest", highlight=False)
         raise typer.Exit(130)
     if excel is not None:
-        _write_excel(report.docs(), excel, force, template)
+        _write_excel(report.docs(), excel, force, template, fields)
         console.print(f"wrote {excel}")
     if report.failed:
         err_console.print(f"[bold red]error:[/] {len(report.failed)} case(s) failed: "

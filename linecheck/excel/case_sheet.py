@@ -25,6 +25,7 @@ from .cells import (
     Cursor,
     align,
     cell_value,
+    header_text,
     is_num,
     kn,
     link,
@@ -87,8 +88,8 @@ def write_case(ws: Worksheet, doc: dict, threshold: float, chart_points: int, su
     right = get_column_letter(CHART_COL + int(CHART_W / 1.75) + 1)
     ws.print_area = f"A1:{right}{max(last_table_row, bottom)}"
     page_setup(ws, summary)
-    ws.oddHeader.left.text = project
-    ws.oddHeader.right.text = str(doc["case"])
+    ws.oddHeader.left.text = header_text(project)
+    ws.oddHeader.right.text = header_text(doc["case"])
 
 
 def _inputs_table(cur: Cursor, doc: dict, params: dict) -> None:
@@ -408,7 +409,9 @@ def _spectral(cur: Cursor, doc: dict) -> None:
                 c.font = Font(name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT)
                 c.fill = PatternFill("solid", fgColor=tpl.FLAG_FILL)
             cur.row += 1
-        cur.note("FLAG: time and frequency domain differ by more than the sampling error of the realizations explains.")
+        if any(isinstance(it, dict) and not it.get("ok") for it in checks):
+            cur.note("FLAG: time and frequency domain differ by more than the sampling error of the realizations "
+                     "explains.")
     rest = {k: v for k, v in sp.items() if k not in done}
     if rest:
         cur.row += 1

@@ -648,7 +648,7 @@ def code_loads(case: Case, *, strict: bool = True) -> list:
         except CaseError as err:
             if strict:
                 raise
-            out.append(C.CodeLoad(code, C.EDITIONS[code], False, "none", None, {}, f"not applied: {err}"))
+            out.append(C.CodeLoad(code, C.EDITIONS[code], False, "synoptic", None, {}, f"not applied: {err}"))
     return out
 
 
@@ -678,7 +678,8 @@ def codes_analysis(case: Case, run: RunResult | None = None, *, strict: bool = T
         for j in range(n_spans + 1):
             peak = float(peaks[j]) if peaks is not None else None
             if load.load_per_length is None:
-                verdict = "outside the code's validity" if load.note.startswith("not applied") else "no provision"
+                verdict = {"none": "no provision", "not established": "provision not established"}.get(
+                    load.provision, "outside the code's validity")
                 rc = ReactionCheck(None, peak, None, verdict)
             else:
                 F = float(load.load_per_length * eq_span[j])

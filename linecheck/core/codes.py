@@ -58,7 +58,8 @@ class CodeLoad:
     Attributes:
         code: one of :data:`CODES`; edition: the edition implemented.
         verified: formula and constants confirmed against public sources (docs/codes.md).
-        provision: "synoptic" (the code's boundary-layer wind load) or "none".
+        provision: "synoptic" (the code's boundary-layer wind load), "none" (no provision for
+            the case's wind) or "not established" (a provision exists, its constants could not be).
         load_per_length: [N/m] transverse load per unit length of wind span (None: no provision).
         inputs: the code's inputs and intermediate factors (SI; names as in the code).
         note: one line on what was, or could not be, established.
@@ -318,6 +319,14 @@ DOWNBURST_NOTES = {
 }
 
 
+DOWNBURST_EDITIONS = {"ASCE74": "ASCE Manual 74, 4th ed. (2020), section 2.2.1",
+                      "ASNZS7000": "AS/NZS 7000:2016, Appendix B"}
+
+
 def downburst_load(code: str) -> CodeLoad:
-    """A code's entry for a downburst case: no synoptic factor is applied to a downburst."""
+    """A code's entry for a downburst case: no synoptic factor is applied to a downburst.
+    ``provision`` is "none" where the code has no downburst provision and "not established"
+    where it has one whose constants could not be obtained from public sources."""
+    if code in DOWNBURST_EDITIONS:
+        return CodeLoad(code, DOWNBURST_EDITIONS[code], False, "not established", None, {}, DOWNBURST_NOTES[code])
     return CodeLoad(code, EDITIONS[code], False, "none", None, {}, DOWNBURST_NOTES[code])

@@ -226,3 +226,21 @@ def test_cli_codes_exit_codes(tmp_path):
     r = CliRunner().invoke(app, ["codes", str(high), "--loads-only"])
     assert r.exit_code == 2
     assert "line.height" in r.output and "IEC60826" in r.output and "Traceback" not in r.output
+
+
+def test_excel_codes_sheet(short_run):
+    from openpyxl import Workbook
+
+    from linecheck.excel import template as tpl
+    from linecheck.excel.codes_sheet import write_codes
+    from linecheck.io.jsonout import run_to_dict
+
+    doc = json.loads(json.dumps(run_to_dict(short_run)))
+    wb = Workbook()
+    tpl.ensure_styles(wb)
+    ws = wb.active
+    assert write_codes(ws, [doc]) == 4 * 2  # four codes x two towers x Ry
+    rows = list(ws.iter_rows(min_row=4, max_row=11, values_only=True))
+    asce = doc["codes"]["ASCE74"]["towers"][0]["Ry"]
+    assert rows[0][1] == "ASCE74" and rows[0][4] == 1 and rows[0][5] == "Ry"
+    assert rows[0][6] == pytest.approx(asce["code_load"] / 1e3) and rows[0][9] == asce["verdict"]

@@ -244,3 +244,25 @@ def test_excel_codes_sheet(short_run):
     asce = doc["codes"]["ASCE74"]["towers"][0]["Ry"]
     assert rows[0][1] == "ASCE74" and rows[0][4] == 1 and rows[0][5] == "Ry"
     assert rows[0][6] == pytest.approx(asce["code_load"] / 1e3) and rows[0][9] == asce["verdict"]
+
+
+async def test_tui_codes_tab_shows_the_run_document(short_run):
+    from textual.widgets import DataTable, TabbedContent
+
+    from linecheck.io.jsonout import run_to_dict
+    from linecheck.tui.app import LinecheckApp
+    from linecheck.tui.widgets.codes import CodesView
+
+    doc = json.loads(json.dumps(run_to_dict(short_run)))
+    app = LinecheckApp([ROOT / "no-such-folder"])
+    async with app.run_test(size=(160, 50)) as pilot:
+        app.query_one(CodesView).show(doc)
+        await pilot.press("5")
+        await pilot.pause()
+        assert app.query_one("#main-tabs", TabbedContent).active == "codes"
+        table = app.query_one("#codes-table", DataTable)
+        assert table.row_count == 8
+        first = [str(c) for c in table.get_row_at(0)]
+        ry = doc["codes"]["ASCE74"]["towers"][0]["Ry"]
+        assert first[:4] == ["ASCE74", "yes", "1", "Ry"]
+        assert first[4] == f"{ry['code_load'] / 1e3:.3f}" and first[7] == ry["verdict"]

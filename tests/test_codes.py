@@ -90,7 +90,7 @@ def test_en_exposure_factor_reproduces_en1991():
     # EN 1991-1-4 Figure 4.2 (c_o = 1): exposure factor c_e(z) = (1 + 7 I_v) c_r^2; terrain II at
     # z = 10 m reads 2.35 (worked examples print c_r(10 m) = 1.00 and c_e = 2.35)
     cr, iv = C.en50341_profile(10.0, "II")
-    assert round(cr, 2) == 1.01 or round(cr, 2) == 1.00
+    assert cr == pytest.approx(1.00, abs=0.01)  # printed as 1.00 (0.19 ln 200 = 1.007)
     assert round((1 + 7 * iv) * cr**2, 2) == 2.35
     # below z_min the profile is constant (EN 1991-1-4 Eq. 4.4)
     assert C.en50341_profile(1.0, "IV") == C.en50341_profile(10.0, "IV")

@@ -48,9 +48,9 @@ def codes(
     case = read_case(case_file)
     if json_out is not None:
         check_target(json_out, what="JSON")
-    service.code_loads(case)  # validity limits first: a bad value fails before the run (exit 2)
+    loads = service.code_loads(case)  # validity limits first: a bad value fails before the run (exit 2)
     run = None
-    if not loads_only:
+    if not loads_only and any(x.load_per_length is not None for x in loads):  # nothing to compare: no run
         with progress_bar() as cb:
             run = service.run_case(case, spectral_check=False, progress=cb)
     res = service.codes_analysis(case, run)

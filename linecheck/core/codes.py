@@ -168,34 +168,44 @@ def asce74_wire_load(v_ref: float, height: float, span: float, diameter: float, 
 
 
 # --------------------------------------------------------------------------- IEC 60826
-IEC_TERRAIN = {  # category: (K_R [-], alpha [-], z_0 [m] of the stand-in gust model)
-    "A": (1.08, 0.12, 0.01),
-    "B": (1.00, 0.16, 0.05),
-    "C": (0.85, 0.22, 0.30),
-    "D": (0.67, 0.28, 1.00),
+# IEC 60826:2017 Table 5: terrain roughness exponent alpha and correction factor K_R of the
+# reference wind.  Confirmed against the public implementation of IEC 60826:2017 by C. K. C.
+# Arruda (CEPEL) used in the revision of ABNT NBR 5422, github.com/carloskleber/nbr5422,
+# iec/roughness.m ("Table 5"; commit 0520fb6): A 0.10/1.08, B 0.16/1.00, C 0.22/0.85, D 0.28/0.67.
+IEC_TERRAIN = {  # category: (K_R [-], alpha [-])
+    "A": (1.08, 0.10),
+    "B": (1.00, 0.16),
+    "C": (0.85, 0.22),
+    "D": (0.67, 0.28),
+}
+# Combined wind factor for conductors G_c(h) = a ln(h) + b (h >= 10 m): STAND-IN.  These are the
+# curve fits of ABNT NBR 5422:2024 section 8.5.2.3, Figure 16 / Table 10 (the Brazilian line
+# design standard, built on IEC 60826's method with the same K_R and 10-min reference wind),
+# as published in the same public implementation (normaslt/nbr5422.py, fatCombVentoCabo).
+# IEC 60826's own G_c figure could not be obtained from a public source; see docs/codes.md.
+IEC_GC_STANDIN = {  # category: (a [-], b [-])
+    "A": (0.2914, 1.0468),
+    "B": (0.3733, 0.9762),
+    "C": (0.4936, 0.9214),
+    "D": (0.6153, 0.8144),
 }
 IEC_AIR = 0.613  # [kg/m^3 / 2] 1/2 tau mu at 15 C, sea level (IEC 60826 6.2.6.1, tau = 1)
 
 
 def iec60826_span_factor(span: float) -> float:
-    """Span factor G_L [-] of IEC 60826 (Figure 5 / 2017 Table), as the cubic fit
-    G_L = 4e-10 L^3 - 5e-7 L^2 - 1e-4 L + 1.0403 of its curve (public implementation
-    "anguloBalanco", see docs/codes.md); L in [m]."""
+    """Span factor G_L [-] of IEC 60826 (span-factor figure), as the cubic fit
+    G_L = 4e-10 L^3 - 5e-7 L^2 - 1e-4 L + 1.0403 of its curve, valid for 200 m <= L <= 800 m
+    (public implementation github.com/carloskleber/nbr5422, normaslt/cigre.py, comment
+    "Coeficiente de efetividade - IEC 60826 / Valido entre 200 e 800 m"); L in [m]."""
     return 4e-10 * span**3 - 5e-7 * span**2 - 1e-4 * span + 1.0403
 
 
 def iec60826_combined_factor(height: float, terrain: str) -> float:
-    """Combined wind factor G_c [-] for conductors.  STAND-IN, not the code's figure: the
-    code's G_c values could not be obtained from public sources, so linecheck uses the code's
-    power-law mean profile times a span-averaged peak pressure factor for the code's
-    reference span of 200 m (where G_L = 1), in the form of EN 50341-1's structural factor:
-    G_c ~ (h/10)^(2 alpha) (1 + 2 k_p I_v(h) sqrt(B^2(200 m))), I_v and B^2 as in
-    :func:`en50341_structural_factor` with the terrain's z_0.  Unverified."""
-    _, alpha, z0 = IEC_TERRAIN[terrain]
-    iv = 1.0 / math.log(height / z0)
-    lh = 300.0 * (height / 200.0) ** (0.67 + 0.05 * math.log(z0))
-    b2 = 1.0 / (1.0 + 1.5 * 200.0 / lh)
-    return (height / 10.0) ** (2 * alpha) * (1.0 + 2.0 * EN_KP * iv * math.sqrt(b2))
+    """Combined wind factor G_c [-] for conductors at height h [m].  STAND-IN, not the code's
+    figure: ABNT NBR 5422:2024 Table 10, G_c = a ln(h) + b (h clamped below at 10 m, as there),
+    see :data:`IEC_GC_STANDIN`.  Unverified for IEC 60826."""
+    a, b = IEC_GC_STANDIN[terrain]
+    return a * math.log(max(height, 10.0)) + b
 
 
 def iec60826_conductor_load(v_ref: float, height: float, span: float, diameter: float, drag: float = 1.0,
@@ -203,21 +213,23 @@ def iec60826_conductor_load(v_ref: float, height: float, span: float, diameter: 
     """IEC 60826 6.2.6.1: A_c = q_0 C_xc G_c G_L d L sin^2(Omega) (per unit L, Omega = 90 deg), with
     q_0 = 1/2 tau mu (K_R V_RB)^2 and V_RB the 10-min mean at 10 m in terrain B.
 
-    Reference wind: the code's mean profile V(h) = K_R V_RB (h/10)^alpha, inverted:
-    V_RB = v_ref / (K_R (h/10)^alpha).
+    Reference wind: the code's mean profile V(h) = K_R V_RB (h/10)^alpha (6.2.2-6.2.4, Table 5),
+    inverted: V_RB = v_ref / (K_R (h/10)^alpha).
     """
     _choice("IEC60826", "codes.iec60826_terrain", terrain, IEC60826_TERRAINS, source)
     _check("IEC60826", "line.height", height, 10.0, 60.0, "m", "conductor heights of the G_c factor", source)
-    _check("IEC60826", "line.span_length", span, 100.0, 800.0, "m", "spans of the G_L factor", source)
-    kr, alpha, _ = IEC_TERRAIN[terrain]
+    _check("IEC60826", "line.span_length", span, 200.0, 800.0, "m", "spans of the G_L curve fit", source)
+    kr, alpha = IEC_TERRAIN[terrain]
     v_rb = v_ref / (kr * (height / 10.0) ** alpha)
     q0 = IEC_AIR * (kr * v_rb) ** 2
     gc = iec60826_combined_factor(height, terrain)
     gl = iec60826_span_factor(span)
     w = q0 * drag * gc * gl * diameter
     inputs = {"terrain": terrain, "V_RB": v_rb, "K_R": kr, "alpha": alpha, "q0": q0, "G_c": gc, "G_L": gl,
+              "G_c_source": "stand-in: ABNT NBR 5422:2024 Table 10 (IEC 60826 figure not obtained)",
               "C_xc": drag, "d": diameter, "span": span, "height": height}
-    note = "G_c is a stand-in (code figure not obtained); G_L from a public fit of the code's curve"
+    note = ("K_R, alpha confirmed (IEC 60826:2017 Table 5, public implementation); G_L from a public fit of "
+            "the code's curve; G_c is a stand-in from NBR 5422:2024 (IEC's figure not obtained)")
     return CodeLoad("IEC60826", EDITIONS["IEC60826"], False, "synoptic", float(w), inputs, note)
 
 
@@ -230,7 +242,8 @@ EN_TERRAIN = {  # category: (z_0 [m], z_min [m])  EN 1991-1-4 Table 4.1
     "IV": (1.0, 10.0),
 }
 EN_RHO = 1.25  # [kg/m^3] EN 1991-1-4 4.5(1) recommended air density
-EN_KP = 3.0  # [-] peak factor k_p of the conductor structural factor (EN 50341-1:2012 4.4.1.2)
+EN_KP = 3.0  # [-] peak factor k_p of the conductor structural factor (EN 50341-1:2012 4.4.1.2, as recalled: NOT
+#               confirmed from a public source, see docs/codes.md)
 
 
 def en50341_profile(height: float, terrain: str) -> tuple[float, float]:

@@ -124,6 +124,21 @@ def test_en_exposure_factor_reproduces_en1991():
     assert C.en50341_profile(1.0, "IV") == C.en50341_profile(10.0, "IV")
 
 
+def test_en_peak_pressure_reproduces_public_worked_example():
+    # Public EN 1991-1-4 worked example (spreadsheet "Wind Load Euro",
+    # scribd.com/document/797462041/wind-load-Euro): terrain III, z = 7.02 m, v_b = 22 m/s,
+    # rho = 1.25 -> k_r = 0.215389, c_r = 0.68, v_m = 14.939 m/s, I_v = 0.31718482,
+    # q_p = 0.449 kN/m^2 (printed precision).  This is the q_p(h) part of EN 50341-1 4.4.1.2.
+    assert 0.19 * (C.EN_TERRAIN["III"][0] / 0.05) ** 0.07 == pytest.approx(0.215389, abs=5e-7)
+    cr, iv = C.en50341_profile(7.02, "III")
+    assert round(cr, 2) == 0.68
+    assert iv == pytest.approx(0.31718482, abs=5e-9)
+    assert round(22.0 * cr, 3) == 14.939
+    r = C.en50341_conductor_load(22.0 * cr, 7.02, 300.0, 0.022, 1.0, "III")
+    assert round(r.inputs["q_p"] / 1e3, 3) == 0.449
+    assert r.inputs["v_b"] == pytest.approx(22.0, rel=1e-12)
+
+
 def test_en_reference_wind_and_structural_factor():
     r = C.en50341_conductor_load(40.0, 43.0, 300.0, 0.022, 1.0, "II")
     assert r.inputs["c_r"] * r.inputs["v_b"] == pytest.approx(40.0, rel=1e-12)  # v_m(h) = v_ref

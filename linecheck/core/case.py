@@ -29,6 +29,7 @@ SUPPORT_TYPES = ("strain", "suspension")
 WIND_TYPES = ("synoptic", "downburst")
 DOWNBURST_PRESETS = ("Db_x", "Db_y")
 DAMPING_MODELS = ("quasi-steady", "paper")
+CODE_TERRAINS = ("sea", "open", "suburban", "urban")  # [codes] terrain (docs/codes.md)
 # Conductor self-damping assumed with the quasi-steady model (ratio at the lowest mean-state
 # mode, stiffness-proportional): it damps the axial modes that no aerodynamic model damps.
 DEFAULT_STRUCTURAL_DAMPING = 0.002
@@ -138,6 +139,12 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         _f("structural_damping", "-", 'structural (self-)damping ratio at the lowest mean-state mode (default: 0 with "paper", 0.002 with "quasi-steady")', low=0.0, high=0.2),
         _f("burn_in", "s", "synoptic: discarded start of the record (default: from the least-damped significant mode)", low=0.0, high=1e5),
     ),
+    "codes": (  # design-code comparison (issue 19, docs/codes.md)
+        FieldSpec("terrain", "choice", "-", 'terrain for the design codes: "sea", "open", "suburban" or "urban" (maps to each code\'s category)', default="open", choices=CODE_TERRAINS),
+        FieldSpec("asce74_exposure", "choice", "-", "ASCE 74 exposure category (default: from terrain)", choices=("B", "C", "D")),
+        FieldSpec("iec60826_terrain", "choice", "-", "IEC 60826 terrain category (default: from terrain)", choices=("A", "B", "C", "D")),
+        FieldSpec("en50341_terrain", "choice", "-", "EN 50341-1 / EN 1991-1-4 terrain category (default: from terrain)", choices=("0", "I", "II", "III", "IV")),
+    ),
 }
 
 
@@ -235,6 +242,16 @@ class Analysis:
 
 
 @dataclass(frozen=True)
+class Codes:
+    """Terrain of the design-code comparison (docs/codes.md); None = from ``terrain``."""
+
+    terrain: str = "open"
+    asce74_exposure: str | None = None
+    iec60826_terrain: str | None = None
+    en50341_terrain: str | None = None
+
+
+@dataclass(frozen=True)
 class Case:
     """One analysis case: a line section, a wind and the analysis settings."""
 
@@ -244,6 +261,7 @@ class Case:
     analysis: Analysis = field(default_factory=Analysis)
     description: str = ""
     source: Path | None = None
+    codes: Codes = field(default_factory=Codes)
 
     @property
     def g_yp(self) -> float:
@@ -258,7 +276,7 @@ class Case:
 
 GRAVITY = 9.81  # [m/s2], paper Eq. 8
 
-_SUBTABLES = {"": ("line", "wind", "analysis"), "wind": ("downburst",)}
+_SUBTABLES = {"": ("line", "wind", "analysis", "codes"), "wind": ("downburst",)}
 
 
 # --------------------------------------------------------------------------- loading
@@ -486,9 +504,10 @@ def case_from_dict(
     analysis = Analysis(**an_d)
     if analysis.duration is not None and analysis.time_step * 4 > analysis.duration:
         raise ctx.error("analysis", "time_step", f"value {analysis.time_step!r} is too large for duration {analysis.duration!r}: expected at most duration/4")
+    codes = Codes(**_read_section(data.get("codes", {}), "codes", ctx))
     name = top["name"] or default_name
     return Case(name=name, description=top["description"] or "", line=line, wind=wind, analysis=analysis,
-                source=Path(file) if file else None)
+                source=Path(file) if file else None, codes=codes)
 
 
 def _build_downburst(d: dict[str, Any], line: Line, ctx: _Ctx, base_dir: Path | None) -> Downburst:
@@ -629,6 +648,8 @@ def case_to_dict(case: Case) -> dict[str, Any]:
                 db.pop(k, None)
         doc["wind"]["downburst"] = db
     doc["analysis"] = pick(case.analysis, "analysis")
+    if case.codes != Codes():
+        doc["codes"] = pick(case.codes, "codes")
     return doc
 
 
@@ -656,7 +677,7 @@ def case_to_toml(case: Case) -> str:
                 lines.append(f"{spec.name} = {_toml_value(table[spec.name])}{unit}")
 
     emit("", doc)
-    for section in ("line", "wind", "wind.downburst", "analysis"):
+    for section in ("line", "wind", "wind.downburst", "analysis", "codes"):
         table = doc.get(section) if "." not in section else doc["wind"].get("downburst")
         if table is None:
             continue

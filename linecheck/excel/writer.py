@@ -230,6 +230,11 @@ def build_workbook(wb: Workbook, docs: list[dict], title: dict[str, Any], thresh
     for d, name in ok:
         ws = wb.create_sheet(name)
         write_case(ws, d, threshold, chart_points, summary, header_text, reactions)
+    if any(d.get("codes") for d, _ in ok):  # design codes (issue 19)
+        from .codes_sheet import write_codes
+
+        at = wb.sheetnames.index(peaks_name) + 1 if peaks_name in wb.sheetnames else None
+        write_codes(wb.create_sheet(sheet_name("Codes", taken), at), [d for d, _ in ok], summary)
     wb.active = wb.sheetnames.index(summary.title)
 
 

@@ -312,3 +312,27 @@ def test_paper_batch_pool_equals_sequential(tmp_path):
     assert r1.exit_code == r2.exit_code == 0
     for p in cases:
         assert (tmp_path / "a" / f"{p.stem}.json").read_bytes() == (tmp_path / "b" / f"{p.stem}.json").read_bytes()
+
+
+# --------------------------------------------------------------------------- faults (issue 14)
+def test_killed_worker_fails_only_the_case_it_held(short_cases, tmp_path, monkeypatch):
+    """An out-of-memory kill of one pool worker (SIGKILL, here by the test hook in the worker
+    running case09-single): the pool is replaced, the other cases -- running or pending --
+    are re-run and saved bit for bit; only the held case fails, with a message saying so."""
+    from linecheck.batch.tasks import KILL_HOOK_ENV
+
+    victim = short_cases[1]
+    monkeypatch.setenv(KILL_HOOK_ENV, victim.stem)  # inherited by the workers spawned below
+    out = tmp_path / "res"
+    with ProcessPool(2) as pool:
+        rep = run_batch(short_cases, executor=pool, json_dir=out, chunk_size=10)
+    monkeypatch.delenv(KILL_HOOK_ENV)
+    assert [o.status for o in rep.outcomes] == ["done", "failed", "done"]
+    err = rep.outcomes[1].error
+    assert err == f"worker died (killed by signal 9, SIGKILL: out of memory?) while running {rep.outcomes[1].name}"
+    assert rep.exit_code == 1
+    assert sorted(p.name for p in out.glob("*.json")) == sorted(f"{p.stem}.json" for p in (short_cases[0], short_cases[2]))
+    ref = run_batch([short_cases[0], short_cases[2]], json_dir=tmp_path / "ref")  # sequential, no kill
+    assert ref.exit_code == 0
+    for p in (short_cases[0], short_cases[2]):
+        assert (out / f"{p.stem}.json").read_bytes() == (tmp_path / "ref" / f"{p.stem}.json").read_bytes()

@@ -24,6 +24,8 @@ from __future__ import annotations
 import contextlib
 import multiprocessing
 import os
+import signal
+import threading
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor
@@ -31,7 +33,7 @@ from concurrent.futures import wait as futures_wait
 from typing import Any
 
 from ..core.errors import Cancelled, CaseError
-from .tasks import Failure, ignore_sigint, noop
+from .tasks import Failure, init_pool_worker, noop
 
 
 def default_jobs() -> int:
@@ -65,6 +67,22 @@ class Executor(ABC):
 
     def running(self, handle: Any) -> bool:
         return False
+
+    #: tasks accept ``report_key=`` and report start/progress through :meth:`reports`
+    reporting: bool = False
+
+    def reports(self) -> list[tuple]:
+        """Start/progress messages of the tasks received since the last call (see :attr:`reporting`)."""
+        return []
+
+    def broken(self) -> bool:
+        """True when the executor lost a worker and must be :meth:`restart`-ed to run more tasks."""
+        return False
+
+    def restart(self) -> dict[int, int]:
+        """Replace a broken executor's workers; returns ``{pid: exit code}`` of the workers that
+        died on their own (not stopped by the executor).  Only where :meth:`broken` can be true."""
+        raise NotImplementedError
 
     @abstractmethod
     def cancel(self, handles: Sequence[Any]) -> None:
@@ -167,16 +185,31 @@ class ProcessPool(Executor):
     Workers are started at once with the ``spawn`` method -- they never inherit the
     coordinator's threads (progress display, Dask) -- and with one BLAS thread each
     (:data:`WORKER_ENV`, unless set by the user).  Ctrl-C is left to the coordinator.
+    Workers exit when the coordinator dies (:func:`~.tasks.init_pool_worker`).
+
+    Tasks report their start (with the worker's pid) and progress on a queue
+    (:meth:`reports`).  When a worker dies (an out-of-memory kill, a crash) the pool is
+    *broken*: every unfinished task fails with ``BrokenProcessPool`` and the other workers
+    are stopped; :meth:`restart` starts a new pool and says which workers died on their
+    own, so the runner can fail only the tasks those held and re-run the others.
     """
 
     name = "process pool"
+    reporting = True
 
     def __init__(self, jobs: int | None = None) -> None:
         if jobs is not None and jobs < 1:
             raise CaseError(f"--jobs: value {jobs} is not allowed: expected an integer >= 1")
         self._jobs = jobs or default_jobs()
-        self._pool = ProcessPoolExecutor(max_workers=self._jobs, mp_context=multiprocessing.get_context("spawn"),
-                                         initializer=ignore_sigint)
+        self._start()
+
+    def _start(self) -> None:
+        ctx = multiprocessing.get_context("spawn")
+        self._queue = ctx.SimpleQueue()
+        # PR_SET_PDEATHSIG follows the thread that starts a worker: only from the main thread
+        pdeathsig = threading.current_thread() is threading.main_thread()
+        self._pool = ProcessPoolExecutor(max_workers=self._jobs, mp_context=ctx, initializer=init_pool_worker,
+                                         initargs=(self._queue, os.getpid(), pdeathsig))
         with _worker_environment():  # each submit starts one worker while none is idle
             for _ in range(self._jobs):
                 self._pool.submit(noop)
@@ -192,6 +225,14 @@ class ProcessPool(Executor):
         futures_wait(handles, timeout=timeout, return_when=FIRST_COMPLETED)
         return [i for i, f in enumerate(handles) if f.done()]
 
+    def reports(self) -> list[tuple]:
+        out = []
+        q = self._queue
+        with contextlib.suppress(OSError, EOFError, ValueError):
+            while not q.empty():
+                out.append(q.get())
+        return out
+
     def outcome(self, handle: Future) -> Any:
         if handle.cancelled():
             return Failure("Cancelled", "cancelled", 130)
@@ -202,6 +243,21 @@ class ProcessPool(Executor):
 
     def running(self, handle: Future) -> bool:
         return handle.running() or handle.done()
+
+    def broken(self) -> bool:
+        return bool(getattr(self._pool, "_broken", False))
+
+    def restart(self) -> dict[int, int]:
+        processes = dict(getattr(self._pool, "_processes", None) or {})
+        self._pool.shutdown(wait=True, cancel_futures=True)  # the broken pool stops and joins its workers
+        for p in processes.values():
+            p.join()
+        dead = {pid: p.exitcode for pid, p in processes.items()
+                if p.exitcode not in (0, None, -signal.SIGTERM)}  # SIGTERM: stopped by the pool itself
+        with contextlib.suppress(OSError):
+            self._queue.close()
+        self._start()
+        return dead
 
     def cancel(self, handles: Sequence[Future]) -> None:
         for f in handles:
@@ -219,6 +275,22 @@ class ProcessPool(Executor):
 
     def close(self) -> None:
         self._pool.shutdown(wait=True, cancel_futures=True)
+        with contextlib.suppress(OSError):
+            self._queue.close()
+
+
+def describe_exit(code: int | None) -> str:
+    """How a worker process ended, for messages: ``killed by signal 9, SIGKILL: out of memory?``."""
+    if code is None:
+        return "ended"
+    if code < 0:
+        try:
+            name = signal.Signals(-code).name
+        except ValueError:
+            name = "unknown signal"
+        hint = ": out of memory?" if -code == getattr(signal, "SIGKILL", 9) else ""
+        return f"killed by signal {-code}, {name}{hint}"
+    return f"exited with code {code}"
 
 
 # --------------------------------------------------------------------------- Dask

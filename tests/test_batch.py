@@ -336,3 +336,56 @@ def test_killed_worker_fails_only_the_case_it_held(short_cases, tmp_path, monkey
     assert ref.exit_code == 0
     for p in (short_cases[0], short_cases[2]):
         assert (out / f"{p.stem}.json").read_bytes() == (tmp_path / "ref" / f"{p.stem}.json").read_bytes()
+
+
+COORDINATOR = """
+import sys, time
+from multiprocessing import resource_tracker
+from linecheck.batch import ProcessPool
+
+if __name__ == "__main__":
+    pool = ProcessPool(2)
+    busy = pool.submit(time.sleep, 3600)  # one worker busy, one idle
+    pool.submit(int, 1).result()  # both workers up and running their initializer
+    print(*pool._pool._processes, resource_tracker._resource_tracker._pid, flush=True)
+    busy.result()
+"""
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "pidfd_open"), reason="waits on Linux pidfds")
+@pytest.mark.parametrize("sig", ["SIGKILL", "SIGTERM"])
+def test_workers_exit_when_the_coordinator_dies(sig):
+    """Kill the coordinating process: its pool workers (busy and idle) and the resource
+    tracker exit instead of waiting forever.  Waits on process-exit events (pidfds); the
+    120 s bound only stops a hang (the watchdog polls every second; PR_SET_PDEATHSIG is
+    immediate), it does not decide the outcome on a slow machine."""
+    import os
+    import select
+    import signal
+
+    proc = subprocess.Popen([sys.executable, "-c", COORDINATOR], stdout=subprocess.PIPE, text=True)
+    try:
+        line = proc.stdout.readline()
+        pids = [int(x) for x in line.split()]
+        assert len(pids) == 3, line  # two workers, the resource tracker
+        fds = []
+        for pid in pids:
+            try:
+                fds.append(os.pidfd_open(pid))
+            except ProcessLookupError:  # pragma: no cover - already gone
+                pass
+        proc.send_signal(getattr(signal, sig))
+        proc.wait()
+        try:
+            waiting = list(fds)
+            while waiting:
+                ready, _, _ = select.select(waiting, [], [], 120.0)
+                assert ready, f"processes still alive 120 s after the coordinator died: {pids}"
+                waiting = [fd for fd in waiting if fd not in ready]
+        finally:
+            for fd in fds:
+                os.close(fd)
+    finally:
+        if proc.poll() is None:  # pragma: no cover
+            proc.kill()
+            proc.wait()

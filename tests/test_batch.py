@@ -389,3 +389,59 @@ def test_workers_exit_when_the_coordinator_dies(sig):
         if proc.poll() is None:  # pragma: no cover
             proc.kill()
             proc.wait()
+
+
+@pytest.mark.parametrize("answer", [None, b"HTTP/1.1 400 Bad Request\r\n\r\n"], ids=["silent", "http"])
+def test_scheduler_that_never_handshakes_exits_2(short_cases, answer):
+    """A TCP peer on the loopback that accepts and stays silent (a hung process) or answers
+    something else (an HTTP server): one line, exit 2, after --connect-timeout.  The 120 s
+    bound of the subprocess only stops a hang (before the fix: > 120 s, or a 3 EiB
+    MemoryError); the verdict is the exit code and the message."""
+    import socket
+
+    with socket.socket() as srv:
+        srv.bind(("127.0.0.1", 0))
+        srv.listen(4)
+        port = srv.getsockname()[1]
+        stop = threading.Event()
+        conns = []
+
+        def serve() -> None:
+            srv.settimeout(0.2)
+            while not stop.is_set():
+                try:
+                    c, _ = srv.accept()
+                except OSError:
+                    continue
+                conns.append(c)
+                if answer is not None:
+                    c.sendall(answer)
+
+        t = threading.Thread(target=serve, daemon=True)
+        t.start()
+        try:
+            r = subprocess.run([sys.executable, "-c", "from linecheck.cli.app import main; main()", "batch", str(short_cases[0]), "--scheduler",
+                                f"tcp://127.0.0.1:{port}", "--connect-timeout", "1"],
+                               capture_output=True, text=True, timeout=120)
+        finally:
+            stop.set()
+            t.join()
+            for c in conns:
+                c.close()
+    assert r.returncode == 2, r.stderr
+    lines = (r.stdout + r.stderr).strip().splitlines()
+    assert len(lines) == 1, lines
+    if answer is None:
+        assert "no Dask handshake within 1 s" in lines[0] and f"tcp://127.0.0.1:{port}" in lines[0]
+    else:
+        assert "not a Dask handshake" in lines[0]
+
+
+def test_scheduler_address_schemes_are_checked():
+    for bad in ("tls://127.0.0.1:8786", "ucx://127.0.0.1:8786", "http://x", "inproc://x"):
+        with pytest.raises(CaseError, match=r"is not supported, expected an address like tcp://HOST:PORT"):
+            make_executor(None, bad)
+    with pytest.raises(CaseError, match="bad port"):
+        make_executor(None, "tcp://127.0.0.1:99999")
+    with pytest.raises(CaseError, match="--connect-timeout"):
+        make_executor(None, "tcp://127.0.0.1:8786", connect_timeout=0)

@@ -298,12 +298,130 @@ DASK_MISSING = ("--scheduler needs Dask distributed, which is not installed: "
                 "pip install 'linecheck[dask]' (or: pip install 'dask[distributed]')")
 
 
-def check_scheduler_address(address: str) -> str:
-    """Validate a scheduler address (``tcp://HOST:PORT``, ``tls://...``, ``inproc://...``)."""
+DEFAULT_CONNECT_TIMEOUT = 10.0  # [s] --connect-timeout: TCP connection, then the scheduler's handshake
+MAX_HANDSHAKE_BYTES = 1 << 20  # a Dask handshake is a few hundred bytes; more is not a Dask scheduler
+
+
+def check_scheduler_address(address: str) -> tuple[str, int]:
+    """Validate a scheduler address ``tcp://HOST:PORT`` (port default 8786); returns (host, port).
+
+    Only ``tcp://`` is accepted: ``tls://`` needs certificates this command cannot take,
+    ``ucx://``/``inproc://`` are not reachable from a separate process.
+    """
+    from urllib.parse import urlsplit
+
+    expected = "expected an address like tcp://HOST:PORT"
     scheme, sep, rest = address.partition("://")
     if not sep or not scheme or not rest:
-        raise CaseError(f"--scheduler: value {address!r} is not allowed: expected an address like tcp://HOST:PORT")
-    return address
+        raise CaseError(f"--scheduler: value {address!r} is not allowed: {expected}")
+    if scheme.lower() != "tcp":
+        raise CaseError(f"--scheduler: value {address!r} is not allowed: scheme {scheme}:// is not supported, "
+                        f"{expected}")
+    try:
+        parts = urlsplit(address)
+        host, port = parts.hostname, parts.port
+    except ValueError:
+        raise CaseError(f"--scheduler: value {address!r} is not allowed: bad port, {expected}") from None
+    if not host or parts.path not in ("", "/") or parts.query or parts.fragment or parts.username:
+        raise CaseError(f"--scheduler: value {address!r} is not allowed: {expected}")
+    return host, port if port is not None else 8786
+
+
+def check_connect_timeout(timeout: float) -> float:
+    if not (timeout > 0 and timeout <= 3600):
+        raise CaseError(f"--connect-timeout: value {timeout!r} is not allowed: expected seconds in (0, 3600]")
+    return float(timeout)
+
+
+def probe_scheduler(address: str, timeout: float = DEFAULT_CONNECT_TIMEOUT) -> None:
+    """Connect to a Dask scheduler and read its handshake, all within ``timeout`` [s].
+
+    A Dask scheduler speaks first: on a new connection it sends its handshake, a message
+    framed by an 8-byte little-endian length (distributed ``comm/tcp.py``).  A peer that
+    accepts and stays silent (a hung process, an HTTP server) or answers something else
+    would make ``distributed.Client`` wait without bound or try to allocate a huge buffer,
+    so it is refused here with a one-line CaseError (exit 2).
+    """
+    import socket
+    import struct
+    import time
+
+    host, port = check_scheduler_address(address)
+    where = f"--scheduler: {address}"
+    deadline = time.monotonic() + timeout
+    try:
+        sock = socket.create_connection((host, port), timeout=timeout)
+    except socket.timeout:
+        raise CaseError(f"{where}: no connection within {timeout:g} s (--connect-timeout)") from None
+    except socket.gaierror as exc:
+        raise CaseError(f"{where}: unknown host {host!r} ({exc.strerror})") from None
+    except OSError as exc:
+        raise CaseError(f"{where}: cannot connect: {exc.strerror or exc}") from None
+
+    def read(n: int) -> bytes:
+        buf = b""
+        while len(buf) < n:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                raise socket.timeout
+            sock.settimeout(left)
+            got = sock.recv(n - len(buf))
+            if not got:
+                raise ConnectionResetError("connection closed by the peer")
+            buf += got
+        return buf
+
+    try:
+        with sock:
+            (n,) = struct.unpack("<Q", read(8))
+            if not 0 < n <= MAX_HANDSHAKE_BYTES:
+                raise CaseError(f"{where}: the peer's answer is not a Dask handshake: is a Dask scheduler "
+                                "listening there?")
+            read(n)
+    except socket.timeout:
+        raise CaseError(f"{where}: connected, but no Dask handshake within {timeout:g} s (--connect-timeout): "
+                        "is a Dask scheduler listening there?") from None
+    except OSError as exc:
+        raise CaseError(f"{where}: connection lost during the Dask handshake: {exc.strerror or exc}") from None
+
+
+@contextlib.contextmanager
+def _quiet_unraisable() -> Iterator[None]:
+    """Swallow destructor noise (``Client.__del__`` of a client that failed to start)."""
+    import gc
+    import sys
+
+    old = sys.unraisablehook
+    sys.unraisablehook = lambda *_: None
+    try:
+        yield
+    finally:
+        gc.collect()
+        sys.unraisablehook = old
+
+
+def _open_client(distributed: Any, address: str, timeout: float) -> Any:
+    """``distributed.Client(address)`` with a bound on the whole start-up (``2 * timeout`` + 5 s)."""
+    box: dict[str, Any] = {}
+
+    def start() -> None:
+        try:
+            box["client"] = distributed.Client(address, timeout=timeout, set_as_default=False)
+        except BaseException as exc:  # noqa: BLE001 - reported below as one line
+            box["error"] = exc
+
+    with _quiet_unraisable():
+        t = threading.Thread(target=start, name="linecheck-dask-connect", daemon=True)
+        t.start()
+        t.join(2 * timeout + 5.0)
+        if t.is_alive():
+            raise CaseError(f"--scheduler: {address}: the Dask client did not start within "
+                            f"{2 * timeout + 5.0:g} s (--connect-timeout {timeout:g})")
+        if "error" in box:
+            exc = box["error"]
+            msg = " ".join(str(exc).split()) or type(exc).__name__
+            raise CaseError(f"--scheduler: cannot connect to the Dask scheduler at {address}: {msg}") from None
+    return box["client"]
 
 
 class DaskExecutor(Executor):
@@ -316,9 +434,11 @@ class DaskExecutor(Executor):
 
     name = "dask"
 
-    def __init__(self, address: str | None = None, *, client: Any = None, timeout: float = 10.0) -> None:
+    def __init__(self, address: str | None = None, *, client: Any = None,
+                 timeout: float = DEFAULT_CONNECT_TIMEOUT) -> None:
         if client is None and address is not None:
             check_scheduler_address(address)  # a usage error first, whether or not Dask is installed
+            check_connect_timeout(timeout)
         try:
             import distributed
         except ImportError:
@@ -328,11 +448,8 @@ class DaskExecutor(Executor):
         if client is None:
             if address is None:
                 raise CaseError("--scheduler: no address given")
-            check_scheduler_address(address)
-            try:
-                client = distributed.Client(address, timeout=timeout, set_as_default=False)
-            except (OSError, TimeoutError, ValueError) as exc:
-                raise CaseError(f"--scheduler: cannot connect to the Dask scheduler at {address}: {exc}") from None
+            probe_scheduler(address, timeout)  # bounded: a silent or foreign peer is refused here
+            client = _open_client(distributed, address, timeout)
         self.client = client
         self.address = address or getattr(client.scheduler, "address", "")
 
@@ -383,12 +500,13 @@ class DaskExecutor(Executor):
             self.client.close()
 
 
-def make_executor(jobs: int | None = None, scheduler: str | None = None) -> Executor:
-    """The executor for ``--jobs`` / ``--scheduler`` (CaseError for bad values)."""
+def make_executor(jobs: int | None = None, scheduler: str | None = None,
+                  connect_timeout: float = DEFAULT_CONNECT_TIMEOUT) -> Executor:
+    """The executor for ``--jobs`` / ``--scheduler`` / ``--connect-timeout`` (CaseError for bad values)."""
     if scheduler is not None:
         if jobs is not None:
             raise CaseError("--jobs and --scheduler cannot be combined: the cluster's workers set the parallelism")
-        return DaskExecutor(scheduler)
+        return DaskExecutor(scheduler, timeout=connect_timeout)
     if jobs is not None and jobs < 1:
         raise CaseError(f"--jobs: value {jobs} is not allowed: expected an integer >= 1")
     n = jobs or default_jobs()

@@ -27,6 +27,9 @@ JobsOpt = Annotated[int | None, typer.Option(
 SchedulerOpt = Annotated[str | None, typer.Option(
     "--scheduler", help="Run on a Dask distributed cluster at this address (tcp://HOST:PORT); "
                         "needs pip install 'linecheck\\[dask]'.", show_default=False)]
+ConnectTimeoutOpt = Annotated[float, typer.Option(
+    "--connect-timeout", help="With --scheduler: seconds allowed for the connection and the scheduler's handshake "
+                              "(each step; an unreachable or silent address exits 2).", min=0.001, max=3600.0)]
 BatchExcelOpt = Annotated[Path | None, typer.Option(
     "--excel", help="Also write the Excel design sheet (.xlsx) of all cases to this file.", show_default=False)]
 BatchTemplateOpt = Annotated[Path | None, typer.Option(
@@ -170,6 +173,7 @@ def batch(
     force: BatchForceOpt = False,
     template: BatchTemplateOpt = None,
     chunk: ChunkOpt = None,
+    connect_timeout: ConnectTimeoutOpt = 10.0,
 ) -> None:
     """Run many cases (all realizations) in parallel, saving each result as it completes."""
     from ..batch import make_executor, run_batch
@@ -178,7 +182,7 @@ def batch(
     _check_excel(excel, force, template)
     out_dir = json_dir if json_dir is not None else ((excel.parent if excel is not None else Path.cwd()) / "results")
     cancel = threading.Event()
-    with make_executor(jobs, scheduler) as executor, BatchDisplay() as display:
+    with make_executor(jobs, scheduler, connect_timeout) as executor, BatchDisplay() as display:
         report = run_batch(paths, executor=executor, json_dir=out_dir, resume=resume, chunk_size=chunk,
                            progress=display, cancel=cancel)
     console.print(summary_table(report))
@@ -252,6 +256,7 @@ def scan(
         show_default=False)] = None,
     jobs: JobsOpt = None,
     scheduler: SchedulerOpt = None,
+    connect_timeout: ConnectTimeoutOpt = 10.0,
 ) -> None:
     """Find the critical downburst configurations: step 1 over a grid of positions and sizes."""
     from ..batch import ScanGrid, make_executor, run_critical, run_scan, write_scan_csv
@@ -263,7 +268,7 @@ def scan(
     if csv_out is not None:
         check_target(csv_out, what="CSV")
     cancel = threading.Event()
-    with make_executor(jobs, scheduler) as executor:
+    with make_executor(jobs, scheduler, connect_timeout) as executor:
         try:
             with progress_bar() as cb:
                 result = run_scan(case_file, grid, executor=executor, hold=hold, progress=cb, cancel=cancel)

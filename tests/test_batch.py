@@ -445,3 +445,55 @@ def test_scheduler_address_schemes_are_checked():
         make_executor(None, "tcp://127.0.0.1:99999")
     with pytest.raises(CaseError, match="--connect-timeout"):
         make_executor(None, "tcp://127.0.0.1:8786", connect_timeout=0)
+
+
+def test_unwritable_results_folder_is_refused_before_computing(short_cases, tmp_path, monkeypatch):
+    """A read-only --json-dir is a usage error (exit 2) before any case runs.  As root, mode
+    0o555 does not stop writes, so the probe's file creation is made to fail as on a
+    read-only folder; the run_case spy shows nothing was computed."""
+    import errno
+    import tempfile
+
+    calls = []
+    monkeypatch.setattr(service, "run_case", lambda *a, **k: calls.append(1))
+    real_mkstemp = tempfile.mkstemp
+
+    def read_only(*a, **k):
+        if str(k.get("dir", "")).endswith("ro"):
+            raise PermissionError(errno.EACCES, "Permission denied")
+        return real_mkstemp(*a, **k)
+
+    monkeypatch.setattr(tempfile, "mkstemp", read_only)
+    r = runner.invoke(app, ["batch", str(short_cases[1]), "--jobs", "1", "--json-dir", str(tmp_path / "ro")])
+    assert r.exit_code == 2, r.output
+    assert "results folder is not writable: Permission denied" in r.output and str(tmp_path / "ro") in r.output
+    assert calls == []
+
+
+def test_disk_full_stops_with_exit_2_keeps_saved_results_and_prints_summary(short_cases, tmp_path, monkeypatch):
+    """ENOSPC while saving the second case (the JSON writer patched to raise it): exit 2 with
+    one clear error line, the first case's result kept, the summary printed."""
+    import errno
+
+    from linecheck.io import jsonout
+
+    real = jsonout.write_json
+    written = []
+
+    def full_disk(path, doc, **kw):
+        if written:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        written.append(path)
+        return real(path, doc, **kw)
+
+    monkeypatch.setattr(jsonout, "write_json", full_disk)
+    out = tmp_path / "res"
+    r = runner.invoke(app, ["batch", *map(str, short_cases), "--jobs", "1", "--json-dir", str(out)])
+    assert r.exit_code == 2, r.output
+    assert "batch summary" in r.output and "1 run, 0 skipped, 1 failed" in r.output
+    errors = [ln for ln in r.output.splitlines() if ln.startswith("error:")]
+    assert len(errors) == 1 and "No space left on device" in errors[0] and "--resume" in errors[0]
+    assert "1 result(s) saved" in errors[0]
+    assert [p.name for p in out.glob("*.json")] == [f"{short_cases[0].stem}.json"]
+    assert json.loads((out / f"{short_cases[0].stem}.json").read_text())["realizations"] == 3
+    assert "internal error" not in r.output

@@ -497,3 +497,73 @@ def test_disk_full_stops_with_exit_2_keeps_saved_results_and_prints_summary(shor
     assert [p.name for p in out.glob("*.json")] == [f"{short_cases[0].stem}.json"]
     assert json.loads((out / f"{short_cases[0].stem}.json").read_text())["realizations"] == 3
     assert "internal error" not in r.output
+
+
+def test_pool_progress_moves_within_a_chunk_per_realization(short_cases, pool):
+    """Workers report progress to the coordinator while a chunk runs: with one task of all 3
+    realizations, events arrive inside every realization (1.x, 2.x) before the result, and
+    the piped display prints plain progress lines from them."""
+    import io
+
+    from rich.console import Console
+
+    from linecheck.cli.batch_cmd import BatchDisplay
+
+    events: list[BatchEvent] = []
+    rep = run_batch([short_cases[0]], executor=pool, chunk_size=3, progress=events.append)
+    assert rep.exit_code == 0
+    kinds = [e.kind for e in events]
+    before = [e.overall_done for e in events[:kinds.index("case_done")] if e.kind == "case_progress"]
+    assert {int(d) for d in before if d < 3} >= {1, 2}, before  # at least once per realization
+    assert before == sorted(before) and before[-1] == 3
+    assert events[-1].cases_done == events[-1].cases_total == 1
+
+    buf = io.StringIO()
+    display = BatchDisplay(interval=0.0, live=False, console=Console(file=buf, width=200))
+    for ev in events:
+        display(ev)
+    lines = buf.getvalue().splitlines()
+    assert lines[0] == "batch: 1 case(s), 3 realizations on process pool (2 workers)"
+    progress = [ln for ln in lines if ln.startswith("progress: cases 0/1, realizations ")]
+    assert len(progress) >= 2 and all("elapsed 0:" in ln and "ETA " in ln for ln in progress)
+    assert lines[-1].startswith(f"done    {rep.outcomes[0].name}  [cases 1/1, realizations 3/3 (100 %)")
+
+
+def test_summary_flags_cont_r_and_failed_sanity_check(short_cases):
+    """Cont_R above 10 % and a failed time- vs frequency-domain check are marked in the
+    batch summary and explained below it; a clean result gets neither."""
+    import copy
+    import io
+
+    from rich.console import Console
+
+    from linecheck.batch import BatchReport
+    from linecheck.cli.batch_cmd import summary_notes, summary_table
+
+    clean = run_batch([short_cases[1]]).outcomes[0]  # synoptic: has the sanity check
+    assert clean.doc["spectral"]["sanity_check"], "synoptic results carry the sanity check"
+    flagged = copy.deepcopy(clean)
+    flagged.name = "flagged"
+    flagged.doc["reactions"]["Ry"]["Cont_R"]["mean"] = 0.25
+    flagged.doc["spectral"]["sanity_check"][0].update(reaction="Rz", quantity="rms_fluctuating", time_domain=176.0,
+                                                      frequency_domain=212.0, allowed_difference=20.0, ok=False)
+    for item in clean.doc["spectral"]["sanity_check"]:
+        item["ok"] = True
+    clean.doc["reactions"]["Ry"]["Cont_R"]["mean"] = 0.05
+    report = BatchReport([clean, flagged])
+
+    def render(obj) -> str:
+        buf = io.StringIO()
+        Console(file=buf, width=250).print(obj)
+        return buf.getvalue()
+
+    table = render(summary_table(report)).splitlines()
+    row = next(ln for ln in table if "flagged" in ln)
+    assert "25.0" in row and "Cont_R>10% Ry" in row and "t/f check" in row
+    clean_row = next(ln for ln in table if clean.name in ln)
+    assert "5.0" in clean_row and "Cont_R>10%" not in clean_row and "t/f" not in clean_row
+    notes = summary_notes(report)
+    assert len(notes) == 2
+    assert "dynamic analysis recommended" in notes[0]
+    assert "flagged: Rz fluctuating r.m.s. 0.176 vs 0.212 kN (allowed difference 0.020)" in notes[1]
+    assert summary_notes(BatchReport([clean])) == []

@@ -91,6 +91,10 @@ def _clock(seconds: float) -> str:
     return f"{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}"
 
 
+def _count(done: float, total: int) -> str:
+    return f"{done:.1f}/{total}" if done != int(done) else f"{int(done)}/{total}"
+
+
 class _Rate:
     """Elapsed time and ETA of a batch from its events (realizations done in this run)."""
 
@@ -110,7 +114,7 @@ class _Rate:
 
     def summary(self, ev: Any) -> str:
         pct = 100.0 * ev.overall_done / ev.overall_total if ev.overall_total else 100.0
-        return (f"cases {ev.cases_done}/{ev.cases_total}, realizations {ev.overall_done:.1f}/{ev.overall_total} "
+        return (f"cases {ev.cases_done}/{ev.cases_total}, realizations {_count(ev.overall_done, ev.overall_total)} "
                 f"({pct:.0f} %), elapsed {_clock(self.elapsed())}, ETA {self.eta(ev.overall_done, ev.overall_total)}")
 
 
@@ -147,7 +151,7 @@ class BatchDisplay:
         self.bars.__exit__(*exc)
 
     def _count(self, done: float, total: int) -> str:
-        return f"{done:.1f}/{total}" if done != int(done) else f"{int(done)}/{total}"
+        return _count(done, total)
 
     def _overall_count(self, ev: Any) -> str:
         return f"{ev.cases_done}/{ev.cases_total} cases, {self._count(ev.overall_done, ev.overall_total)} realizations"

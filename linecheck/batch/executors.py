@@ -9,7 +9,10 @@ All three share one small interface used by the batch and scan runners:
   when the task raised (a bug, a killed worker, a broken pool);
 - ``running(handle)`` -> best-effort "has started" flag (progress display only);
 - ``abort(handles)`` -> cancel what has not run and stop what is running;
-- ``close()``.
+- ``close()``;
+- process pool only (``reporting``): ``reports()`` -> start/progress messages sent by the
+  tasks from inside the workers; ``broken()``/``restart()`` -> a worker died, start a new
+  pool and learn which workers died on their own.
 
 The sequential executor runs one task per ``wait`` call in the calling process and
 passes it the batch's ``cancel`` event and a progress callback (``in_process``).

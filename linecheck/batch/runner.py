@@ -18,7 +18,13 @@ Contract:
   cases.  With ``resume`` a case whose saved JSON carries the same file hash is
   skipped and its saved document reused.
 - One failing case (bad file, non-convergence, any LinecheckError, a crashed worker)
-  is reported in its :class:`CaseOutcome`; the other cases complete.
+  is reported in its :class:`CaseOutcome`; the other cases complete.  When a process-pool
+  worker dies (out-of-memory kill), the pool is restarted (:meth:`Executor.restart`): the
+  tasks the dead worker held fail their case ("worker died (killed by signal 9, ...) while
+  running NAME"), every other unfinished task runs again -- same results, bit for bit.
+- The results folder is checked writable before anything runs (CaseError, exit 2).  A
+  result that cannot be written later (disk full) fails its case and stops the batch
+  (``report.output_error``, exit code 2); the results saved so far stay.
 - Progress goes to ``progress(event)`` (:class:`BatchEvent`, overall and per case);
   setting ``cancel`` (a :class:`threading.Event`) or Ctrl-C stops the batch after
   saving what is finished.

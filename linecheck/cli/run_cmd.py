@@ -18,6 +18,10 @@ from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .export_cmd import ExcelOpt, ForceOpt, TemplateOpt
 from .progress import progress_bar
 
+ModelsOpt = Annotated[str | None, typer.Option(
+    "--models", help='Downburst model spread: run the case under "all" built-in running-mean models '
+                     '(or a comma list, e.g. holmes-oliver,ring-jet) with the same turbulence seeds; '
+                     'adds a "models" block and the envelope.', show_default=False)]
 RealOpt = Annotated[int | None, typer.Option("--realizations", "-n", help="Number of realizations (overrides the case).", min=1)]
 SeedOpt = Annotated[int | None, typer.Option("--seed", help="Random seed (overrides the case).", min=0)]
 
@@ -45,6 +49,31 @@ def results_table(doc: dict) -> Table:
         t.add_column(f"{st.label} {st.unit}" if st.unit != "-" else st.label, justify="right")
     for r in REACTIONS:
         t.add_row(r, *(stat_text(doc["reactions"][r][st.key], st, n) for st in SUMMARY_STATS))
+    return t
+
+
+def models_table(doc: dict) -> Table:
+    """Rich table of the model spread (issue 15): one row per model and the envelope."""
+    by_key = {st.key: st for st in SUMMARY_STATS}
+    stat_by_key = by_key.__getitem__
+    n = doc["realizations"]
+    keys = ("mean_max", "peak_dynamic", "GF_Dy", "GF_QS", "peak_normalised")
+    t = Table(title=f"{doc['case']}: downburst model spread at tower {doc['tower_of_interest']}", title_justify="left")
+    t.add_column("model", justify="left", no_wrap=True)
+    for r in ("Rx", "Ry"):
+        for k in keys:
+            st = stat_by_key(k)
+            t.add_column(f"{r} {st.label}" + (f" {st.unit}" if st.unit != "-" else ""), justify="right")
+    for name, blk in doc["models"].items():
+        t.add_row(name, *(stat_text(blk[r][k], stat_by_key(k), n) for r in ("Rx", "Ry") for k in keys))
+    env = doc["models_envelope"]
+    cells = []
+    for r in ("Rx", "Ry"):
+        for k in keys:
+            e = env[r][k]
+            st = stat_by_key(k)
+            cells.append("" if e["value"] is None else f"{st.fmt.format(e['value'] * st.scale)} ({e['model']})")
+    t.add_row("[bold]envelope[/]", *cells)
     return t
 
 
@@ -77,6 +106,7 @@ def run(
     template: TemplateOpt = None,
     force: ForceOpt = False,
     no_check: Annotated[bool, typer.Option("--no-check", help="Skip the frequency-domain sanity check of a synoptic case (long lines: its cost grows faster than the number of spans).")] = False,
+    models: ModelsOpt = None,
 ) -> None:
     """Steps 1-3: mean, background and resonant reactions, gust factors and contributions."""
     case = override(read_case(case_file), realizations, seed)
@@ -86,10 +116,23 @@ def run(
         from ..excel.writer import check_excel_target
 
         check_excel_target(excel, force=force, template=template)
+    names = service.parse_models(case, models) if models is not None else ()
     with progress_bar() as cb:
-        res = service.run_case(case, progress=cb, spectral_check=not no_check)
+        if names:
+            spread = service.run_models(case, names, progress=cb, spectral_check=not no_check)
+            own = case.wind.downburst.model_name
+            res = spread[own] if own in spread else next(iter(spread.values()))
+        else:
+            res = service.run_case(case, progress=cb, spectral_check=not no_check)
     doc = run_to_dict(res, full_histories=full_histories)
+    if names:
+        from ..io.jsonout import models_block
+
+        doc["model"] = res.case.wind.downburst.model_name
+        doc.update(models_block(spread))
     console.print(results_table(doc))
+    if names:
+        console.print(models_table(doc))
     console.print("[dim]GF ** : mean reaction zero by symmetry (or < 1 % of the largest mean); "
                   "Cont_R = share of the peak that a quasi-static analysis misses.[/]")
     from .spectral_cmd import print_sanity

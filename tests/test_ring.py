@@ -183,3 +183,30 @@ def test_cli_bad_model_exits_2(tmp_path):
     assert r.exit_code == 2
     out = r.output.strip()
     assert len(out.splitlines()) == 1 and "wind.downburst" in out and '"ring-jet"' in out
+
+
+def test_run_models_cli_json_block(tmp_path):
+    """run --models all: a "models" block per built-in model with the statistics of "reactions";
+    the case's own model's block is its "reactions"; the envelope takes the largest magnitude."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from linecheck.cli.app import app
+    from linecheck.core.results import STATISTICS
+
+    out = tmp_path / "r.json"
+    r = CliRunner().invoke(app, ["run", str(CASES / "paper" / "case07-single.toml"), "-n", "1", "--models", "all",
+                                 "--json", str(out)])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(out.read_text())
+    assert list(doc["models"]) == ["holmes-oliver", "ring-jet"] and doc["model"] == "holmes-oliver"
+    assert doc["models"]["holmes-oliver"] == doc["reactions"]
+    assert set(doc["models"]["ring-jet"]["Ry"]) == set(STATISTICS)
+    for rn in ("Rx", "Ry"):
+        vals = {m: doc["models"][m][rn]["peak_dynamic"]["mean"] for m in doc["models"]}
+        e = doc["models_envelope"][rn]["peak_dynamic"]
+        assert e["value"] == max(vals.values(), key=abs) and vals[e["model"]] == e["value"]
+    assert doc["models"]["ring-jet"]["Ry"]["peak_dynamic"]["mean"] != doc["reactions"]["Ry"]["peak_dynamic"]["mean"]
+    bad = CliRunner().invoke(app, ["run", str(CASES / "paper" / "case07-single.toml"), "--models", "vortex"])
+    assert bad.exit_code == 2 and len(bad.output.strip().splitlines()) == 1

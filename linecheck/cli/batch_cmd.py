@@ -170,11 +170,20 @@ def batch(
     force: BatchForceOpt = False,
     template: BatchTemplateOpt = None,
     chunk: ChunkOpt = None,
+    models: Annotated[str | None, typer.Option(
+        "--models", help='Downburst model spread: run every case under "all" built-in running-mean models (or a '
+                         'comma list) with the same seeds; <stem>.<model>.json per run, <stem>.json with the '
+                         '"models" block and envelope.', show_default=False)] = None,
 ) -> None:
     """Run many cases (all realizations) in parallel, saving each result as it completes."""
     from ..batch import make_executor, run_batch
 
     paths = expand_cases(cases)
+    plan = None
+    if models is not None:
+        from ..batch.models import model_jobs
+
+        paths, plan = model_jobs(paths, models)
     _check_excel(excel, force, template)
     out_dir = json_dir if json_dir is not None else ((excel.parent if excel is not None else Path.cwd()) / "results")
     cancel = threading.Event()
@@ -190,8 +199,19 @@ def batch(
         err_console.print(f"[bold red]interrupted[/]: finished cases are saved in {out_dir}; "
                           "run again with --resume to do the rest", highlight=False)
         raise typer.Exit(130)
+    docs = report.docs()
+    if plan is not None:
+        from ..batch.models import combined_documents
+        from ..io.jsonout import write_json
+
+        docs = combined_documents(report, plan)
+        for path, doc in zip(plan, docs):
+            if "error" not in doc:
+                write_json(out_dir / f"{path.stem}.json", doc)
+        console.print(f"model spread: {len(docs)} case document(s) with a \"models\" block in {out_dir}",
+                      highlight=False)
     if excel is not None:
-        _write_excel(report.docs(), excel, force, template)
+        _write_excel(docs, excel, force, template)
         console.print(f"wrote {excel}")
     if report.failed:
         err_console.print(f"[bold red]error:[/] {len(report.failed)} case(s) failed: "

@@ -210,3 +210,19 @@ def test_run_models_cli_json_block(tmp_path):
     assert doc["models"]["ring-jet"]["Ry"]["peak_dynamic"]["mean"] != doc["reactions"]["Ry"]["peak_dynamic"]["mean"]
     bad = CliRunner().invoke(app, ["run", str(CASES / "paper" / "case07-single.toml"), "--models", "vortex"])
     assert bad.exit_code == 2 and len(bad.output.strip().splitlines()) == 1
+
+
+def test_scan_under_each_model_reports_its_critical_position():
+    from linecheck.batch import ScanGrid, run_scan
+
+    path = CASES / "paper" / "case07-single.toml"
+    case = load_case(path)
+    grid = ScanGrid.from_options(case, "0.8:1.6:0.4Dj", "0,30", None)
+    out = {m: run_scan(path, grid, model=m) for m in ("holmes-oliver", "ring-jet")}
+    for m, res in out.items():
+        assert res.model == m and res.n_failed == 0
+        assert {c.reaction for c in res.criticals(("Rx", "Ry"))} == {"Rx", "Ry"}
+    # the case's own model gives the scan without --models, bit for bit
+    np.testing.assert_array_equal(out["holmes-oliver"].peak, run_scan(path, grid).peak)
+    # and the other model is a different field
+    assert not np.array_equal(out["ring-jet"].peak, out["holmes-oliver"].peak)

@@ -223,8 +223,21 @@ def batch(
 PAPER_CRITICAL = {"Rx": ("Db_x", 1.6, 30.0), "Ry": ("Db_y", 1.2, 0.0)}  # paper Table 2 (El Damatty et al. 2013)
 
 
+def models_scan_table(results: list[Any]) -> Table:
+    """Critical configuration per downburst model (issue 15)."""
+    t = Table(title="critical configuration per downburst model", title_justify="left")
+    for col in ("model", "reaction", "R m", "R/D_j", "Θ deg", "D_j m", "max |mean| kN", "at t s"):
+        t.add_column(col, justify="right" if col not in ("model", "reaction") else "left")
+    for res in results:
+        for c in res.criticals(("Rx", "Ry")):
+            t.add_row(res.model or "", c.reaction, f"{c.distance:.0f}", f"{c.distance_over_dj:.2f}", f"{c.angle:g}",
+                      f"{c.jet_diameter:.0f}", f"{c.value / 1e3:.3f}", f"{c.time:.1f}")
+    return t
+
+
 def scan_table(result: Any) -> Table:
-    t = Table(title=f"{result.case.name}: critical downburst configurations "
+    model = escape(f" [{result.model}]") if getattr(result, "model", None) else ""
+    t = Table(title=f"{result.case.name}{model}: critical downburst configurations "
                     f"(tower {result.case.line.tower_of_interest}, step 1)", title_justify="left")
     for col in ("reaction", "R m", "R/D_j", "Θ deg", "D_j m", "max |mean| kN", "at t s", "V_ref at p m/s", "paper"):
         t.add_column(col, justify="right")
@@ -272,6 +285,9 @@ def scan(
         show_default=False)] = None,
     jobs: JobsOpt = None,
     scheduler: SchedulerOpt = None,
+    models: Annotated[str | None, typer.Option(
+        "--models", help='Scan under "all" built-in downburst running-mean models (or a comma list) and report '
+                         "the critical position per model.", show_default=False)] = None,
 ) -> None:
     """Find the critical downburst configurations: step 1 over a grid of positions and sizes."""
     from ..batch import ScanGrid, make_executor, run_critical, run_scan, write_scan_csv
@@ -279,39 +295,49 @@ def scan(
     from .progress import progress_bar
 
     case = read_case(case_file)
+    from .. import service
+
+    names = service.parse_models(case, models) if models is not None else (None,)
     grid = ScanGrid.from_options(case, distance, angle, jet_diameter)
     if csv_out is not None:
         check_target(csv_out, what="CSV")
     cancel = threading.Event()
     with make_executor(jobs, scheduler) as executor:
-        try:
-            with progress_bar() as cb:
-                result = run_scan(case_file, grid, executor=executor, hold=hold, progress=cb, cancel=cancel)
-        except KeyboardInterrupt:
-            cancel.set()
-            raise
-        console.print(scan_table(result))
-        strength = (f"one storm, V_max = {result.v_max:.1f} m/s (the case's own configuration)"
-                    if result.hold == "jet" else f"V_ref = {case.wind.v_ref:g} m/s at point p everywhere")
-        console.print(f"[dim]{grid.size} configurations in {result.elapsed:.1f} s on {escape(result.executor)}; "
-                      f"{strength}; value = wind-induced mean reaction with the largest magnitude over the "
-                      "event.[/]", highlight=False)
-        if result.n_failed:
-            first = next(e for e in result.errors if e)
-            err_console.print(f"[yellow]warning:[/] {result.n_failed} configuration(s) failed and were left out, "
-                              f"e.g.: {escape(first)}", highlight=False, soft_wrap=True)
-        if csv_out is not None:
-            write_scan_csv(result, csv_out)
-            console.print(f"wrote {csv_out}")
-        if not result.criticals():
-            raise CaseError("no scan configuration could be analysed", file=str(case_file))
-        if dynamic:
-            console.print(f"[dim]full analysis at the critical configurations with the case's V_ref = "
-                          f"{case.wind.v_ref:g} m/s at point p[/]", highlight=False)
-            with BatchDisplay() as display:
-                report = run_critical(result, executor=executor, json_dir=json_dir, progress=display, cancel=cancel)
-            console.print(dynamic_table(report))
-            if report.cancelled:
-                raise typer.Exit(130)
-            if report.failed:
-                raise typer.Exit(1)
+        summary = []
+        for model in names:
+            try:
+                with progress_bar() as cb:
+                    result = run_scan(case_file, grid, executor=executor, hold=hold, progress=cb, cancel=cancel,
+                                      model=model)
+            except KeyboardInterrupt:
+                cancel.set()
+                raise
+            console.print(scan_table(result))
+            strength = (f"one storm, V_max = {result.v_max:.1f} m/s (the case's own configuration)"
+                        if result.hold == "jet" else f"V_ref = {case.wind.v_ref:g} m/s at point p everywhere")
+            console.print(f"[dim]{grid.size} configurations in {result.elapsed:.1f} s on {escape(result.executor)}; "
+                          f"{strength}; value = wind-induced mean reaction with the largest magnitude over the "
+                          "event.[/]", highlight=False)
+            if result.n_failed:
+                first = next(e for e in result.errors if e)
+                err_console.print(f"[yellow]warning:[/] {result.n_failed} configuration(s) failed and were left out, "
+                                  f"e.g.: {escape(first)}", highlight=False, soft_wrap=True)
+            if csv_out is not None:
+                target = csv_out if model is None else csv_out.with_name(f"{csv_out.stem}.{model}{csv_out.suffix}")
+                write_scan_csv(result, target)
+                console.print(f"wrote {target}")
+            if not result.criticals():
+                raise CaseError("no scan configuration could be analysed", file=str(case_file))
+            summary.append(result)
+            if dynamic:
+                console.print(f"[dim]full analysis at the critical configurations with the case's V_ref = "
+                              f"{case.wind.v_ref:g} m/s at point p[/]", highlight=False)
+                with BatchDisplay() as display:
+                    report = run_critical(result, executor=executor, json_dir=json_dir, progress=display, cancel=cancel)
+                console.print(dynamic_table(report))
+                if report.cancelled:
+                    raise typer.Exit(130)
+                if report.failed:
+                    raise typer.Exit(1)
+        if len(summary) > 1:
+            console.print(models_scan_table(summary))

@@ -353,3 +353,24 @@ async def test_run_errors_open_a_dialog_not_a_crash(short_case: Path, monkeypatc
             assert not app.running
         assert [m.title for m in of_type(messages, msg.RunFailed)] == ["Numerical failure", "Unexpected error"]
         assert "non-finite" in of_type(messages, msg.RunFailed)[0].message
+
+
+async def test_model_spread_action(tmp_path: Path) -> None:
+    """m runs a downburst case under every built-in model: the document gets the "models" block
+    (same as the service's) and the summary notes list each model and the envelope."""
+    folder = tmp_path / "cases"
+    folder.mkdir()
+    write_case(folder, "case07-single.toml", "db", **{"analysis.duration": 30.0, "analysis.realizations": 1})
+    messages: list = []
+    app = LinecheckApp([folder])
+    async with app.run_test(size=SIZE, message_hook=messages.append) as pilot:
+        await pilot.pause()
+        await pilot.press("enter")
+        await wait_for(pilot, lambda: of_type(messages, msg.CaseOpened), 5, "CaseOpened")
+        await pilot.press("m")
+        await wait_for(pilot, lambda: of_type(messages, msg.RunFinished), 120, "RunFinished")
+        doc = of_type(messages, msg.RunFinished)[-1].output.doc
+        assert list(doc["models"]) == ["holmes-oliver", "ring-jet"]
+        assert doc["models"]["holmes-oliver"] == doc["reactions"]
+        notes = str(app.query_one("#summary-notes", Static).render())
+        assert "ring-jet" in notes and "envelope" in notes

@@ -226,3 +226,28 @@ def test_scan_under_each_model_reports_its_critical_position():
     np.testing.assert_array_equal(out["holmes-oliver"].peak, run_scan(path, grid).peak)
     # and the other model is a different field
     assert not np.array_equal(out["ring-jet"].peak, out["holmes-oliver"].peak)
+
+
+def test_batch_models_writes_one_document_per_case(tmp_path):
+    """batch --models all: per-model results plus <stem>.json whose "models" block holds each
+    per-model run's "reactions" and whose main block is the case's own model."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from linecheck.cli.app import app
+    from linecheck.core.case import case_to_toml
+
+    case = with_values(load_case(CASES / "paper" / "case07-single.toml"),
+                       {"analysis.duration": 40.0, "analysis.realizations": 1, "name": "db"})
+    path = tmp_path / "db.toml"
+    path.write_text(case_to_toml(case))
+    out = tmp_path / "res"
+    r = CliRunner().invoke(app, ["batch", str(path), "--models", "all", "--json-dir", str(out), "-j", "1"])
+    assert r.exit_code == 0, r.output
+    per = {m: json.loads((out / f"db.{m}.json").read_text()) for m in ("holmes-oliver", "ring-jet")}
+    doc = json.loads((out / "db.json").read_text())
+    assert doc["model"] == "holmes-oliver" and doc["reactions"] == per["holmes-oliver"]["reactions"]
+    assert {m: b for m, b in doc["models"].items()} == {m: d["reactions"] for m, d in per.items()}
+    e = doc["models_envelope"]["Ry"]["peak_dynamic"]
+    assert e["value"] == max((d["reactions"]["Ry"]["peak_dynamic"]["mean"] for d in per.values()), key=abs)

@@ -29,7 +29,9 @@ Cross-checks: `supports` has `spans + 1` entries and both end towers are `"strai
 `tower_of_interest` ≤ number of towers; `sag` < `span_length`/4; `[wind.downburst]` is
 required for `type = "downburst"` and rejected for `"synoptic"`; `span_speeds` (synoptic only)
 has one entry per span; a `preset` and explicit `jet_diameter`/`distance`/`angle` must agree;
-`time_step` ≤ `duration`/4.
+`time_step` ≤ `duration`/4; downburst `model` (default `"table"` with a `field`, else
+`"holmes-oliver"`): `"table"` needs `field`, `field` needs `"table"`, `jet_velocity` is for
+`"ring-jet"` only and `t1`/`t_f` are not (docs/wind.md).
 
 Example (paper case 9, single span):
 

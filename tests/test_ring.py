@@ -242,9 +242,15 @@ def test_batch_models_writes_one_document_per_case(tmp_path):
                        {"analysis.duration": 40.0, "analysis.realizations": 1, "name": "db"})
     path = tmp_path / "db.toml"
     path.write_text(case_to_toml(case))
+    syn = with_values(load_case(CASES / "paper" / "case09-single.toml"),
+                      {"analysis.duration": 40.0, "analysis.realizations": 1, "name": "syn"})
+    (tmp_path / "syn.toml").write_text(case_to_toml(syn))
     out = tmp_path / "res"
-    r = CliRunner().invoke(app, ["batch", str(path), "--models", "all", "--json-dir", str(out), "-j", "1"])
+    r = CliRunner().invoke(app, ["batch", str(path), str(tmp_path / "syn.toml"), "--models", "all",
+                                 "--json-dir", str(out), "-j", "1"])
     assert r.exit_code == 0, r.output
+    # a synoptic case in the batch runs once, as without --models
+    assert "models" not in json.loads((out / "syn.json").read_text())
     per = {m: json.loads((out / f"db.{m}.json").read_text()) for m in ("holmes-oliver", "ring-jet")}
     doc = json.loads((out / "db.json").read_text())
     assert doc["model"] == "holmes-oliver" and doc["reactions"] == per["holmes-oliver"]["reactions"]

@@ -19,6 +19,10 @@ def model_jobs(paths: list[Path], models: str) -> tuple[list[RunJob], dict[Path,
     for p in paths:
         case = load_case(p)
         plan[p] = []
+        if case.wind.type != "downburst":  # a synoptic case in the batch runs once, as without --models
+            plan[p].append(("", len(jobs)))
+            jobs.append(RunJob(p))
+            continue
         for m in parse_models(case, models):
             plan[p].append((m, len(jobs)))
             jobs.append(RunJob(p, label=f"{case.name} [{m}]", changes=model_changes(case, m) or None,
@@ -33,6 +37,9 @@ def combined_documents(report: BatchReport, plan: dict[Path, list[tuple[str, int
 
     out = []
     for path, entries in plan.items():
+        if entries[0][0] == "":  # synoptic: its own document
+            out.append(report.outcomes[entries[0][1]].excel_doc())
+            continue
         runs = {m: report.outcomes[i] for m, i in entries}
         done = {m: o.doc for m, o in runs.items() if o.ok and o.doc is not None}
         if not done:

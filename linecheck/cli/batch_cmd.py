@@ -206,9 +206,10 @@ def batch(
 
         docs = combined_documents(report, plan)
         for path, doc in zip(plan, docs):
-            if "error" not in doc:
+            if "models" in doc:
                 write_json(out_dir / f"{path.stem}.json", doc)
-        console.print(f"model spread: {len(docs)} case document(s) with a \"models\" block in {out_dir}",
+        console.print(f"model spread: {sum('models' in d for d in docs)} case document(s) with a \"models\" block "
+                      f"in {out_dir}",
                       highlight=False)
     if excel is not None:
         _write_excel(docs, excel, force, template)

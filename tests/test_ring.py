@@ -257,3 +257,15 @@ def test_batch_models_writes_one_document_per_case(tmp_path):
     assert {m: b for m, b in doc["models"].items()} == {m: d["reactions"] for m, d in per.items()}
     e = doc["models_envelope"]["Ry"]["peak_dynamic"]
     assert e["value"] == max((d["reactions"]["Ry"]["peak_dynamic"]["mean"] for d in per.values()), key=abs)
+
+
+def test_wall_jet_is_the_holmes_oliver_wood_profile():
+    # the settled state behind the front is the same Holmes & Oliver (2000) x Wood et al. (2001)
+    # profile as model "holmes-oliver" (defaults r_max = 1.2 D_j, R_r = D_j/2, z_max = 0.025 D_j);
+    # ring.py carries z_max/delta to 5 digits: 1e-4 relative is that rounding
+    dj = 1000.0
+    rho = np.linspace(0.0, 3.0, 61)
+    for z in (10.0, 25.0, 43.0, 120.0):
+        ref = M.radial_profile(rho * dj, 1.2 * dj, 0.5 * dj) * M.vertical_profile(z, M.wood_delta(0.025 * dj))
+        np.testing.assert_allclose(R.wall_jet(rho, z / dj), R.C_W * ref, rtol=1e-4, atol=1e-12)
+    assert R._ETA_PEAK == pytest.approx(M.ETA_PEAK, rel=1e-4)

@@ -262,46 +262,13 @@ def dynamic_table(report: Any) -> Table:
     return t
 
 
-@app.command()
-@handle_errors
-def scan(
-    case_file: CaseArg,
-    distance: Annotated[str | None, typer.Option(
-        "--distance", help="R values START:STOP:STEP (metres, or with a Dj suffix multiples of D_j) or a list "
-                           "(default 0.5:2.5:0.1Dj).", show_default=False)] = None,
-    angle: Annotated[str | None, typer.Option(
-        "--angle", help="Θ values START:STOP:STEP or a list, degrees (default -80:80:10).", show_default=False)] = None,
-    jet_diameter: Annotated[str | None, typer.Option(
-        "--jet-diameter", help="D_j values START:STOP:STEP or a list, metres (default: the case's D_j).",
-        show_default=False)] = None,
-    csv_out: Annotated[Path | None, typer.Option("--csv", help="Write every scan point to this CSV file.",
-                                                 show_default=False)] = None,
-    hold: Annotated[str, typer.Option(
-        "--hold", help="Storm strength over the grid: 'jet' = one storm (V_max of the case's own configuration) "
-                       "moved around; 'vref' = the case's V_ref at point p in every configuration.")] = "jet",
-    dynamic: Annotated[bool, typer.Option(
-        "--dynamic", help="Then run the full three-step analysis at the critical configurations.")] = False,
-    json_dir: Annotated[Path | None, typer.Option(
-        "--json-dir", help="With --dynamic: save the critical runs' JSON results in this folder.",
-        show_default=False)] = None,
-    jobs: JobsOpt = None,
-    scheduler: SchedulerOpt = None,
-    models: Annotated[str | None, typer.Option(
-        "--models", help='Scan under "all" built-in downburst running-mean models (or a comma list) and report '
-                         "the critical position per model.", show_default=False)] = None,
-) -> None:
-    """Find the critical downburst configurations: step 1 over a grid of positions and sizes."""
-    from ..batch import ScanGrid, make_executor, run_critical, run_scan, write_scan_csv
-    from ..io.atomic import check_target
+def _scan_each_model(case_file: Path, case: Any, grid: Any, names: tuple[str, ...], *, hold: str,
+                     csv_out: Path | None, dynamic: bool, json_dir: Path | None, jobs: int | None,
+                     scheduler: str | None) -> None:
+    """``scan --models``: the scan under each downburst model, then the critical position per model."""
+    from ..batch import make_executor, run_critical, run_scan, write_scan_csv
     from .progress import progress_bar
 
-    case = read_case(case_file)
-    from .. import service
-
-    names = service.parse_models(case, models) if models is not None else (None,)
-    grid = ScanGrid.from_options(case, distance, angle, jet_diameter)
-    if csv_out is not None:
-        check_target(csv_out, what="CSV")
     cancel = threading.Event()
     with make_executor(jobs, scheduler) as executor:
         summary = []
@@ -342,3 +309,81 @@ def scan(
                     raise typer.Exit(1)
         if len(summary) > 1:
             console.print(models_scan_table(summary))
+
+
+@app.command()
+@handle_errors
+def scan(
+    case_file: CaseArg,
+    distance: Annotated[str | None, typer.Option(
+        "--distance", help="R values START:STOP:STEP (metres, or with a Dj suffix multiples of D_j) or a list "
+                           "(default 0.5:2.5:0.1Dj).", show_default=False)] = None,
+    angle: Annotated[str | None, typer.Option(
+        "--angle", help="Θ values START:STOP:STEP or a list, degrees (default -80:80:10).", show_default=False)] = None,
+    jet_diameter: Annotated[str | None, typer.Option(
+        "--jet-diameter", help="D_j values START:STOP:STEP or a list, metres (default: the case's D_j).",
+        show_default=False)] = None,
+    csv_out: Annotated[Path | None, typer.Option("--csv", help="Write every scan point to this CSV file.",
+                                                 show_default=False)] = None,
+    hold: Annotated[str, typer.Option(
+        "--hold", help="Storm strength over the grid: 'jet' = one storm (V_max of the case's own configuration) "
+                       "moved around; 'vref' = the case's V_ref at point p in every configuration.")] = "jet",
+    dynamic: Annotated[bool, typer.Option(
+        "--dynamic", help="Then run the full three-step analysis at the critical configurations.")] = False,
+    json_dir: Annotated[Path | None, typer.Option(
+        "--json-dir", help="With --dynamic: save the critical runs' JSON results in this folder.",
+        show_default=False)] = None,
+    jobs: JobsOpt = None,
+    scheduler: SchedulerOpt = None,
+    models: Annotated[str | None, typer.Option(
+        "--models", help='Scan under "all" built-in downburst running-mean models (or a comma list) and report '
+                         "the critical position per model.", show_default=False)] = None,
+) -> None:
+    """Find the critical downburst configurations: step 1 over a grid of positions and sizes."""
+    from ..batch import ScanGrid, make_executor, run_critical, run_scan, write_scan_csv
+    from ..io.atomic import check_target
+    from .progress import progress_bar
+
+    case = read_case(case_file)
+    grid = ScanGrid.from_options(case, distance, angle, jet_diameter)
+    if csv_out is not None:
+        check_target(csv_out, what="CSV")
+    cancel = threading.Event()
+    if models is not None:
+        from .. import service
+
+        _scan_each_model(case_file, case, grid, service.parse_models(case, models), hold=hold, csv_out=csv_out,
+                         dynamic=dynamic, json_dir=json_dir, jobs=jobs, scheduler=scheduler)
+        return
+    with make_executor(jobs, scheduler) as executor:
+        try:
+            with progress_bar() as cb:
+                result = run_scan(case_file, grid, executor=executor, hold=hold, progress=cb, cancel=cancel)
+        except KeyboardInterrupt:
+            cancel.set()
+            raise
+        console.print(scan_table(result))
+        strength = (f"one storm, V_max = {result.v_max:.1f} m/s (the case's own configuration)"
+                    if result.hold == "jet" else f"V_ref = {case.wind.v_ref:g} m/s at point p everywhere")
+        console.print(f"[dim]{grid.size} configurations in {result.elapsed:.1f} s on {escape(result.executor)}; "
+                      f"{strength}; value = wind-induced mean reaction with the largest magnitude over the "
+                      "event.[/]", highlight=False)
+        if result.n_failed:
+            first = next(e for e in result.errors if e)
+            err_console.print(f"[yellow]warning:[/] {result.n_failed} configuration(s) failed and were left out, "
+                              f"e.g.: {escape(first)}", highlight=False, soft_wrap=True)
+        if csv_out is not None:
+            write_scan_csv(result, csv_out)
+            console.print(f"wrote {csv_out}")
+        if not result.criticals():
+            raise CaseError("no scan configuration could be analysed", file=str(case_file))
+        if dynamic:
+            console.print(f"[dim]full analysis at the critical configurations with the case's V_ref = "
+                          f"{case.wind.v_ref:g} m/s at point p[/]", highlight=False)
+            with BatchDisplay() as display:
+                report = run_critical(result, executor=executor, json_dir=json_dir, progress=display, cancel=cancel)
+            console.print(dynamic_table(report))
+            if report.cancelled:
+                raise typer.Exit(130)
+            if report.failed:
+                raise typer.Exit(1)

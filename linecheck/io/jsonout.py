@@ -138,12 +138,7 @@ def run_to_dict(res: Any, *, full_histories: bool = False, max_points: int = 200
     j = res.tower_index
 
     def reaction_block(tower: int) -> dict[str, Any]:
-        out = {}
-        for c, rname in enumerate(REACTIONS):
-            out[rname] = {
-                s: {"mean": _num(stats.mean(s)[tower, c]), "std": _num(stats.std(s)[tower, c])} for s in STATISTICS
-            }
-        return out
+        return reactions_block(stats, tower)
 
     still = res.static.mean.still_air
     m = res.static.mean
@@ -231,6 +226,38 @@ def codes_block(res: Any) -> dict[str, Any]:
     from ..service import codes_analysis
 
     return codes_to_dict(codes_analysis(res.case, res, strict=False))
+
+
+def reactions_block(stats: Any, tower: int) -> dict[str, Any]:
+    """``{"Rx": {stat: {"mean", "std"}}, "Ry": .., "Rz": ..}`` of one tower (0-based)."""
+    from ..core.results import REACTIONS, STATISTICS
+
+    return {rname: {s: {"mean": _num(stats.mean(s)[tower, c]), "std": _num(stats.std(s)[tower, c])}
+                    for s in STATISTICS} for c, rname in enumerate(REACTIONS)}
+
+
+def models_block(results: dict[str, Any]) -> dict[str, Any]:
+    """Model spread of issue 15: ``{"models": {name: <same as "reactions">}, "models_envelope":
+    {R: {stat: {"value", "model"}}}}`` at the tower of interest.  The envelope takes, per
+    reaction and statistic, the realization mean of largest magnitude and names its model."""
+    return models_from_reactions({name: reactions_block(res.stats, res.tower_index) for name, res in results.items()})
+
+
+def models_from_reactions(models: dict[str, Any]) -> dict[str, Any]:
+    """:func:`models_block` from each model's ``"reactions"`` block (e.g. of saved documents)."""
+    from ..core.results import REACTIONS, STATISTICS
+
+    env: dict[str, Any] = {}
+    for r in REACTIONS:
+        env[r] = {}
+        for s in STATISTICS:
+            best, who = None, None
+            for name, blk in models.items():
+                v = blk[r][s]["mean"]
+                if v is not None and (best is None or abs(v) > abs(best)):
+                    best, who = v, name
+            env[r][s] = {"value": best, "model": who}
+    return {"models": models, "models_envelope": env}
 
 
 def spectral_to_dict(sp: Any) -> dict[str, Any]:

@@ -49,10 +49,33 @@ def mean_state_times(case: Case) -> np.ndarray:
     return np.linspace(t0, t1, case.analysis.mean_states)
 
 
+def turbulence_variance_ratio(case: Case, normal: np.ndarray, longitudinal: np.ndarray) -> np.ndarray:
+    """sigma^2 / |V|^2 [-]: variance of the along-wind turbulence over the squared running-mean
+    speed, same shape as ``normal`` [m/s] (0 where |V| = 0).
+
+    Downburst: sigma = I |V_m| (Chay et al. 2006), so the ratio is I^2; synoptic: sigma = I V_ref
+    on a span of mean speed |V| (I^2 unless ``span_speeds`` differ from v_ref).
+    """
+    i = case.wind.turbulence_intensity
+    if case.wind.type == "downburst":
+        return np.full(np.shape(normal), i * i)
+    speed2 = normal**2 + longitudinal**2
+    sig2 = (i * case.wind.v_ref) ** 2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(speed2 > 0, sig2 / np.where(speed2 > 0, speed2, 1.0), 0.0)
+
+
 def mean_loads(case: Case, wind: MeanWind) -> np.ndarray:
-    """Transverse mean load per unit length [N/m], shape (n_t, n_spans, ne+1) (paper Eq. 1)."""
+    """Transverse mean load per unit length [N/m], shape (n_t, n_spans, ne+1) (paper Eq. 1).
+
+    ``drag = "quadratic"``: the mean of the drag on the total wind, 1/2 rho C_d D V_n|V_n|
+    (1 + sigma^2/|V|^2), i.e. the paper's Eq. 1 times (1 + I^2) (docs/method.md "Quadratic drag").
+    """
     line = case.line
-    return drag_intensity(wind.normal, case.wind.air_density, line.drag_coefficient, line.diameter)
+    g = drag_intensity(wind.normal, case.wind.air_density, line.drag_coefficient, line.diameter)
+    if case.analysis.drag == "quadratic":
+        g = g * (1.0 + turbulence_variance_ratio(case, wind.normal, wind.longitudinal))
+    return g
 
 
 def static_analysis(
@@ -289,6 +312,53 @@ def _interpolated_models(case: Case, st: StaticResult, bracket: np.ndarray, weig
     return model_at
 
 
+def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: np.ndarray, vn: np.ndarray,
+                      cos_n: np.ndarray, vl: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Fluctuating transverse nodal loads of steps 2-3 from the along-wind turbulence.
+
+    Args:
+        v: [m/s] along-wind turbulence, shape (n_real, n_steps, n_nodes).
+        vn: [m/s] running-mean normal speed at the nodes, (n_steps, n_nodes); cos_n: [-] |V_n|/|V|;
+        vl: [m/s] running-mean longitudinal speed (downburst; None: zero).
+    Returns:
+        loads [N] on the free nodes, (n_steps, n_real, n_free); direct [N] reactions of the loads
+        at pinned nodes, (n_steps, n_real, 3 n_towers).
+
+    ``drag = "linear"``: rho C_d D L_i V_n v_n (paper Eq. 5), v_n = v cos(phi) the normal component
+    of the fluctuation.  ``"quadratic"`` adds the zero-mean rest of the drag on the total wind,
+    1/2 rho C_d D L_i V_n|V_n|/|V|^2 (v^2 - sigma^2) (docs/method.md "Quadratic drag"; its mean
+    sigma^2 is in step 1, :func:`mean_loads`).
+    """
+    line, wind = case.line, case.wind
+    coef = wind.air_density * line.drag_coefficient * line.diameter
+    # Eq. 5 per unit v, normal component of the fluctuation: v cos(phi), phi the angle of
+    # the mean wind to the normal of the line
+    per_v = coef * model.tributary[None, :] * (vn * cos_n)  # (n_steps, n_nodes)
+    quad = case.analysis.drag == "quadratic"
+    if quad:
+        vl0 = np.zeros_like(vn) if vl is None else vl
+        ratio = turbulence_variance_ratio(case, vn, vl0)  # sigma^2/|V|^2
+        speed2 = vn**2 + vl0**2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inv = np.where(speed2 > 0, 1.0 / np.where(speed2 > 0, speed2, 1.0), 0.0)
+        # 1/2 rho C_d D L V_n|V_n| / |V|^2 per unit (v^2 - sigma^2); sigma^2 = ratio |V|^2
+        per_q = 0.5 * coef * model.tributary[None, :] * vn * np.abs(vn) * inv
+        sig2 = ratio * speed2
+    free = model.dofs.free_nodes
+    pinned = system.tower_nodes[~system.suspension]
+    n_real = v.shape[0]
+    loads = np.empty((t.size, n_real, free.size))
+    direct = np.zeros((t.size, n_real, 3 * system.n_towers))
+    for i in range(n_real):
+        f_i = per_v * v[i]  # (n_steps, n_nodes)
+        if quad:
+            f_i += per_q * (v[i] * v[i] - sig2)
+        loads[:, i, :] = f_i[:, free]
+        # loads at pinned nodes go straight into their supports (R_y)
+        direct[:, i, 3 * np.flatnonzero(~system.suspension) + 1] = f_i[:, pinned]
+    return loads, direct
+
+
 def run_case(
     case: Case,
     *,
@@ -354,27 +424,20 @@ def run_case(
         with np.errstate(invalid="ignore", divide="ignore"):
             cos_n = np.where(speed > 0, np.abs(vn) / np.where(speed > 0, speed, 1.0), 1.0)
     v = fluctuating_velocity(case, system, t, list(real))  # (n_real, n_steps, n_nodes), along-wind
+    loads, direct = fluctuating_loads(case, system, models[0], t, v, vn, cos_n, vl=None if mw is None else vl)
     if progress is not None:
         progress("wind", 1, 1)
     check_cancel()
-    coef = wind.air_density * line.drag_coefficient * line.diameter
-    # Eq. 5 per unit v, normal component of the fluctuation: v cos(phi), phi the angle of
-    # the mean wind to the normal of the line
-    per_v = coef * models[0].tributary[None, :] * (vn * cos_n)  # (n_steps, n_nodes)
-    free = models[0].dofs.free_nodes
-    pinned = system.tower_nodes[~system.suspension]
-    loads = np.empty((t.size, real.size, free.size))
-    direct = np.zeros((t.size, real.size, 3 * system.n_towers))
-    for i in range(real.size):
-        f_i = per_v * v[i]  # (n_steps, n_nodes)
-        loads[:, i, :] = f_i[:, free]
-        # loads at pinned nodes go straight into their supports (R_y)
-        direct[:, i, 3 * np.flatnonzero(~system.suspension) + 1] = f_i[:, pinned]
     del v
+    second = None
+    if case.analysis.tension == "second-order":
+        from .core.second_order import second_order_operator
+
+        second = [second_order_operator(m, mean.state(k)) for k, m in enumerate(models)]
     cb = None if progress is None else (lambda d, n: progress("steps 2-3: dynamics", d, n))
     resp = integrate(models, damping, state_of_step, loads, dt, direct=direct,
                      model_at=_interpolated_models(case, st, bracket, weights) if interpolate_states else None,
-                     progress=cb, cancel=cancel)
+                     second_order=second, progress=cb, cancel=cancel)
 
     # ---- mean M(t): step-1 reactions interpolated to the record grid (wind-induced)
     rw = mean.reactions_wind  # (n_k, n_towers, 3)

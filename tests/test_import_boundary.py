@@ -16,6 +16,7 @@ CORE_MODULES = [
     "linecheck.core.results",
     "linecheck.core.modes",
     "linecheck.core.spectral",
+    "linecheck.core.second_order",
     "linecheck.core.wind.mean",
     "linecheck.core.wind.turbulence",
     "linecheck.core.wind.point",

@@ -97,6 +97,7 @@ def integrate(
     *,
     direct: np.ndarray | None = None,
     model_at: Callable[[int], tuple[LinearModel, np.ndarray]] | None = None,
+    second_order: list | None = None,
     progress: Callable[[int, int], None] | None = None,
     cancel: threading.Event | None = None,
 ) -> DynamicResponse:
@@ -116,6 +117,10 @@ def integrate(
             step n itself (reference scheme: the step-1 state interpolated in time and the
             model rebuilt and factorised at every step); default: ``models[state_of_step[n]]``
             held piecewise constant.
+        second_order: optional :class:`~linecheck.core.second_order.SecondOrder` operator of
+            every mean state (same length as ``models``): the reactions of F and of B then
+            include the second-order tension increment of their own displacement histories
+            (issue 16; with ``model_at`` the operator of the nearest state is used).
         progress: ``progress(done, total)`` about every 1 % of the steps (per block).
         cancel: stop early (raises :class:`Cancelled`).
 
@@ -150,6 +155,13 @@ def integrate(
     # -------- step 3: quasi-static background, one factorisation per mean state
     R_B = np.empty((n_steps, n_real, n_r))
     chunk = max(1, 8192 // max(n_real, 1))
+    if second_order is not None:
+        from .second_order import second_order_from_components, second_order_reactions
+
+        def so(n: int, U: np.ndarray) -> np.ndarray:
+            """Second-order reactions of global displacements U (..., n_dof) under the state of step n."""
+            return second_order_reactions(second_order[int(state_of_step[n])], U.reshape(-1, n_dof)).reshape(
+                U.shape[:-1] + (n_r,))
     if model_at is None:
         for k in np.unique(state_of_step):
             c = _factor(models[k].K_band, np.zeros(n_dof), f"stiffness of mean state {k + 1}")
@@ -159,11 +171,17 @@ def integrate(
             for i0 in range(0, all_steps.size, chunk):
                 steps = all_steps[i0:i0 + chunk]
                 R_B[steps] = _rowdot(loads[steps].reshape(-1, n_free), TB).reshape(steps.size, n_real, n_r)
+                if second_order is not None:  # the quasi-static displacements themselves
+                    UB = _solve(c, np.asfortranarray(loads_full(loads[steps].reshape(-1, n_free)).T)).T
+                    R_B[steps] += so(int(steps[0]), UB).reshape(steps.size, n_real, n_r)
     else:
         for n in range(n_steps):
             m, _ = model_of(n)
             c = _factor(m.K_band, np.zeros(n_dof), f"stiffness at step {n}")
-            R_B[n] = _rowdot(_solve(c, loads_full(loads[n]).T).T, m.G.T)
+            UB = _solve(c, loads_full(loads[n]).T).T
+            R_B[n] = _rowdot(UB, m.G.T)
+            if second_order is not None:
+                R_B[n] += so(n, UB)
 
     # -------- step 2: Newmark, one factorisation per mean state, in node bases that make
     # M and C diagonal (so that the per-step products are elementwise; see _Stepper)
@@ -172,6 +190,8 @@ def integrate(
     U = _solve(chol, loads_full(loads[0]).T).T  # quasi-static start, (n_real, n_dof), global
     R_F = np.empty((n_steps, n_real, n_r))
     R_F[0] = _rowdot(U, m0.G.T)
+    if second_order is not None:
+        R_F[0] += so(0, U)
     block = max(1, min(512, 2_000_000 // max(n_real * n_dof, 1)))  # steps per block
     buf = np.empty((block, n_real, n_dof))
     # segments: runs of steps under one linear model (one mean state), cut into blocks
@@ -236,6 +256,11 @@ def integrate(
                 A, A_new = A_new, A
                 buf[k] = U
             R_F[b0:b1] = st.reactions(buf[: b1 - b0])
+            if second_order is not None:  # back to global coordinates, u = T u~ node by node
+                ut = buf[: b1 - b0].reshape(-1, n_dof)
+                comps = [sum(ut[:, j::3] * st.T[:, c, j] for j in range(3)) for c in range(3)]
+                R_F[b0:b1] += second_order_from_components(
+                    second_order[int(state_of_step[b0])], *comps).reshape(b1 - b0, n_real, n_r)
             if progress is not None and b1 // report != b0 // report:
                 progress(b1, n_steps)
             if cancel is not None and cancel.is_set():

@@ -312,14 +312,25 @@ def _interpolated_models(case: Case, st: StaticResult, bracket: np.ndarray, weig
     return model_at
 
 
+def record_mean_wind(case: Case, st: StaticResult, t: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """Running-mean normal and longitudinal speeds [m/s] at the global nodes over the record
+    ``t``, shape (n_steps, n_nodes) each (synoptic: the step-1 wind held, longitudinal None)."""
+    system = st.system
+    if case.wind.type == "synoptic":
+        vn = np.broadcast_to(to_global_nodes(system, st.wind.normal)[0], (t.size, system.n_nodes))
+        return vn, None
+    mw = mean_wind(case, system, t)
+    return to_global_nodes(system, mw.normal), to_global_nodes(system, mw.longitudinal)
+
+
 def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: np.ndarray, vn: np.ndarray,
-                      cos_n: np.ndarray, vl: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+                      vl: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Fluctuating transverse nodal loads of steps 2-3 from the along-wind turbulence.
 
     Args:
         v: [m/s] along-wind turbulence, shape (n_real, n_steps, n_nodes).
-        vn: [m/s] running-mean normal speed at the nodes, (n_steps, n_nodes); cos_n: [-] |V_n|/|V|;
-        vl: [m/s] running-mean longitudinal speed (downburst; None: zero).
+        vn: [m/s] running-mean normal speed at the nodes, (n_steps, n_nodes);
+        vl: [m/s] running-mean longitudinal speed (downburst; None: zero, cos(phi) = 1).
     Returns:
         loads [N] on the free nodes, (n_steps, n_real, n_free); direct [N] reactions of the loads
         at pinned nodes, (n_steps, n_real, 3 n_towers).
@@ -330,6 +341,12 @@ def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: n
     sigma^2 is in step 1, :func:`mean_loads`).
     """
     line, wind = case.line, case.wind
+    if vl is None:
+        cos_n = np.ones_like(vn)
+    else:
+        speed = np.hypot(vn, vl)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            cos_n = np.where(speed > 0, np.abs(vn) / np.where(speed > 0, speed, 1.0), 1.0)
     coef = wind.air_density * line.drag_coefficient * line.diameter
     # Eq. 5 per unit v, normal component of the fluctuation: v cos(phi), phi the angle of
     # the mean wind to the normal of the line
@@ -413,18 +430,9 @@ def run_case(
     # ---- fluctuating load F_w = rho C_d D L_e V_m v (paper Eq. 5), normal components
     if progress is not None:
         progress("wind", 0, 1)
-    mw = mean_wind(case, system, t) if wind.type == "downburst" else None
-    if mw is None:
-        vn = np.broadcast_to(vn_states[0], (t.size, system.n_nodes))
-        cos_n = np.ones_like(vn)
-    else:
-        vn = to_global_nodes(system, mw.normal)
-        vl = to_global_nodes(system, mw.longitudinal)
-        speed = np.hypot(vn, vl)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            cos_n = np.where(speed > 0, np.abs(vn) / np.where(speed > 0, speed, 1.0), 1.0)
+    vn, vl = record_mean_wind(case, st, t)
     v = fluctuating_velocity(case, system, t, list(real))  # (n_real, n_steps, n_nodes), along-wind
-    loads, direct = fluctuating_loads(case, system, models[0], t, v, vn, cos_n, vl=None if mw is None else vl)
+    loads, direct = fluctuating_loads(case, system, models[0], t, v, vn, vl)
     if progress is not None:
         progress("wind", 1, 1)
     check_cancel()
@@ -491,6 +499,102 @@ def modes_analysis(case: Case, *, n_modes: int = 20) -> ModesResult:
     damped = dataclasses.replace(cm, frequencies_hz=cm.frequencies_hz[:n], damping_ratio=cm.damping_ratio[:n],
                                  poles=cm.poles[:n])
     return ModesResult(case, still, at_mean, float(mean.time[k]), damped)
+
+
+@dataclass(frozen=True)
+class WindField:
+    """The wind of one realization of a run at every conductor node (``linecheck wind --field``;
+    public NPZ layout in docs/wind.md).
+
+    Attributes:
+        t: [s] the analysed record's equally spaced instants, burn-in included, shape (n_t,).
+        burn_in: [s] the discarded start of ``t`` (0 for downbursts and ``damping = "paper"``).
+        x_node: [m] still-air node positions (x along the line, z up), shape (n_nodes, 3);
+            nodes in line order, tower nodes once (n_spans * elements_per_span + 1).
+        u_mean: [m/s] running-mean wind velocity (x, y, z) at each node, (n_t, n_nodes, 3).
+        u_turb: [m/s] turbulent wind velocity (x, y, z): the along-wind fluctuation v along the
+            running mean's direction, (n_t, n_nodes, 3).
+        v_along: [m/s] the along-wind fluctuation v itself (signed), (n_t, n_nodes).
+        realization: 1-based; seed: the case's seed.
+    """
+
+    case: Case
+    t: np.ndarray
+    burn_in: float
+    x_node: np.ndarray
+    u_mean: np.ndarray
+    u_turb: np.ndarray
+    v_along: np.ndarray
+    realization: int
+    seed: int
+
+    def to_npz_dict(self) -> dict[str, np.ndarray]:
+        """Arrays of the public NPZ layout (docs/wind.md)."""
+        return {
+            "t": self.t, "burn_in": np.float64(self.burn_in), "x_node": self.x_node,
+            "u_mean": self.u_mean, "u_turb": self.u_turb, "v_along": self.v_along,
+            "realization": np.int64(self.realization), "seed": np.int64(self.seed),
+            "case": np.str_(self.case.name), "units": np.str_("SI: s, m, m/s; x along the line, y transverse, z up"),
+        }
+
+
+def record_grid(case: Case, st: StaticResult | None = None) -> tuple[np.ndarray, float]:
+    """Instants of steps 2-3 [s] with the burn-in exactly as :func:`run_case` builds them, and
+    the burn-in [s]."""
+    st = static_analysis(case) if st is None else st
+    t = record_time(case)
+    dt = case.analysis.time_step
+    burn = 0.0
+    if case.wind.type == "synoptic":
+        burn = burn_in(case, synoptic_model(case, st)).seconds
+    if burn > 0:
+        t = t[0] - dt * np.round(burn / dt) + dt * np.arange(t.size + int(np.round(burn / dt)))
+    return t, float(burn)
+
+
+def wind_field(case: Case, *, realization: int = 0) -> WindField:
+    """The running mean and turbulence of ``realization`` (0-based) at every conductor node and
+    step of the record :func:`run_case` analyses (burn-in included): the same calls, so the same
+    field bit for bit (issue 16).  u_turb = v (V_x, V_y, 0)/|V| (Eq. 5's normal component is its
+    y component); no vertical wind (z components zero)."""
+    from .core.errors import CaseError
+    from .core.wind.turbulence import fluctuating_velocity
+
+    if not 0 <= realization < case.analysis.realizations:
+        raise CaseError(f"realization {realization + 1} is out of range: expected 1 to {case.analysis.realizations} "
+                        "(analysis.realizations)")
+    st = static_analysis(case)
+    system = st.system
+    t, burn = record_grid(case, st)
+    vn, vl = record_mean_wind(case, st, t)
+    vl = np.zeros_like(vn) if vl is None else vl
+    v = fluctuating_velocity(case, system, t, [realization])[0]
+    zero = np.zeros_like(vn)
+    u_mean = np.stack([vl, vn, zero], axis=-1)
+    speed = np.hypot(vn, vl)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        unit_n = np.where(speed > 0, vn / np.where(speed > 0, speed, 1.0), 1.0)
+        unit_l = np.where(speed > 0, vl / np.where(speed > 0, speed, 1.0), 0.0)
+    u_turb = np.stack([v * unit_l, v * unit_n, zero], axis=-1)
+    x_node = st.mean.still_air.nodes.copy()
+    return WindField(case, t, burn, x_node, u_mean, u_turb, v, realization + 1, case.analysis.seed)
+
+
+def read_wind_field(path) -> dict[str, np.ndarray]:
+    """The arrays of a ``linecheck wind --field`` NPZ file (docs/wind.md)."""
+    with np.load(path, allow_pickle=False) as z:
+        return {k: z[k] for k in z.files}
+
+
+def loads_from_field(case: Case, field: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Fluctuating loads of steps 2-3 (:func:`fluctuating_loads`) from a wind field's arrays
+    (``WindField.to_npz_dict`` or :func:`read_wind_field`): loads [N] (n_t, 1, n_free) and the
+    direct reactions [N] (n_t, 1, 3 n_towers)."""
+    st = static_analysis(case)
+    model = build_model(st.system, st.mean.state(0))
+    u = field["u_mean"]
+    vl = None if case.wind.type == "synoptic" else u[:, :, 0]
+    return fluctuating_loads(case, st.system, model, field["t"], field["v_along"][None], u[:, :, 1], vl)
 
 
 @dataclass(frozen=True)

@@ -139,7 +139,7 @@ def second_order_from_components(op: SecondOrder, ux: np.ndarray, uy: np.ndarray
     """
     m = ux.shape[0]
     chunk = max(8, SINGLE_THREAD_WORK // op.A.size)
-    n_blk = max(1, 4096 // chunk) * chunk  # rows of one elementwise pass (a multiple of chunk)
+    n_blk = max(1, 512 // chunk) * chunk  # rows of one elementwise pass: arrays stay in cache
     out = np.empty((m, op.A.shape[1]))
     for i0 in range(0, m, n_blk):
         i1 = min(i0 + n_blk, m)

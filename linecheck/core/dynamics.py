@@ -258,9 +258,9 @@ def integrate(
             R_F[b0:b1] = st.reactions(buf[: b1 - b0])
             if second_order is not None:  # back to global coordinates, u = T u~ node by node
                 ut = buf[: b1 - b0].reshape(-1, n_dof)
-                comps = [sum(ut[:, j::3] * st.T[:, c, j] for j in range(3)) for c in range(3)]
                 R_F[b0:b1] += second_order_from_components(
-                    second_order[int(state_of_step[b0])], *comps).reshape(b1 - b0, n_real, n_r)
+                    second_order[int(state_of_step[b0])], ut[:, 0::3], ut[:, 1::3], ut[:, 2::3],
+                    T=st.T).reshape(b1 - b0, n_real, n_r)
             if progress is not None and b1 // report != b0 // report:
                 progress(b1, n_steps)
             if cancel is not None and cancel.is_set():

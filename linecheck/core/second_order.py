@@ -127,9 +127,11 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray) -> np.ndarray:
     return second_order_from_components(op, U3[:, :, 0], U3[:, :, 1], U3[:, :, 2])
 
 
-def second_order_from_components(op: SecondOrder, ux: np.ndarray, uy: np.ndarray, uz: np.ndarray) -> np.ndarray:
+def second_order_from_components(op: SecondOrder, ux: np.ndarray, uy: np.ndarray, uz: np.ndarray,
+                                  T: np.ndarray | None = None) -> np.ndarray:
     """[N] R_2 at every tower from the x, y, z displacements [m] of the free nodes, each
-    shape (m, n_free_nodes) -> (m, n_r).
+    shape (m, n_free_nodes) -> (m, n_r).  With ``T`` (per-node bases, (n_free_nodes, 3, 3)) the
+    components are those of u~ in the node bases, u = T u~ (rotated block by block).
 
     Rows are processed in blocks of a fixed size that depends on the operator only (the last
     block padded with zeros), so the BLAS product always has the same shape: a row's result
@@ -143,7 +145,10 @@ def second_order_from_components(op: SecondOrder, ux: np.ndarray, uy: np.ndarray
     out = np.empty((m, op.A.shape[1]))
     for i0 in range(0, m, n_blk):
         i1 = min(i0 + n_blk, m)
-        f = _member_forces(op, ux[i0:i1], uy[i0:i1], uz[i0:i1])
+        comps = (ux[i0:i1], uy[i0:i1], uz[i0:i1])
+        if T is not None:  # u = T u~ node by node
+            comps = tuple(comps[0] * T[:, c, 0] + comps[1] * T[:, c, 1] + comps[2] * T[:, c, 2] for c in range(3))
+        f = _member_forces(op, *comps)
         for j0 in range(0, i1 - i0, chunk):
             j1 = min(j0 + chunk, i1 - i0)
             if j1 - j0 == chunk:

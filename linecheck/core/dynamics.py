@@ -167,12 +167,16 @@ def integrate(
             c = _factor(models[k].K_band, np.zeros(n_dof), f"stiffness of mean state {k + 1}")
             # static transfer from the y-loads to the reactions, (G K^-1 P)^T = (K^-1 G^T)[y]
             TB = np.ascontiguousarray(_solve(c, np.asfortranarray(models[k].G.T))[ydof])  # (n_free, n_r)
+            if second_order is not None:  # (K^-1 P)^T: the y-loads to the quasi-static displacements
+                E = np.zeros((n_dof, n_free), order="F")
+                E[ydof, np.arange(n_free)] = 1.0
+                XT = np.ascontiguousarray(_solve(c, E).T)  # (n_free, n_dof)
             all_steps = np.flatnonzero(state_of_step == k)
             for i0 in range(0, all_steps.size, chunk):
                 steps = all_steps[i0:i0 + chunk]
                 R_B[steps] = _rowdot(loads[steps].reshape(-1, n_free), TB).reshape(steps.size, n_real, n_r)
                 if second_order is not None:  # the quasi-static displacements themselves
-                    UB = _solve(c, np.asfortranarray(loads_full(loads[steps].reshape(-1, n_free)).T)).T
+                    UB = _fixed_matmul(loads[steps].reshape(-1, n_free), XT)
                     R_B[steps] += so(int(steps[0]), UB).reshape(steps.size, n_real, n_r)
     else:
         for n in range(n_steps):
@@ -277,6 +281,25 @@ def integrate(
         fluctuating=np.ascontiguousarray(R_F.reshape(shape).transpose(1, 0, 2, 3)),
         background=np.ascontiguousarray(R_B.reshape(shape).transpose(1, 0, 2, 3)),
     )
+
+
+def _fixed_matmul(X: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """X @ B by BLAS on blocks of a fixed number of rows (the last one padded with zeros) that
+    depends on B only: every row is computed by the same call shape whatever the number of rows
+    (realizations) in X, so results are bit-identical across batch chunking; the blocks are small
+    enough for OpenBLAS to stay on one thread (below its 4 x 65536 multiply-add threshold)."""
+    m = X.shape[0]
+    chunk = max(8, 250_000 // B.size)
+    out = np.empty((m, B.shape[1]))
+    for i0 in range(0, m, chunk):
+        i1 = min(i0 + chunk, m)
+        if i1 - i0 == chunk:
+            np.matmul(X[i0:i1], B, out=out[i0:i1])
+        else:
+            pad = np.zeros((chunk, X.shape[1]))
+            pad[: i1 - i0] = X[i0:i1]
+            out[i0:i1] = (pad @ B)[: i1 - i0]
+    return out
 
 
 def _rowdot(X: np.ndarray, BT: np.ndarray) -> np.ndarray:

@@ -445,7 +445,7 @@ def run_case(
     cb = None if progress is None else (lambda d, n: progress("steps 2-3: dynamics", d, n))
     resp = integrate(models, damping, state_of_step, loads, dt, direct=direct,
                      model_at=_interpolated_models(case, st, bracket, weights) if interpolate_states else None,
-                     second_order=second, progress=cb, cancel=cancel)
+                     second_order=second, second_order_start=int(np.argmax(keep)), progress=cb, cancel=cancel)
 
     # ---- mean M(t): step-1 reactions interpolated to the record grid (wind-induced)
     rw = mean.reactions_wind  # (n_k, n_towers, 3)

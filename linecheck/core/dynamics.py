@@ -98,6 +98,7 @@ def integrate(
     direct: np.ndarray | None = None,
     model_at: Callable[[int], tuple[LinearModel, np.ndarray]] | None = None,
     second_order: list | None = None,
+    second_order_start: int = 0,
     progress: Callable[[int, int], None] | None = None,
     cancel: threading.Event | None = None,
 ) -> DynamicResponse:
@@ -120,7 +121,9 @@ def integrate(
         second_order: optional :class:`~linecheck.core.second_order.SecondOrder` operator of
             every mean state (same length as ``models``): the reactions of F and of B then
             include the second-order tension increment of their own displacement histories
-            (issue 16; with ``model_at`` the operator of the nearest state is used).
+            (issue 16; with ``model_at`` the operator of the nearest state is used), from step
+            ``second_order_start`` on (the steps before it, a burn-in the caller discards, keep
+            the linear reactions).
         progress: ``progress(done, total)`` about every 1 % of the steps (per block).
         cancel: stop early (raises :class:`Cancelled`).
 
@@ -175,16 +178,17 @@ def integrate(
             for i0 in range(0, all_steps.size, chunk):
                 steps = all_steps[i0:i0 + chunk]
                 R_B[steps] = _rowdot(loads[steps].reshape(-1, n_free), TB).reshape(steps.size, n_real, n_r)
-                if second_order is not None:  # the quasi-static displacements themselves
-                    UB = _fixed_matmul(loads[steps].reshape(-1, n_free), XT)
-                    R_B[steps] += so(int(steps[0]), UB).reshape(steps.size, n_real, n_r)
+                sk = steps[steps >= second_order_start]
+                if second_order is not None and sk.size:  # the quasi-static displacements themselves
+                    UB = _fixed_matmul(loads[sk].reshape(-1, n_free), XT)
+                    R_B[sk] += so(int(sk[0]), UB).reshape(sk.size, n_real, n_r)
     else:
         for n in range(n_steps):
             m, _ = model_of(n)
             c = _factor(m.K_band, np.zeros(n_dof), f"stiffness at step {n}")
             UB = _solve(c, loads_full(loads[n]).T).T
             R_B[n] = _rowdot(UB, m.G.T)
-            if second_order is not None:
+            if second_order is not None and n >= second_order_start:
                 R_B[n] += so(n, UB)
 
     # -------- step 2: Newmark, one factorisation per mean state, in node bases that make
@@ -194,7 +198,7 @@ def integrate(
     U = _solve(chol, loads_full(loads[0]).T).T  # quasi-static start, (n_real, n_dof), global
     R_F = np.empty((n_steps, n_real, n_r))
     R_F[0] = _rowdot(U, m0.G.T)
-    if second_order is not None:
+    if second_order is not None and second_order_start == 0:
         R_F[0] += so(0, U)
     block = max(1, min(512, 2_000_000 // max(n_real * n_dof, 1)))  # steps per block
     buf = np.empty((block, n_real, n_dof))
@@ -260,11 +264,12 @@ def integrate(
                 A, A_new = A_new, A
                 buf[k] = U
             R_F[b0:b1] = st.reactions(buf[: b1 - b0])
-            if second_order is not None:  # back to global coordinates, u = T u~ node by node
-                ut = buf[: b1 - b0].reshape(-1, n_dof)
-                R_F[b0:b1] += second_order_from_components(
-                    second_order[int(state_of_step[b0])], ut[:, 0::3], ut[:, 1::3], ut[:, 2::3],
-                    T=st.T).reshape(b1 - b0, n_real, n_r)
+            c0 = max(b0, second_order_start)
+            if second_order is not None and c0 < b1:  # back to global coordinates, u = T u~ node by node
+                ut = buf[c0 - b0: b1 - b0].reshape(-1, n_dof)
+                R_F[c0:b1] += second_order_from_components(
+                    second_order[int(state_of_step[c0])], ut[:, 0::3], ut[:, 1::3], ut[:, 2::3],
+                    T=st.T).reshape(b1 - c0, n_real, n_r)
             if progress is not None and b1 // report != b0 // report:
                 progress(b1, n_steps)
             if cancel is not None and cancel.is_set():

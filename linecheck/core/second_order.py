@@ -51,7 +51,7 @@ class SecondOrder:
             attachment), flattened (x, y, z per member), shape (3 n_m,), n_m = n_el + n_s.
         c: [N/m^2] (EA - N)/L_e^2 of every cable element, then (k_ax v - R_res)/v^2 of every
             insulator, shape (n_m,).
-        n_nodes: global nodes.
+        n_nodes: global nodes; pinned: the pinned (strain tower) nodes.
         runs: contiguous runs of free nodes (first node, end node, first free index).
         ins_free: index among the free nodes of every suspension attachment, (n_s,).
         A: [-] member second-order forces -> reactions: the support terms S f2 minus the
@@ -61,6 +61,7 @@ class SecondOrder:
     e: np.ndarray
     c: np.ndarray
     n_nodes: int
+    pinned: np.ndarray
     runs: tuple[tuple[int, int, int], ...]
     ins_free: np.ndarray
     A: np.ndarray
@@ -113,7 +114,8 @@ def second_order_operator(model: LinearModel, state: StaticState) -> SecondOrder
     cuts = np.flatnonzero(np.diff(free) != 1) + 1
     runs = tuple((int(r[0]), int(r[-1]) + 1, int(np.searchsorted(free, r[0]))) for r in np.split(free, cuts) if r.size)
     A = A.transpose(1, 0, 2).reshape(3 * n_m, n_r)  # component-major rows, as _member_forces
-    return SecondOrder(np.concatenate([e_el, model.axes]).ravel(), np.concatenate([c_el, c_in]), n_nodes, runs,
+    pinned = np.setdiff1d(np.arange(n_nodes), free)
+    return SecondOrder(np.concatenate([e_el, model.axes]).ravel(), np.concatenate([c_el, c_in]), n_nodes, pinned, runs,
                        model.dofs.node_dof[system.tower_nodes[sus]] // 3, np.ascontiguousarray(A))
 
 
@@ -166,7 +168,8 @@ def _member_forces(op: SecondOrder, *comps: np.ndarray) -> np.ndarray:
     m = comps[0].shape[0]
     n_m, n_el = op.c.size, op.n_nodes - 1
     d = np.empty((3, m, n_m))
-    u = np.zeros((m, op.n_nodes))
+    u = np.empty((m, op.n_nodes))
+    u[:, op.pinned] = 0.0
     for k, uk in enumerate(comps):
         for lo, hi, f0 in op.runs:  # free nodes in contiguous runs (slices, no fancy indexing)
             u[:, lo:hi] = uk[:, f0:f0 + hi - lo]

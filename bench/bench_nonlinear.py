@@ -39,6 +39,13 @@ docs/validation.md and docs/performance.md come from
     .venv/bin/python bench/bench_nonlinear.py --diagnostic --transverse --dt-check --mesh 20 40
     .venv/bin/python bench/bench_nonlinear.py --diagnostic --realizations 0 1 2 3 4
     .venv/bin/python bench/bench_nonlinear.py --no-paper --repeat 2 --ensemble 10
+    .venv/bin/python bench/bench_nonlinear.py --options --no-paper --realizations 0 1 2 3 4   # issue 16
+
+``--options`` adds linecheck with every combination of ``[analysis] drag`` and ``tension``
+(``linecheck_quadratic_linear``, ``linecheck_linear_second-order``,
+``linecheck_quadratic_second-order``; ``linecheck_quasi_steady`` is linear/linear), all with
+the quasi-steady damping, against the same OpenSees analysis.  The wind reaches OpenSees through
+the exported field file (``linecheck wind --field``, read by ``opensees_reference.read_field``).
 
 An import failure of openseespy (e.g. the system BLAS/LAPACK missing) is reported in one line
 and the script exits with status 2.
@@ -65,8 +72,8 @@ from opensees_reference import (  # noqa: E402
     NonlinearLine,
     OpenSeesUnavailable,
     WindRecord,
-    linecheck_wind,
     load_opensees,
+    read_field,
 )
 
 from linecheck import service  # noqa: E402
@@ -75,7 +82,22 @@ from linecheck.core.case import load_case  # noqa: E402
 CASES = ("case10-single", "case09-single", "case10-six", "case09-six", "case05-single", "case05-six")
 COMPONENTS = ("R_x", "R_y")
 STATS = ("mean", "rms", "peak")
+OPTION_COMBOS = (("linear", "linear"), ("quadratic", "linear"), ("linear", "second-order"),
+                 ("quadratic", "second-order"))
 ZERO_MEAN = 0.01  # a mean below 1 % of the case's largest mean reaction is zero (by symmetry), as in linecheck
+
+
+def field_wind(case, realization: int) -> WindRecord:
+    """linecheck's wind for ``case`` and ``realization`` (0-based) through the exported field
+    file (``linecheck wind --field``; the same arrays, via the service layer) read back by the
+    OpenSees reference."""
+    import tempfile
+
+    fld = service.wind_field(case, realization=realization)
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "field.npz"
+        np.savez(path, **fld.to_npz_dict())
+        return read_field(path)
 
 
 def with_analysis(case, **changes):
@@ -167,6 +189,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--dt-check", action="store_true", help="extra OpenSees run at dt/2")
     ap.add_argument("--diagnostic", action="store_true", help="extra run with the drag linearised about the mean")
     ap.add_argument("--transverse", action="store_true", help="extra run with the transverse-only drag, no structural damping")
+    ap.add_argument("--options", action="store_true",
+                    help="also linecheck with drag = quadratic and/or tension = second-order (issue 16)")
     ap.add_argument("--no-paper", action="store_true", help="skip linecheck's \"paper\" damping")
     ap.add_argument("--repeat", type=int, default=1, help="time both analyses best of N")
     ap.add_argument("--ensemble", type=int, default=0,
@@ -198,7 +222,7 @@ def main(argv: list[str] | None = None) -> int:
     warm = with_analysis(load_case(ROOT / "cases" / "paper" / "case10-single.toml"), duration=5.0,
                          damping="quasi-steady")
     wres = service.run_case(warm, realizations=[0])
-    NonlinearLine(warm).run(linecheck_wind(warm, 0, burn_in=wres.burn_in.seconds))
+    NonlinearLine(warm).run(field_wind(warm, 0))
 
     results = []
     for name in args.cases:
@@ -215,7 +239,7 @@ def main(argv: list[str] | None = None) -> int:
 def run_one(name: str, r: int, args) -> dict:
     """linecheck (quasi-steady, paper) and OpenSees (+ the requested checks) for one case and realization."""
     base = load_case(ROOT / "cases" / "paper" / f"{name}.toml")
-    changes = {"damping": "quasi-steady"}
+    changes = {"damping": "quasi-steady", "drag": "linear", "tension": "linear"}
     if args.duration is not None:
         changes["duration"] = args.duration
     case = with_analysis(base, **changes)
@@ -226,7 +250,7 @@ def run_one(name: str, r: int, args) -> dict:
         res = service.run_case(case, realizations=[r])
         t_lc = min(t_lc, time.perf_counter() - t0)
     burn = res.burn_in.seconds
-    wind = linecheck_wind(case, r, burn_in=burn)
+    wind = field_wind(case, r)
     if not np.allclose(wind.time[wind.keep], res.time, rtol=0, atol=1e-9):
         raise SystemExit(f"{name}: record grid differs from linecheck's")
     R_lc, M_lc = linecheck_history(res)
@@ -259,6 +283,12 @@ def run_one(name: str, r: int, args) -> dict:
             "linecheck_quasi_steady": statistics(R_lc, None if synoptic else M_lc),
         },
     }
+    if args.options:  # issue 16: every drag/tension combination (quasi-steady damping), same wind
+        for drag, tension in OPTION_COMBOS[1:]:
+            co = with_analysis(case, drag=drag, tension=tension, burn_in=burn)  # same record, same wind
+            ro = service.run_case(co, realizations=[r])
+            Ro, Mo = linecheck_history(ro)
+            entry["stats"][f"linecheck_{drag}_{tension}"] = statistics(Ro, None if synoptic else Mo)
     if not args.no_paper:
         cp = with_analysis(case, damping="paper", burn_in=burn)  # same record, same wind
         rp = service.run_case(cp, realizations=[r])

@@ -31,9 +31,11 @@ Model (the same system as linecheck; docs/method.md for axes and signs)
       F_i = 1/2 rho C_d D L_i |U_i| U_i,
 
   L_i the tributary unstretched length and U_i the relative velocity.  The wind is linecheck's,
-  for the same case, seed and record: the running-mean normal component V_n plus the normal
-  component of the along-wind fluctuation, v V_n / |V| (= v |V_n|/|V| sign V_n, as linecheck
-  does; synoptic: V + v), blowing toward +y.  Three drag models:
+  for the same case, seed and record, read from the file ``linecheck wind CASE --field OUT.npz``
+  writes (:func:`read_field`; layout in docs/wind.md): the running-mean normal component V_n
+  (``u_mean[..., 1]``) plus the normal component of the along-wind fluctuation
+  (``u_turb[..., 1]`` = v V_n / |V|, as linecheck's Eq. 5 uses it; synoptic: V + v), blowing
+  toward +y.  Three drag models:
 
   - ``"crossflow"`` (default): U = W_n y - P u', P = I - e e^T, e the current conductor tangent
     at the node: the relative velocity in every direction normal to the conductor axis (the
@@ -147,47 +149,19 @@ class WindRecord:
     keep: np.ndarray
 
 
-def record_grid(case: Case, burn_in: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    """Record instants and the analysed mask exactly as ``service.run_case`` builds them."""
-    from linecheck import service
-
-    t = service.record_time(case)
-    dt = case.analysis.time_step
-    if burn_in > 0:
-        nb = int(np.round(burn_in / dt))
-        t = t[0] - dt * nb + dt * np.arange(t.size + nb)
-    keep = t >= t[0] + burn_in - 1e-9
-    return t, keep
-
-
-def linecheck_wind(case: Case, realization: int = 0, *, burn_in: float = 0.0,
-                   fluctuating: bool = True) -> WindRecord:
-    """The wind linecheck synthesises for ``case`` and ``realization`` (0-based) on its record grid.
-
-    Same calls as ``service.run_case``: ``fluctuating_velocity(case, system, t, [r])`` on the
-    same instants (so the same field, bit for bit) and the running mean at the nodes.
-    """
-    from linecheck import service
-    from linecheck.core.wind.mean import mean_wind
-    from linecheck.core.wind.turbulence import fluctuating_velocity
-
-    system = LineSystem(case.line)
-    t, keep = record_grid(case, burn_in)
-    if case.wind.type == "synoptic":
-        mw = mean_wind(case, system, np.zeros(1))
-        vn = np.broadcast_to(service.to_global_nodes(system, mw.normal)[0], (t.size, system.n_nodes)).copy()
-        vl = np.broadcast_to(service.to_global_nodes(system, mw.longitudinal)[0], (t.size, system.n_nodes)).copy()
-    else:
-        mw = mean_wind(case, system, t)
-        vn = service.to_global_nodes(system, mw.normal)
-        vl = service.to_global_nodes(system, mw.longitudinal)
-    total = vn.copy()
-    if fluctuating:
-        v = fluctuating_velocity(case, system, t, [realization])[0]
-        speed = np.hypot(vn, vl)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            total += np.where(speed > 0, v * vn / np.where(speed > 0, speed, 1.0), 0.0)
-    return WindRecord(t, total, vn, keep)
+def read_field(path) -> WindRecord:
+    """The wind of one record from a ``linecheck wind CASE --field OUT.npz`` file (public layout,
+    docs/wind.md): the total normal wind W_n = u_mean_y + u_turb_y and the running mean u_mean_y
+    at every conductor node and instant (burn-in included, marked by ``burn_in``).  Only the
+    file is read: nothing of linecheck's internals is called, so any wind in that layout (from
+    linecheck or elsewhere) can be fed to this reference."""
+    with np.load(path, allow_pickle=False) as z:
+        t = np.asarray(z["t"], dtype=float)
+        burn = float(z["burn_in"])
+        u_mean = np.asarray(z["u_mean"], dtype=float)
+        u_turb = np.asarray(z["u_turb"], dtype=float)
+    keep = t >= t[0] + burn - 1e-9
+    return WindRecord(t, u_mean[:, :, 1] + u_turb[:, :, 1], u_mean[:, :, 1].copy(), keep)
 
 
 # --------------------------------------------------------------------------- results

@@ -37,6 +37,8 @@ time_step = 0.05
 realizations = 10
 seed = {seed}
 damping = "paper"        # Eq. 13 exactly (transverse only), as in the paper
+drag = "linear"          # Eq. 5: the v^2 term dropped, as in the paper
+tension = "linear"       # reactions linear in the motion, as in the paper
 """
 
 
@@ -101,6 +103,8 @@ time_step = 0.05
 realizations = 10
 seed = {1000 + V}
 damping = "paper"        # Eq. 13 exactly (transverse only), as in the paper
+drag = "linear"          # Eq. 5, as in the paper
+tension = "linear"       # as in the paper
 '''
         (val / f"matheson-holmes-v{V}.toml").write_text(text)
 

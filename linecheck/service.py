@@ -80,10 +80,33 @@ def mean_state_times(case: Case) -> np.ndarray:
     return np.linspace(t0, t1, case.analysis.mean_states)
 
 
+def turbulence_variance_ratio(case: Case, normal: np.ndarray, longitudinal: np.ndarray) -> np.ndarray:
+    """sigma^2 / |V|^2 [-]: variance of the along-wind turbulence over the squared running-mean
+    speed, same shape as ``normal`` [m/s] (0 where |V| = 0).
+
+    Downburst: sigma = I |V_m| (Chay et al. 2006), so the ratio is I^2; synoptic: sigma = I V_ref
+    on a span of mean speed |V| (I^2 unless ``span_speeds`` differ from v_ref).
+    """
+    i = case.wind.turbulence_intensity
+    if case.wind.type == "downburst":
+        return np.full(np.shape(normal), i * i)
+    speed2 = normal**2 + longitudinal**2
+    sig2 = (i * case.wind.v_ref) ** 2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(speed2 > 0, sig2 / np.where(speed2 > 0, speed2, 1.0), 0.0)
+
+
 def mean_loads(case: Case, wind: MeanWind) -> np.ndarray:
-    """Transverse mean load per unit length [N/m], shape (n_t, n_spans, ne+1) (paper Eq. 1)."""
+    """Transverse mean load per unit length [N/m], shape (n_t, n_spans, ne+1) (paper Eq. 1).
+
+    ``drag = "quadratic"``: the mean of the drag on the total wind, 1/2 rho C_d D V_n|V_n|
+    (1 + sigma^2/|V|^2), i.e. the paper's Eq. 1 times (1 + I^2) (docs/method.md "Quadratic drag").
+    """
     line = case.line
-    return drag_intensity(wind.normal, case.wind.air_density, line.drag_coefficient, line.diameter)
+    g = drag_intensity(wind.normal, case.wind.air_density, line.drag_coefficient, line.diameter)
+    if case.analysis.drag == "quadratic":
+        g = g * (1.0 + turbulence_variance_ratio(case, wind.normal, wind.longitudinal))
+    return g
 
 
 def static_analysis(
@@ -329,6 +352,70 @@ def _interpolated_models(case: Case, st: StaticResult, bracket: np.ndarray, weig
     return model_at
 
 
+def record_mean_wind(case: Case, st: StaticResult, t: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """Running-mean normal and longitudinal speeds [m/s] at the global nodes over the record
+    ``t``, shape (n_steps, n_nodes) each (synoptic: the step-1 wind held, longitudinal None)."""
+    system = st.system
+    if case.wind.type == "synoptic":
+        vn = np.broadcast_to(to_global_nodes(system, st.wind.normal)[0], (t.size, system.n_nodes))
+        return vn, None
+    mw = mean_wind(case, system, t)
+    return to_global_nodes(system, mw.normal), to_global_nodes(system, mw.longitudinal)
+
+
+def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: np.ndarray, vn: np.ndarray,
+                      vl: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Fluctuating transverse nodal loads of steps 2-3 from the along-wind turbulence.
+
+    Args:
+        v: [m/s] along-wind turbulence, shape (n_real, n_steps, n_nodes).
+        vn: [m/s] running-mean normal speed at the nodes, (n_steps, n_nodes);
+        vl: [m/s] running-mean longitudinal speed (downburst; None: zero, cos(phi) = 1).
+    Returns:
+        loads [N] on the free nodes, (n_steps, n_real, n_free); direct [N] reactions of the loads
+        at pinned nodes, (n_steps, n_real, 3 n_towers).
+
+    ``drag = "linear"``: rho C_d D L_i V_n v_n (paper Eq. 5), v_n = v cos(phi) the normal component
+    of the fluctuation.  ``"quadratic"`` adds the zero-mean rest of the drag on the total wind,
+    1/2 rho C_d D L_i V_n|V_n|/|V|^2 (v^2 - sigma^2) (docs/method.md "Quadratic drag"; its mean
+    sigma^2 is in step 1, :func:`mean_loads`).
+    """
+    line, wind = case.line, case.wind
+    if vl is None:
+        cos_n = np.ones_like(vn)
+    else:
+        speed = np.hypot(vn, vl)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            cos_n = np.where(speed > 0, np.abs(vn) / np.where(speed > 0, speed, 1.0), 1.0)
+    coef = wind.air_density * line.drag_coefficient * line.diameter
+    # Eq. 5 per unit v, normal component of the fluctuation: v cos(phi), phi the angle of
+    # the mean wind to the normal of the line
+    per_v = coef * model.tributary[None, :] * (vn * cos_n)  # (n_steps, n_nodes)
+    quad = case.analysis.drag == "quadratic"
+    if quad:
+        vl0 = np.zeros_like(vn) if vl is None else vl
+        ratio = turbulence_variance_ratio(case, vn, vl0)  # sigma^2/|V|^2
+        speed2 = vn**2 + vl0**2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inv = np.where(speed2 > 0, 1.0 / np.where(speed2 > 0, speed2, 1.0), 0.0)
+        # 1/2 rho C_d D L V_n|V_n| / |V|^2 per unit (v^2 - sigma^2); sigma^2 = ratio |V|^2
+        per_q = 0.5 * coef * model.tributary[None, :] * vn * np.abs(vn) * inv
+        sig2 = ratio * speed2
+    free = model.dofs.free_nodes
+    pinned = system.tower_nodes[~system.suspension]
+    n_real = v.shape[0]
+    loads = np.empty((t.size, n_real, free.size))
+    direct = np.zeros((t.size, n_real, 3 * system.n_towers))
+    for i in range(n_real):
+        f_i = per_v * v[i]  # (n_steps, n_nodes)
+        if quad:
+            f_i += per_q * (v[i] * v[i] - sig2)
+        loads[:, i, :] = f_i[:, free]
+        # loads at pinned nodes go straight into their supports (R_y)
+        direct[:, i, 3 * np.flatnonzero(~system.suspension) + 1] = f_i[:, pinned]
+    return loads, direct
+
+
 def run_case(
     case: Case,
     *,
@@ -391,38 +478,22 @@ def run_case(
     # ---- fluctuating load F_w = rho C_d D L_e V_m v (paper Eq. 5), normal components
     if progress is not None:
         progress("wind", 0, 1)
-    mw = mean_wind(case, system, t) if wind.type == "downburst" else None
-    if mw is None:
-        vn = np.broadcast_to(vn_states[0], (t.size, system.n_nodes))
-        cos_n = np.ones_like(vn)
-    else:
-        vn = to_global_nodes(system, mw.normal)
-        vl = to_global_nodes(system, mw.longitudinal)
-        speed = np.hypot(vn, vl)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            cos_n = np.where(speed > 0, np.abs(vn) / np.where(speed > 0, speed, 1.0), 1.0)
+    vn, vl = record_mean_wind(case, st, t)
     v = fluctuating_velocity(case, system, t, list(real))  # (n_real, n_steps, n_nodes), along-wind
+    loads, direct = fluctuating_loads(case, system, models[0], t, v, vn, vl)
     if progress is not None:
         progress("wind", 1, 1)
     check_cancel()
-    coef = wind.air_density * line.drag_coefficient * line.diameter
-    # Eq. 5 per unit v, normal component of the fluctuation: v cos(phi), phi the angle of
-    # the mean wind to the normal of the line
-    per_v = coef * models[0].tributary[None, :] * (vn * cos_n)  # (n_steps, n_nodes)
-    free = models[0].dofs.free_nodes
-    pinned = system.tower_nodes[~system.suspension]
-    loads = np.empty((t.size, real.size, free.size))
-    direct = np.zeros((t.size, real.size, 3 * system.n_towers))
-    for i in range(real.size):
-        f_i = per_v * v[i]  # (n_steps, n_nodes)
-        loads[:, i, :] = f_i[:, free]
-        # loads at pinned nodes go straight into their supports (R_y)
-        direct[:, i, 3 * np.flatnonzero(~system.suspension) + 1] = f_i[:, pinned]
     del v
+    second = None
+    if case.analysis.tension == "second-order":
+        from .core.second_order import second_order_operator
+
+        second = [second_order_operator(m, mean.state(k)) for k, m in enumerate(models)]
     cb = None if progress is None else (lambda d, n: progress("steps 2-3: dynamics", d, n))
     resp = integrate(models, damping, state_of_step, loads, dt, direct=direct,
                      model_at=_interpolated_models(case, st, bracket, weights) if interpolate_states else None,
-                     progress=cb, cancel=cancel)
+                     second_order=second, second_order_start=int(np.argmax(keep)), progress=cb, cancel=cancel)
 
     # ---- mean M(t): step-1 reactions interpolated to the record grid (wind-induced)
     rw = mean.reactions_wind  # (n_k, n_towers, 3)
@@ -477,6 +548,102 @@ def modes_analysis(case: Case, *, n_modes: int = 20, warn: Warn | None = None) -
     damped = dataclasses.replace(cm, frequencies_hz=cm.frequencies_hz[:n], damping_ratio=cm.damping_ratio[:n],
                                  poles=cm.poles[:n])
     return ModesResult(case, still, at_mean, float(mean.time[k]), damped)
+
+
+@dataclass(frozen=True)
+class WindField:
+    """The wind of one realization of a run at every conductor node (``linecheck wind --field``;
+    public NPZ layout in docs/wind.md).
+
+    Attributes:
+        t: [s] the analysed record's equally spaced instants, burn-in included, shape (n_t,).
+        burn_in: [s] the discarded start of ``t`` (0 for downbursts and ``damping = "paper"``).
+        x_node: [m] still-air node positions (x along the line, z up), shape (n_nodes, 3);
+            nodes in line order, tower nodes once (n_spans * elements_per_span + 1).
+        u_mean: [m/s] running-mean wind velocity (x, y, z) at each node, (n_t, n_nodes, 3).
+        u_turb: [m/s] turbulent wind velocity (x, y, z): the along-wind fluctuation v along the
+            running mean's direction, (n_t, n_nodes, 3).
+        v_along: [m/s] the along-wind fluctuation v itself (signed), (n_t, n_nodes).
+        realization: 1-based; seed: the case's seed.
+    """
+
+    case: Case
+    t: np.ndarray
+    burn_in: float
+    x_node: np.ndarray
+    u_mean: np.ndarray
+    u_turb: np.ndarray
+    v_along: np.ndarray
+    realization: int
+    seed: int
+
+    def to_npz_dict(self) -> dict[str, np.ndarray]:
+        """Arrays of the public NPZ layout (docs/wind.md)."""
+        return {
+            "t": self.t, "burn_in": np.float64(self.burn_in), "x_node": self.x_node,
+            "u_mean": self.u_mean, "u_turb": self.u_turb, "v_along": self.v_along,
+            "realization": np.int64(self.realization), "seed": np.int64(self.seed),
+            "case": np.str_(self.case.name), "units": np.str_("SI: s, m, m/s; x along the line, y transverse, z up"),
+        }
+
+
+def record_grid(case: Case, st: StaticResult | None = None) -> tuple[np.ndarray, float]:
+    """Instants of steps 2-3 [s] with the burn-in exactly as :func:`run_case` builds them, and
+    the burn-in [s]."""
+    st = static_analysis(case) if st is None else st
+    t = record_time(case)
+    dt = case.analysis.time_step
+    burn = 0.0
+    if case.wind.type == "synoptic":
+        burn = burn_in(case, synoptic_model(case, st)).seconds
+    if burn > 0:
+        t = t[0] - dt * np.round(burn / dt) + dt * np.arange(t.size + int(np.round(burn / dt)))
+    return t, float(burn)
+
+
+def wind_field(case: Case, *, realization: int = 0) -> WindField:
+    """The running mean and turbulence of ``realization`` (0-based) at every conductor node and
+    step of the record :func:`run_case` analyses (burn-in included): the same calls, so the same
+    field bit for bit (issue 16).  u_turb = v (V_x, V_y, 0)/|V| (Eq. 5's normal component is its
+    y component); no vertical wind (z components zero)."""
+    from .core.errors import CaseError
+    from .core.wind.turbulence import fluctuating_velocity
+
+    if not 0 <= realization < case.analysis.realizations:
+        raise CaseError(f"realization {realization + 1} is out of range: expected 1 to {case.analysis.realizations} "
+                        "(analysis.realizations)")
+    st = static_analysis(case)
+    system = st.system
+    t, burn = record_grid(case, st)
+    vn, vl = record_mean_wind(case, st, t)
+    vl = np.zeros_like(vn) if vl is None else vl
+    v = fluctuating_velocity(case, system, t, [realization])[0]
+    zero = np.zeros_like(vn)
+    u_mean = np.stack([vl, vn, zero], axis=-1)
+    speed = np.hypot(vn, vl)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        unit_n = np.where(speed > 0, vn / np.where(speed > 0, speed, 1.0), 1.0)
+        unit_l = np.where(speed > 0, vl / np.where(speed > 0, speed, 1.0), 0.0)
+    u_turb = np.stack([v * unit_l, v * unit_n, zero], axis=-1)
+    x_node = st.mean.still_air.nodes.copy()
+    return WindField(case, t, burn, x_node, u_mean, u_turb, v, realization + 1, case.analysis.seed)
+
+
+def read_wind_field(path) -> dict[str, np.ndarray]:
+    """The arrays of a ``linecheck wind --field`` NPZ file (docs/wind.md)."""
+    with np.load(path, allow_pickle=False) as z:
+        return {k: z[k] for k in z.files}
+
+
+def loads_from_field(case: Case, field: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Fluctuating loads of steps 2-3 (:func:`fluctuating_loads`) from a wind field's arrays
+    (``WindField.to_npz_dict`` or :func:`read_wind_field`): loads [N] (n_t, 1, n_free) and the
+    direct reactions [N] (n_t, 1, 3 n_towers)."""
+    st = static_analysis(case)
+    model = build_model(st.system, st.mean.state(0))
+    u = field["u_mean"]
+    vl = None if case.wind.type == "synoptic" else u[:, :, 0]
+    return fluctuating_loads(case, st.system, model, field["t"], field["v_along"][None], u[:, :, 1], vl)
 
 
 @dataclass(frozen=True)

@@ -14,11 +14,16 @@ from rich.table import Table
 from ..core.case import Case
 from ..core.wind.mean import downburst_field, event_window
 from ..core.wind.point import PointSeries, point_series
-from ..io.atomic import check_target, write_text_atomic
+from ..io.atomic import check_target, write_atomic, write_text_atomic
 from ..io.jsonout import write_json
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
 
 CsvOpt = Annotated[Path | None, typer.Option("--csv", help="Write time, mean and total velocity at p as CSV to this file.")]
+FieldOpt = Annotated[
+    Path | None,
+    typer.Option("--field", help="Write the run's full wind (running mean and turbulence at every conductor node and "
+                 "time step of the realization) to this NPZ file (layout: docs/wind.md)."),
+]
 RealizationOpt = Annotated[
     int, typer.Option("--realization", min=1, help="Turbulence realization to show, 1 to analysis.realizations.")
 ]
@@ -101,6 +106,7 @@ def wind(
     csv_out: CsvOpt = None,
     json_out: JsonOpt = None,
     realization: RealizationOpt = 1,
+    field_out: FieldOpt = None,
 ) -> None:
     """Wind at point p: running mean and mean + turbulence over the record (paper Fig. 3)."""
     case = read_case(case_file)
@@ -112,6 +118,8 @@ def wind(
     from .limits import warn as limits_warn
 
     service.check_budget(case, "wind", warn=limits_warn)  # resource guard (issue 14)
+    if field_out is not None:
+        check_target(field_out, what="NPZ")
     s = point_series(case, realization - 1)
     doc = series_summary(case, s)
     table = Table(title=f"{case.name}: wind at point p (x = {s.point_p:.1f} m), realization {realization}",
@@ -137,3 +145,16 @@ def wind(
     if json_out is not None:
         write_json(json_out, doc)
         console.print(f"wrote {json_out}")
+    if field_out is not None:
+        from .. import service
+
+        fld = service.wind_field(case, realization=realization - 1)
+        arrays = fld.to_npz_dict()
+
+        def save(tmp: Path) -> None:
+            with open(tmp, "wb") as fh:  # a file object: numpy would append ".npz" to a name
+                np.savez(fh, **arrays)
+
+        write_atomic(field_out, save, what="NPZ")
+        console.print(f"wrote {field_out} ({fld.t.size} steps incl. {fld.burn_in:g} s burn-in, "
+                      f"{fld.x_node.shape[0]} nodes)")

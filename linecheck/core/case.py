@@ -35,6 +35,8 @@ DOWNBURST_PRESETS = ("Db_x", "Db_y")
 DOWNBURST_MODELS = ("holmes-oliver", "table", "ring-jet")
 DAMPING_MODELS = ("quasi-steady", "paper")
 CODE_TERRAINS = ("sea", "open", "suburban", "urban")  # [codes] terrain (docs/codes.md)
+DRAG_MODELS = ("linear", "quadratic")
+TENSION_MODELS = ("linear", "second-order")
 # Conductor self-damping assumed with the quasi-steady model (ratio at the lowest mean-state
 # mode, stiffness-proportional): it damps the axial modes that no aerodynamic model damps.
 DEFAULT_STRUCTURAL_DAMPING = 0.002
@@ -145,6 +147,8 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         FieldSpec("damping", "choice", "-", 'aerodynamic damping: "quasi-steady" (every direction of relative motion) or "paper" (Eq. 13, transverse only)', default="quasi-steady", choices=DAMPING_MODELS),
         _f("structural_damping", "-", 'structural (self-)damping ratio at the lowest mean-state mode (default: 0 with "paper", 0.002 with "quasi-steady")', low=0.0, high=0.2),
         _f("burn_in", "s", "synoptic: discarded start of the record (default: from the least-damped significant mode)", low=0.0, high=1e5),
+        FieldSpec("drag", "choice", "-", 'fluctuating drag: "linear" (paper Eq. 5) or "quadratic" (the v^2 term kept, its mean I^2 in step 1)', default="quadratic", choices=DRAG_MODELS),
+        FieldSpec("tension", "choice", "-", 'reactions: "linear" (paper) or "second-order" (+ the tension increment quadratic in the linear motion)', default="second-order", choices=TENSION_MODELS),
     ),
     "codes": (  # design-code comparison (issue 19, docs/codes.md)
         FieldSpec("terrain", "choice", "-", 'terrain for the design codes: "sea", "open", "suburban" or "urban" (maps to each code\'s category)', default="open", choices=CODE_TERRAINS),
@@ -247,6 +251,8 @@ class Analysis:
     damping: str = "quasi-steady"
     structural_damping: float | None = None  # [-]; None = default of the damping model
     burn_in: float | None = None  # [s]; None = derived (synoptic)
+    drag: str = "quadratic"  # DRAG_MODELS (docs/method.md "Quadratic drag")
+    tension: str = "second-order"  # TENSION_MODELS (docs/method.md "Second-order tension")
 
     @property
     def structural_ratio(self) -> float:

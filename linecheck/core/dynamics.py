@@ -97,6 +97,8 @@ def integrate(
     *,
     direct: np.ndarray | None = None,
     model_at: Callable[[int], tuple[LinearModel, np.ndarray]] | None = None,
+    second_order: list | None = None,
+    second_order_start: int = 0,
     progress: Callable[[int, int], None] | None = None,
     cancel: threading.Event | None = None,
 ) -> DynamicResponse:
@@ -116,6 +118,12 @@ def integrate(
             step n itself (reference scheme: the step-1 state interpolated in time and the
             model rebuilt and factorised at every step); default: ``models[state_of_step[n]]``
             held piecewise constant.
+        second_order: optional :class:`~linecheck.core.second_order.SecondOrder` operator of
+            every mean state (same length as ``models``): the reactions of F and of B then
+            include the second-order tension increment of their own displacement histories
+            (issue 16; with ``model_at`` the operator of the nearest state is used), from step
+            ``second_order_start`` on (the steps before it, a burn-in the caller discards, keep
+            the linear reactions).
         progress: ``progress(done, total)`` about every 1 % of the steps (per block).
         cancel: stop early (raises :class:`Cancelled`).
 
@@ -150,20 +158,38 @@ def integrate(
     # -------- step 3: quasi-static background, one factorisation per mean state
     R_B = np.empty((n_steps, n_real, n_r))
     chunk = max(1, 8192 // max(n_real, 1))
+    if second_order is not None:
+        from .second_order import second_order_from_components, second_order_reactions
+
+        def so(n: int, U: np.ndarray) -> np.ndarray:
+            """Second-order reactions of global displacements U (..., n_dof) under the state of step n."""
+            return second_order_reactions(second_order[int(state_of_step[n])], U.reshape(-1, n_dof)).reshape(
+                U.shape[:-1] + (n_r,))
     if model_at is None:
         for k in np.unique(state_of_step):
             c = _factor(models[k].K_band, np.zeros(n_dof), f"stiffness of mean state {k + 1}")
             # static transfer from the y-loads to the reactions, (G K^-1 P)^T = (K^-1 G^T)[y]
             TB = np.ascontiguousarray(_solve(c, np.asfortranarray(models[k].G.T))[ydof])  # (n_free, n_r)
+            if second_order is not None:  # (K^-1 P)^T: the y-loads to the quasi-static displacements
+                E = np.zeros((n_dof, n_free), order="F")
+                E[ydof, np.arange(n_free)] = 1.0
+                XT = np.ascontiguousarray(_solve(c, E).T)  # (n_free, n_dof)
             all_steps = np.flatnonzero(state_of_step == k)
             for i0 in range(0, all_steps.size, chunk):
                 steps = all_steps[i0:i0 + chunk]
                 R_B[steps] = _rowdot(loads[steps].reshape(-1, n_free), TB).reshape(steps.size, n_real, n_r)
+                sk = steps[steps >= second_order_start]
+                if second_order is not None and sk.size:  # the quasi-static displacements themselves
+                    UB = _fixed_matmul(loads[sk].reshape(-1, n_free), XT)
+                    R_B[sk] += so(int(sk[0]), UB).reshape(sk.size, n_real, n_r)
     else:
         for n in range(n_steps):
             m, _ = model_of(n)
             c = _factor(m.K_band, np.zeros(n_dof), f"stiffness at step {n}")
-            R_B[n] = _rowdot(_solve(c, loads_full(loads[n]).T).T, m.G.T)
+            UB = _solve(c, loads_full(loads[n]).T).T
+            R_B[n] = _rowdot(UB, m.G.T)
+            if second_order is not None and n >= second_order_start:
+                R_B[n] += so(n, UB)
 
     # -------- step 2: Newmark, one factorisation per mean state, in node bases that make
     # M and C diagonal (so that the per-step products are elementwise; see _Stepper)
@@ -172,6 +198,8 @@ def integrate(
     U = _solve(chol, loads_full(loads[0]).T).T  # quasi-static start, (n_real, n_dof), global
     R_F = np.empty((n_steps, n_real, n_r))
     R_F[0] = _rowdot(U, m0.G.T)
+    if second_order is not None and second_order_start == 0:
+        R_F[0] += so(0, U)
     block = max(1, min(512, 2_000_000 // max(n_real * n_dof, 1)))  # steps per block
     buf = np.empty((block, n_real, n_dof))
     # segments: runs of steps under one linear model (one mean state), cut into blocks
@@ -236,6 +264,12 @@ def integrate(
                 A, A_new = A_new, A
                 buf[k] = U
             R_F[b0:b1] = st.reactions(buf[: b1 - b0])
+            c0 = max(b0, second_order_start)
+            if second_order is not None and c0 < b1:  # back to global coordinates, u = T u~ node by node
+                ut = buf[c0 - b0: b1 - b0].reshape(-1, n_dof)
+                R_F[c0:b1] += second_order_from_components(
+                    second_order[int(state_of_step[c0])], ut[:, 0::3], ut[:, 1::3], ut[:, 2::3],
+                    T=st.T).reshape(b1 - c0, n_real, n_r)
             if progress is not None and b1 // report != b0 // report:
                 progress(b1, n_steps)
             if cancel is not None and cancel.is_set():
@@ -252,6 +286,25 @@ def integrate(
         fluctuating=np.ascontiguousarray(R_F.reshape(shape).transpose(1, 0, 2, 3)),
         background=np.ascontiguousarray(R_B.reshape(shape).transpose(1, 0, 2, 3)),
     )
+
+
+def _fixed_matmul(X: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """X @ B by BLAS on blocks of a fixed number of rows (the last one padded with zeros) that
+    depends on B only: every row is computed by the same call shape whatever the number of rows
+    (realizations) in X, so results are bit-identical across batch chunking; the blocks are small
+    enough for OpenBLAS to stay on one thread (below its 4 x 65536 multiply-add threshold)."""
+    m = X.shape[0]
+    chunk = max(8, 250_000 // B.size)
+    out = np.empty((m, B.shape[1]))
+    for i0 in range(0, m, chunk):
+        i1 = min(i0 + chunk, m)
+        if i1 - i0 == chunk:
+            np.matmul(X[i0:i1], B, out=out[i0:i1])
+        else:
+            pad = np.zeros((chunk, X.shape[1]))
+            pad[: i1 - i0] = X[i0:i1]
+            out[i0:i1] = (pad @ B)[: i1 - i0]
+    return out
 
 
 def _rowdot(X: np.ndarray, BT: np.ndarray) -> np.ndarray:

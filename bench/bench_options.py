@@ -1,0 +1,76 @@
+"""Cost of the issue-16 options: drag = "quadratic" and tension = "second-order" (docs/performance.md).
+
+Run from the repository root:
+
+    .venv/bin/python bench/bench_options.py                   # case09-six, 10 realizations, best of 3
+    .venv/bin/python bench/bench_options.py --case case10-six --repeat 5
+
+``service.run_case`` of the six-span synoptic case (all 10 realizations, the paper's 600 s
+record, wind synthesis, burn-in and frequency-domain check included) with every combination of
+the two keys, timed in this process, interleaved (so that the machine's load affects all
+alike), best of ``--repeat``.  Ratios are to the paper's linear/linear run of the same case.
+All four runs analyse the same record: the burn-in is derived once (linear/linear) and imposed
+(the derived burn-in can move by one step with the mean state, which changes the wind
+synthesis' FFT length and its cost by up to 20 %, unrelated to the options).
+Target (issue 16): both options together add at most 15 %.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import os
+import platform
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from linecheck import service  # noqa: E402
+from linecheck.core.case import load_case  # noqa: E402
+
+COMBOS = (("linear", "linear"), ("quadratic", "linear"), ("linear", "second-order"), ("quadratic", "second-order"))
+TARGET = 1.15
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--case", default="case09-six")
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--damping", default="quasi-steady", choices=("quasi-steady", "paper"))
+    args = ap.parse_args(argv)
+    base = load_case(ROOT / "cases" / "paper" / f"{args.case}.toml")
+    ref = dataclasses.replace(base, analysis=dataclasses.replace(base.analysis, damping=args.damping))
+    # the same record for all: the derived burn-in moves by a step with the mean state, and the
+    # wind synthesis' FFT length (hence its cost) with it
+    burn = service.burn_in(ref, service.synoptic_model(ref, service.static_analysis(ref))).seconds \
+        if ref.wind.type == "synoptic" else None
+    cases = {c: dataclasses.replace(base, analysis=dataclasses.replace(
+        base.analysis, damping=args.damping, drag=c[0], tension=c[1], burn_in=burn)) for c in COMBOS}
+    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, load average "
+          f"{os.getloadavg()[0]:.1f}; python {platform.python_version()}, numpy {np.__version__}")
+    print(f"{args.case}: {base.analysis.realizations} realizations, damping = \"{args.damping}\", best of {args.repeat}")
+    service.run_case(cases[COMBOS[-1]], realizations=[0])  # warm-up (imports, first calls)
+    best = {c: np.inf for c in COMBOS}
+    for _ in range(args.repeat):
+        for c in COMBOS:
+            t0 = time.perf_counter()
+            service.run_case(cases[c])
+            best[c] = min(best[c], time.perf_counter() - t0)
+    ref = best[COMBOS[0]]
+    print("| drag | tension | time [s] | ratio |")
+    print("| --- | --- | ---: | ---: |")
+    for c in COMBOS:
+        print(f"| {c[0]} | {c[1]} | {best[c]:.2f} | {best[c] / ref:.3f} |")
+    both = best[COMBOS[-1]] / ref
+    print(f"both options: +{100 * (both - 1):.1f} % (target <= +{100 * (TARGET - 1):.0f} %): "
+          f"{'met' if both <= TARGET else 'NOT met'}; load average now {os.getloadavg()[0]:.1f}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -14,6 +14,7 @@ CORE_MODULES = [
     "linecheck.core.dynamics",
     "linecheck.core.damping",
     "linecheck.core.results",
+    "linecheck.core.extremes",
     "linecheck.core.modes",
     "linecheck.core.spectral",
     "linecheck.core.wind.mean",

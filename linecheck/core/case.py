@@ -135,6 +135,8 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         FieldSpec("damping", "choice", "-", 'aerodynamic damping: "quasi-steady" (every direction of relative motion) or "paper" (Eq. 13, transverse only)', default="quasi-steady", choices=DAMPING_MODELS),
         _f("structural_damping", "-", 'structural (self-)damping ratio at the lowest mean-state mode (default: 0 with "paper", 0.002 with "quasi-steady")', low=0.0, high=0.2),
         _f("burn_in", "s", "synoptic: discarded start of the record (default: from the least-damped significant mode)", low=0.0, high=1e5),
+        _f("peak_window", "s", "peaks taken per window of the analysed record; statistics over windows x realizations (default: the whole record; a downburst's whole event)", low=0.0, high=1e5, low_open=True),
+        _f("design_fractile", "-", "non-exceedance probability of the Gumbel design peak (0.5 = median peak)", default=0.5, low=0.0, high=0.999, low_open=True),
     ),
 }
 
@@ -222,6 +224,8 @@ class Analysis:
     damping: str = "quasi-steady"
     structural_damping: float | None = None  # [-]; None = default of the damping model
     burn_in: float | None = None  # [s]; None = derived (synoptic)
+    peak_window: float | None = None  # [s]; None = the whole analysed record (issue 18)
+    design_fractile: float = 0.5  # [-] non-exceedance probability of the design peak (issue 18)
 
     @property
     def structural_ratio(self) -> float:
@@ -443,6 +447,8 @@ def case_from_dict(
     analysis = Analysis(**an_d)
     if analysis.duration is not None and analysis.time_step * 4 > analysis.duration:
         raise ctx.error("analysis", "time_step", f"value {analysis.time_step!r} is too large for duration {analysis.duration!r}: expected at most duration/4")
+    if analysis.peak_window is not None and analysis.peak_window < 4 * analysis.time_step:
+        raise ctx.error("analysis", "peak_window", f"value {analysis.peak_window!r} is too short for time_step {analysis.time_step!r}: expected at least 4 time steps")
     name = top["name"] or default_name
     return Case(name=name, description=top["description"] or "", line=line, wind=wind, analysis=analysis,
                 source=Path(file) if file else None)

@@ -121,45 +121,35 @@ def case_parameters(case: Any) -> dict[str, Any]:
     return case_to_dict(case)
 
 
-def run_to_dict(res: Any, *, full_histories: bool = False, max_points: int = 2000) -> dict[str, Any]:
-    """JSON document of a run (issue 4 contract).
+def run_to_dict(res: Any, *, full_histories: bool = False, max_points: int = 2000,
+                extra: dict[str, Any] | None = None) -> dict[str, Any]:
+    """JSON document of a run: ``run_document(res, ...).to_json()`` (issue 18 contract,
+    :class:`~linecheck.io.document.RunDocument`; layout in docs/results.schema.json)."""
+    return run_document(res, full_histories=full_histories, max_points=max_points, extra=extra).to_json()
 
-    ``{"case", "wind", "units": "SI", "tower_of_interest", "g_yp_L",
-    "reactions": {"Rx": {stat: {"mean", "std"}}, "Ry": .., "Rz": ..},
-    "towers": [...all towers...], "still_air": {...}, "static": {...},
-    "time_histories": {...}}``.  Forces in N, Cont_* as fractions, GF null where the
-    mean vanishes.  Time histories are those of realization 1 at the tower of
-    interest, thinned to about ``max_points`` samples keeping every block's extremes
-    unless ``full_histories``.
+
+def run_document(res: Any, *, full_histories: bool = False, max_points: int = 2000,
+                 extra: dict[str, Any] | None = None) -> Any:
+    """The typed :class:`~linecheck.io.document.RunDocument` of a run.
+
+    Typed: the header (``"schema_version"``, ``"case"``, ..., ``"realizations"``, ``"windows"``),
+    ``"reactions"`` at the tower of interest and ``"towers"`` (every statistic
+    ``{"mean", "std", "se", "p05", "p50", "p95"}``, peaks with ``"gumbel"``, GF_Dy/GF_QS/Cont_R
+    with ``"ci"``, each reaction with ``"dynamic_analysis"``), ``"until"``.  Untyped blocks:
+    ``"still_air"``, ``"static"``, ``"parameters"``, ``"burn_in"``, ``"damping"``,
+    ``"spectral"``, ``"time_histories"`` and any ``extra`` blocks (e.g. ``"codes"``).
+    Forces in N, Cont_* as fractions, GF null where the mean vanishes.  Time histories are
+    those of realization 1 at the tower of interest, thinned to about ``max_points`` samples
+    keeping every block's extremes unless ``full_histories``.
     """
-    from ..core.results import REACTIONS, STATISTICS
+    from ..core.results import REACTIONS
+    from .document import document_of
 
-    case, stats = res.case, res.stats
+    case = res.case
     j = res.tower_index
-
-    def reaction_block(tower: int) -> dict[str, Any]:
-        out = {}
-        for c, rname in enumerate(REACTIONS):
-            out[rname] = {
-                s: {"mean": _num(stats.mean(s)[tower, c]), "std": _num(stats.std(s)[tower, c])} for s in STATISTICS
-            }
-        return out
-
     still = res.static.mean.still_air
     m = res.static.mean
     doc: dict[str, Any] = {
-        **_header(case),
-        "g_yp_L": _num(case.g_yp_L),
-        "v_ref": case.wind.v_ref,
-        "span_length": case.line.span_length,
-        "spans": case.line.spans,
-        "realizations": int(res.realizations.size),
-        "seed": case.analysis.seed,
-        "duration": _num(res.time[-1] - res.time[0]),
-        "time_step": case.analysis.time_step,
-        "reactions": reaction_block(j),
-        "towers": [{"index": k + 1, "support": case.line.supports[k], "reactions": reaction_block(k)}
-                   for k in range(res.system.n_towers)],
         "still_air": {
             "reactions": {r: _num(still.reactions[j, c]) for c, r in enumerate(REACTIONS)},
             "tension": _num(still.tension),
@@ -201,7 +191,9 @@ def run_to_dict(res: Any, *, full_histories: bool = False, max_points: int = 200
         "time": _num(res.time[idx]),
         **{r: {"M": _num(M[idx, c]), "B": _num(B[idx, c]), "R": _num(R[idx, c])} for c, r in enumerate(REACTIONS)},
     }
-    return doc
+    if extra:
+        doc.update(extra)
+    return document_of(res, doc)
 
 
 def spectral_to_dict(sp: Any) -> dict[str, Any]:

@@ -127,9 +127,10 @@ def compute_statistics(
     """Statistics of Eqs 15-17 from response histories.
 
     With ``window`` (samples, issue 18 ``analysis.peak_window``) the record is cut into
-    n_w = n_t // window consecutive windows (a remainder shorter than a window at the end is
-    dropped) and every statistic is taken per window: the result has n_real x n_w samples,
-    realization-major.  ``window`` None or >= n_t: the whole record.
+    n_w = (n_t - 1) // window consecutive windows of ``window`` samples (a remainder shorter
+    than a window at the end is dropped) and every statistic is taken per window: the result
+    has n_real x n_w samples, realization-major.  ``window`` None or >= n_t - 1 steps: the
+    whole record.
 
     Args:
         mean: [N] wind-induced mean reaction M(t), shape (n_t, n_towers, 3).
@@ -141,8 +142,8 @@ def compute_statistics(
     """
     scale = max(float(np.abs(mean).max()), 1e-300)
     n_real, n_t = background.shape[:2]
-    if window is not None and 0 < window < n_t:
-        n_w = n_t // window
+    if window is not None and 0 < window < n_t - 1:
+        n_w = (n_t - 1) // window  # n_t samples span n_t - 1 steps
         cut = n_w * window
         tail = background.shape[2:]
         background = background[:, :cut].reshape((n_real * n_w, window) + tail)

@@ -1,0 +1,134 @@
+"""Issue 18 through the service: peak windows, --until, the typed result document."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from linecheck import service
+from linecheck.core.case import load_case, with_values
+from linecheck.core.errors import CaseError
+from linecheck.core.results import STATISTICS, compute_statistics
+from linecheck.io.document import SCHEMA_VERSION, RunDocument
+from linecheck.io.jsonout import run_to_dict
+
+from .conftest import CASES
+
+
+def _same_stats(a, b) -> None:
+    for s in STATISTICS:
+        assert np.array_equal(a.stats.values(s), b.stats.values(s), equal_nan=True), s
+
+
+@pytest.fixture(scope="module")
+def case9():
+    return load_case(CASES / "paper" / "case09-single.toml")
+
+
+@pytest.fixture(scope="module")
+def run9(case9):
+    return service.run_case(case9, realizations=range(2), spectral_check=False)
+
+
+def test_peak_window_monotone_and_per_window(case9, run9):
+    """Nested windows (30 | 60 | 300 | 600 s of the 600 s record): every longer window's peak is
+    the largest of the shorter ones it contains, so the mean GF over windows x realizations
+    cannot decrease -- and it must increase strictly on this record."""
+    j = run9.tower_index
+    dt = case9.analysis.time_step
+    assert run9.time.size == 12001  # 600 s at 0.05 s, both ends
+
+    def gf(window_s):
+        w = int(round(window_s / dt))
+        st = compute_statistics(run9.mean[:, j:j + 1], run9.background[:, :, None], run9.resonant[:, :, None],
+                                run9.still_air[j:j + 1], case9.g_yp_L, window=w)
+        return st
+
+    gfs = [gf(w) for w in (30.0, 60.0, 300.0, 600.0)]
+    assert [g.n_samples for g in gfs] == [40, 20, 4, 2]
+    ry = [float(g.GF_QS[:, 0, 1].mean()) for g in gfs]
+    dy = [float(g.GF_Dy[:, 0, 1].mean()) for g in gfs]
+    assert np.all(np.diff(ry) > 0) and np.all(np.diff(dy) > 0), (ry, dy)
+    # the whole-record window is the default
+    assert ry[-1] == pytest.approx(float(run9.stats.GF_QS[:, j, 1].mean()), rel=1e-12)
+    # end to end: [analysis] peak_window = 60 gives the per-window statistics of the same record
+    r60 = service.run_case(with_values(case9, {"analysis.peak_window": 60.0}), realizations=range(2),
+                           spectral_check=False)
+    assert r60.windows == 10 and r60.stats.n_samples == 20
+    np.testing.assert_array_equal(r60.stats.GF_QS[:, j, 1], gfs[1].GF_QS[:, 0, 1])
+    doc = run_to_dict(r60)
+    assert doc["peak_window"] == 60.0 and doc["windows"] == 10 and doc["realizations"] == 2
+
+
+def test_peak_window_validation(case9):
+    with pytest.raises(CaseError, match="peak_window"):
+        with_values(case9, {"analysis.peak_window": 0.1})
+
+
+def test_until_fast_variant_matches_fixed_run(case9):
+    """--until 2 % on the single-span synoptic case: stops below the target, and the result is
+    bit-identical to a fixed run of the same count (realization r always has the same turbulence)."""
+    res = service.run_until(case9, 0.02, max_realizations=40, spectral_check=False)
+    n = int(res.realizations.size)
+    assert res.until.reached and res.until.achieved <= 0.02
+    assert 2 <= n <= 40
+    assert res.realizations.tolist() == list(range(n))
+    fixed = service.run_case(case9, realizations=range(n), spectral_check=False)
+    _same_stats(res, fixed)
+    assert service.relative_standard_error(fixed) == res.until.achieved
+    a, b = run_to_dict(res), run_to_dict(fixed)
+    assert a["reactions"] == b["reactions"]
+    assert a["until"]["target"] == 0.02 and a["until"]["achieved"] == res.until.achieved
+    assert "until" not in b
+
+
+def test_until_stops_at_the_cap(case9):
+    res = service.run_until(case9, 1e-6, max_realizations=3, spectral_check=False)
+    assert res.realizations.size == 3 and not res.until.reached and res.until.achieved > 1e-6
+
+
+@pytest.mark.slow
+def test_until_one_percent_case09_six():
+    """Acceptance: --until 1 % on case09-six stops with se <= 1 % and matches a fixed run."""
+    case = load_case(CASES / "paper" / "case09-six.toml")
+    res = service.run_until(case, 0.01, max_realizations=200, spectral_check=False)
+    n = int(res.realizations.size)
+    assert res.until.achieved <= 0.01 and n > case.analysis.realizations
+    fixed = service.run_case(case, realizations=range(n), spectral_check=False)
+    _same_stats(res, fixed)
+    assert run_to_dict(res)["reactions"] == run_to_dict(fixed)["reactions"]
+
+
+def test_document_keys_roundtrip_and_old_files(run9, tmp_path):
+    doc = json.loads(json.dumps(run_to_dict(run9), allow_nan=False))
+    assert doc["schema_version"] == SCHEMA_VERSION and doc["realizations"] == 2
+    ry = doc["reactions"]["Ry"]
+    for s in STATISTICS:
+        assert set(ry[s]) >= {"mean", "std", "se", "p05", "p50", "p95"}, s
+    assert set(ry["peak_dynamic"]["gumbel"]) == {"location", "scale", "ppcc", "design"}
+    assert "gumbel" not in ry["GF_Dy"] and "ci" not in ry["peak_dynamic"]
+    for s in ("GF_Dy", "GF_QS", "Cont_R"):
+        lo, hi = ry[s]["ci"]
+        assert lo < ry[s]["mean"] < hi
+    assert ry["dynamic_analysis"] in ("recommended", "inconclusive", None)
+    # numbers: se = std / sqrt(n); the Gumbel design value at the median = u + 0.3665 beta
+    v = run9.stats.peak_dynamic[:, run9.tower_index, 1]
+    assert ry["peak_dynamic"]["mean"] == pytest.approx(v.mean())
+    assert ry["peak_dynamic"]["se"] == pytest.approx(np.std(v, ddof=1) / np.sqrt(2))
+    g = ry["peak_dynamic"]["gumbel"]
+    assert g["design"] == pytest.approx(g["location"] - g["scale"] * np.log(np.log(2.0)))
+    # round trip through the typed document
+    typed = RunDocument.from_json(doc)
+    assert typed.to_json() == doc
+    assert typed.reactions["Ry"]["GF_Dy"].mean == ry["GF_Dy"]["mean"]
+    # extra blocks (e.g. "codes") pass through
+    d2 = dict(doc, codes={"x": 1})
+    assert RunDocument.from_json(d2).to_json()["codes"] == {"x": 1}
+    # an old (pre-issue-18) document fails with a message saying how to regenerate it
+    old = {k: v for k, v in doc.items() if k != "schema_version"}
+    with pytest.raises(CaseError, match="regenerate it with `linecheck run"):
+        RunDocument.from_json(old, source="old.json")
+    with pytest.raises(CaseError, match="not a linecheck run result"):
+        RunDocument.from_json({"x": 1}, source="x.json")

@@ -132,3 +132,26 @@ def test_document_keys_roundtrip_and_old_files(run9, tmp_path):
         RunDocument.from_json(old, source="old.json")
     with pytest.raises(CaseError, match="not a linecheck run result"):
         RunDocument.from_json({"x": 1}, source="x.json")
+
+
+def test_result_schema_file_is_generated_and_validates(run9):
+    """docs/results.schema.json is what tools/make_result_schema.py generates, and the validator
+    rejects broken documents (so the suite-wide validation in conftest can fail)."""
+    import importlib.util
+
+    from .conftest import ROOT, _result_schema
+    from .schema_check import errors
+
+    spec = importlib.util.spec_from_file_location("mrs", ROOT / "tools" / "make_result_schema.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    assert (ROOT / "docs" / "results.schema.json").read_text() == mod.render()
+    schema = _result_schema()
+    doc = json.loads(json.dumps(run_to_dict(run9)))
+    assert errors(doc, schema) == []
+    bad = json.loads(json.dumps(doc))
+    del bad["reactions"]["Ry"]["GF_Dy"]["ci"]
+    bad["reactions"]["Rx"]["dynamic_analysis"] = "maybe"
+    bad["towers"][0]["reactions"]["Rz"]["peak_dynamic"]["gumbel"]["ppcc"] = "high"
+    errs = errors(bad, schema)
+    assert len(errs) == 3, errs

@@ -23,6 +23,7 @@ CORE_MODULES = [
     "linecheck.service",
     "linecheck.io.jsonout",
     "linecheck.io.display",
+    "linecheck.io.document",
 ]
 
 

@@ -155,3 +155,47 @@ def test_result_schema_file_is_generated_and_validates(run9):
     bad["towers"][0]["reactions"]["Rz"]["peak_dynamic"]["gumbel"]["ppcc"] = "high"
     errs = errors(bad, schema)
     assert len(errs) == 3, errs
+
+
+# --------------------------------------------------------------------------- CLI
+def _short_case(tmp_path, name="case09-single", realizations=3, duration=60.0):
+    import re
+
+    text = (CASES / "paper" / f"{name}.toml").read_text(encoding="utf-8")
+    text = re.sub(r"(?m)^\s*(duration|realizations)\s*=.*$", "", text)
+    text = text.replace("[analysis]", f"[analysis]\nduration = {duration}\nrealizations = {realizations}", 1)
+    p = tmp_path / f"{name}.toml"
+    p.write_text(text, encoding="utf-8")
+    return p
+
+
+def test_cli_run_until_and_export_of_old_results(tmp_path):
+    from typer.testing import CliRunner
+
+    from linecheck.cli.app import app
+
+    runner = CliRunner(env={"COLUMNS": "250"})
+    case = _short_case(tmp_path)
+    out = tmp_path / "r.json"
+    res = runner.invoke(app, ["run", str(case), "--until", "3%", "--max-realizations", "30", "--no-check",
+                              "--json", str(out)])
+    assert res.exit_code == 0, res.output
+    doc = json.loads(out.read_text())
+    assert doc["until"]["target"] == 0.03 and doc["until"]["achieved"] <= 0.03
+    assert f"--until 3 %: {doc['realizations']} realizations" in res.output
+    assert "design values at tower 1" in res.output
+    fixed = service.run_case(load_case(case), realizations=range(doc["realizations"]), spectral_check=False)
+    assert json.loads(json.dumps(run_to_dict(fixed)["reactions"])) == doc["reactions"]  # bit for bit
+    bad = runner.invoke(app, ["run", str(case), "--until", "abc"])
+    assert bad.exit_code == 2 and "--until" in bad.output and "1%" in bad.output
+    # a result saved before issue 18 (no schema_version, statistics {"mean", "std"} only)
+    old = {k: v for k, v in doc.items() if k not in ("schema_version", "until")}
+    old["reactions"] = {r: {s: {"mean": e["mean"], "std": e["std"]} for s, e in blk.items() if isinstance(e, dict)}
+                        for r, blk in doc["reactions"].items()}
+    (tmp_path / "old.json").write_text(json.dumps(old))
+    res = runner.invoke(app, ["export", str(tmp_path / "old.json"), "--excel", str(tmp_path / "o.xlsx")])
+    assert res.exit_code == 2, res.output
+    assert "schema_version 1" in res.output and "regenerate it with `linecheck run" in res.output
+    assert not (tmp_path / "o.xlsx").exists()
+    res = runner.invoke(app, ["export", str(out), "--excel", str(tmp_path / "n.xlsx")])
+    assert res.exit_code == 0, res.output

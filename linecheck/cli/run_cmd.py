@@ -17,6 +17,8 @@ from ..io.jsonout import _num, run_to_dict, write_json
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .export_cmd import ExcelOpt, ForceOpt, TemplateOpt
 from .progress import progress_bar
+from .stats_view import MaxRealOpt, UntilOpt, design_table, parse_until
+from .stats_view import notes as stats_notes
 
 RealOpt = Annotated[int | None, typer.Option("--realizations", "-n", help="Number of realizations (overrides the case).", min=1)]
 SeedOpt = Annotated[int | None, typer.Option("--seed", help="Random seed (overrides the case).", min=0)]
@@ -77,9 +79,12 @@ def run(
     template: TemplateOpt = None,
     force: ForceOpt = False,
     no_check: Annotated[bool, typer.Option("--no-check", help="Skip the frequency-domain sanity check of a synoptic case (long lines: its cost grows faster than the number of spans).")] = False,
+    until: UntilOpt = None,
+    max_realizations: MaxRealOpt = 1000,
 ) -> None:
     """Steps 1-3: mean, background and resonant reactions, gust factors and contributions."""
     case = override(read_case(case_file), realizations, seed)
+    target = parse_until(until)
     if json_out is not None:
         check_target(json_out, what="JSON")
     if excel is not None:
@@ -87,9 +92,16 @@ def run(
 
         check_excel_target(excel, force=force, template=template)
     with progress_bar() as cb:
-        res = service.run_case(case, progress=cb, spectral_check=not no_check)
+        if target is None:
+            res = service.run_case(case, progress=cb, spectral_check=not no_check)
+        else:
+            res = service.run_until(case, target, max_realizations=max_realizations, progress=cb,
+                                    spectral_check=not no_check)
     doc = run_to_dict(res, full_histories=full_histories)
     console.print(results_table(doc))
+    console.print(design_table(doc))
+    for line in stats_notes(doc):
+        console.print(f"[dim]{line}[/]", highlight=False)
     console.print("[dim]GF ** : mean reaction zero by symmetry (or < 1 % of the largest mean); "
                   "Cont_R = share of the peak that a quasi-static analysis misses.[/]")
     from .spectral_cmd import print_sanity

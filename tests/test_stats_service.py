@@ -199,3 +199,27 @@ def test_cli_run_until_and_export_of_old_results(tmp_path):
     assert not (tmp_path / "o.xlsx").exists()
     res = runner.invoke(app, ["export", str(out), "--excel", str(tmp_path / "n.xlsx")])
     assert res.exit_code == 0, res.output
+
+
+def test_excel_summary_design_block(run9, tmp_path):
+    """The Summary sheet's design block: R_x, R_y, R_z rows with the Gumbel design peak, the total
+    (still air + wind) design reaction, intervals and the flag state, from the JSON values."""
+    from openpyxl import load_workbook
+
+    from linecheck.excel.writer import write_workbook
+
+    doc = json.loads(json.dumps(run_to_dict(run9)))
+    path = write_workbook([doc], tmp_path / "d.xlsx")
+    ws = load_workbook(path)["Summary"]
+    rows = [[c for c in r] for r in ws.iter_rows(values_only=True)]
+    head = next(i for i, r in enumerate(rows) if "design total\n(kN)" in r)
+    cols = {v: k for k, v in enumerate(rows[head]) if v is not None}
+    body = {r[cols["Reaction"]]: r for r in rows[head + 1:head + 4]}
+    assert set(body) == {"Rx", "Ry", "Rz"}
+    for r in ("Rx", "Ry", "Rz"):
+        e = doc["reactions"][r]
+        assert body[r][cols["design total\n(kN)"]] == pytest.approx(e["peak_dynamic_total"]["gumbel"]["design"] / 1e3)
+        assert body[r][cols["design peak\nwind (kN)"]] == pytest.approx(e["peak_dynamic"]["gumbel"]["design"] / 1e3)
+        assert body[r][cols["still air\n(kN)"]] == pytest.approx(doc["still_air"]["reactions"][r] / 1e3)
+    lo, hi = doc["reactions"]["Ry"]["GF_Dy"]["ci"]
+    assert body["Ry"][cols["GF_Dy\n95 % CI"]] == f"[{lo:.3f}, {hi:.3f}]"

@@ -122,6 +122,9 @@ def write_summary(ws: Worksheet, docs: list[dict], names: list[str | None], thre
              "Ry transverse (wind), Rz vertical" + ("" if "Rz" in summary_reactions else
                                                     " (Rz on the case sheets: its wind-induced part is small beside "
                                                     "the conductor weight)") + ".")
+    from .design import write_design_block  # issue 18: design values, intervals, flag states, how to read
+
+    cur.row = write_design_block(ws, docs, cur.row + 1, left)
     ws.auto_filter.ref = f"{get_column_letter(left)}{top}:{get_column_letter(right)}{last}"
     ws.freeze_panes = ws.cell(row=top + 1, column=left + 1)
     ws.print_title_rows = f"{top}:{top}"

@@ -223,3 +223,20 @@ def test_excel_summary_design_block(run9, tmp_path):
         assert body[r][cols["still air\n(kN)"]] == pytest.approx(doc["still_air"]["reactions"][r] / 1e3)
     lo, hi = doc["reactions"]["Ry"]["GF_Dy"]["ci"]
     assert body["Ry"][cols["GF_Dy\n95 % CI"]] == f"[{lo:.3f}, {hi:.3f}]"
+
+
+def test_batch_until_matches_run_until(tmp_path):
+    """batch --until: each case stops like run_until and saves the same numbers (one task per case)."""
+    from typer.testing import CliRunner
+
+    from linecheck.cli.app import app
+
+    case = _short_case(tmp_path)
+    out = tmp_path / "res"
+    res = CliRunner(env={"COLUMNS": "250"}).invoke(
+        app, ["batch", str(case), "--until", "3%", "--max-realizations", "30", "--jobs", "1", "--json-dir", str(out)])
+    assert res.exit_code == 0, res.output
+    doc = json.loads((out / f"{case.stem}.json").read_text())
+    ref = service.run_until(load_case(case), 0.03, max_realizations=30)
+    assert doc["realizations"] == ref.realizations.size and doc["until"]["achieved"] == ref.until.achieved
+    assert doc["reactions"] == json.loads(json.dumps(run_to_dict(ref)["reactions"]))

@@ -40,7 +40,7 @@ from ..core.case import Case, case_hash, load_case
 from ..core.errors import Cancelled, CaseError, LinecheckError
 from .executors import Executor, SequentialExecutor
 from .merge import merge_runs
-from .tasks import Failure, apply_changes, run_chunk
+from .tasks import Failure, apply_changes, run_chunk, run_until_case
 
 POLL_S = 0.2  # how often the coordinator checks the cancel event while tasks run
 
@@ -217,6 +217,7 @@ def run_batch(
     keep_results: bool = False,
     progress: BatchProgress | None = None,
     cancel: threading.Event | None = None,
+    until: tuple[float, int] | None = None,
 ) -> BatchReport:
     """Run every case (all realizations) and save each result as it completes.
 
@@ -230,6 +231,9 @@ def run_batch(
         keep_results: keep the merged RunResult of each case in its outcome.
         progress: ``progress(BatchEvent)``; called in the calling thread.
         cancel: a threading.Event; when set the batch stops, finished cases stay saved.
+        until: ``(target, max_realizations)``: each case adds realizations until the relative
+            standard error is below ``target`` (:func:`linecheck.service.run_until`), as one task
+            per case (cases still run in parallel); bit-identical to a fixed run of the same count.
 
     Returns:
         A :class:`BatchReport`; it never raises for a failing case.
@@ -340,6 +344,16 @@ def run_batch(
         return cb
 
     for st in todo:
+        if until is not None:  # adaptive count: one task per case (issue 18)
+            st.chunks, st.parts = [list(range(st.outcome.realizations))], [None]
+            kwargs = {"cancel": cancel, "progress": in_process_progress(st, 0, st.outcome.realizations)} \
+                if executor.in_process else {}
+            h = executor.submit(run_until_case, str(st.job.path), float(until[0]), int(until[1]), st.outcome.hash,
+                                dict(st.job.changes) if st.job.changes else None, **kwargs)
+            st.handles.append(h)
+            handles.append(h)
+            owner.append((st, 0))
+            continue
         st.chunks = chunk_ranges(st.outcome.realizations, size)
         st.parts = [None] * len(st.chunks)
         before = 0

@@ -107,6 +107,30 @@ def run_chunk(
         return Failure.of(err)
 
 
+def run_until_case(
+    case_path: str,
+    target: float,
+    max_realizations: int,
+    expected_hash: str | None = None,
+    changes: Mapping[str, Any] | None = None,
+    *,
+    progress: Callable[[str, int, int], None] | None = None,
+    cancel: threading.Event | None = None,
+) -> Any:
+    """``batch --until``: one case with an adaptive realization count (:func:`service.run_until`),
+    as one task (its chunks run in sequence: each decides the next).  Returns the RunResult or a
+    :class:`Failure`."""
+    from ..service import run_until
+
+    try:
+        case = load_checked(case_path, expected_hash, changes)
+        return run_until(case, target, max_realizations=max_realizations, progress=progress, cancel=cancel)
+    except Cancelled:
+        raise
+    except LinecheckError as err:
+        return Failure.of(err)
+
+
 @dataclass(frozen=True)
 class ScanChunk:
     """Step-1 results at a list of downburst scan points.

@@ -20,6 +20,7 @@ from rich.table import Table
 
 from ..core.errors import CaseError
 from .app import CaseArg, app, console, err_console, handle_errors, read_case
+from .stats_view import MaxRealOpt, UntilOpt, parse_until
 
 JobsOpt = Annotated[int | None, typer.Option(
     "--jobs", "-j", help="Local worker processes (default: the number of cores; 1 runs in this process).",
@@ -138,7 +139,7 @@ def _kn(doc: dict[str, Any] | None, reaction: str, stat: str, scale: float = 1e-
 def summary_table(report: Any) -> Table:
     """One row per case: status, peak reactions, gust factors, Cont_R, time, JSON or error."""
     t = Table(title="batch summary (tower of interest)", title_justify="left")
-    for col, just in (("case", "left"), ("status", "left"), ("peak Rx kN", "right"), ("peak Ry kN", "right"),
+    for col, just in (("case", "left"), ("status", "left"), ("n", "right"), ("peak Rx kN", "right"), ("peak Ry kN", "right"),
                       ("GF_Dy Rx", "right"), ("GF_Dy Ry", "right"), ("Cont_R Ry %", "right"), ("time s", "right"),
                       ("result / error", "left")):
         t.add_column(col, justify=just, overflow="fold")
@@ -147,6 +148,7 @@ def summary_table(report: Any) -> Table:
         d = o.doc
         t.add_row(
             escape(o.name), f"[{colours.get(o.status, 'white')}]{o.status}[/]",
+            str(d.get("realizations", "")) if d else "",
             _kn(d, "Rx", "peak_dynamic"), _kn(d, "Ry", "peak_dynamic"),
             _kn(d, "Rx", "GF_Dy", 1.0, "{:.3f}"), _kn(d, "Ry", "GF_Dy", 1.0, "{:.3f}"),
             _kn(d, "Ry", "Cont_R", 100.0, "{:.1f}"),
@@ -170,17 +172,21 @@ def batch(
     force: BatchForceOpt = False,
     template: BatchTemplateOpt = None,
     chunk: ChunkOpt = None,
+    until: UntilOpt = None,
+    max_realizations: MaxRealOpt = 1000,
 ) -> None:
     """Run many cases (all realizations) in parallel, saving each result as it completes."""
     from ..batch import make_executor, run_batch
 
     paths = expand_cases(cases)
+    target = parse_until(until)
     _check_excel(excel, force, template)
     out_dir = json_dir if json_dir is not None else ((excel.parent if excel is not None else Path.cwd()) / "results")
     cancel = threading.Event()
     with make_executor(jobs, scheduler) as executor, BatchDisplay() as display:
         report = run_batch(paths, executor=executor, json_dir=out_dir, resume=resume, chunk_size=chunk,
-                           progress=display, cancel=cancel)
+                           progress=display, cancel=cancel,
+                           until=None if target is None else (target, max_realizations))
     console.print(summary_table(report))
     n_done = sum(o.status == "done" for o in report.outcomes)
     n_skip = sum(o.status == "skipped" for o in report.outcomes)

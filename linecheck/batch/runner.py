@@ -175,6 +175,10 @@ def saved_result(json_path: Path, digest: str, changes: Mapping[str, Any] | None
         return None
     if not isinstance(doc, dict) or doc.get("case_hash") != digest or "reactions" not in doc:
         return None
+    from ..io.document import SCHEMA_VERSION
+
+    if doc.get("schema_version") != SCHEMA_VERSION:  # saved by an older linecheck: run it again
+        return None
     if doc.get("changes") != (json.loads(json.dumps(dict(changes))) if changes else None):
         return None
     return doc

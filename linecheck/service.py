@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .core import budget
 from .core.case import Case
 from .core.damping import aerodynamic_damping, stiffness_proportional
 from .core.dynamics import integrate
@@ -27,6 +28,36 @@ from .core.system import LineSystem
 from .core.wind.mean import MeanWind, mean_wind
 
 Progress = Callable[[str, int, int], None]
+Warn = Callable[[str], None]
+
+
+def check_budget(case: Case, job: str = "run", *, warn: Warn | None = None, **kwargs) -> budget.Estimate:
+    """Estimated peak memory and time of ``job`` (:mod:`linecheck.core.budget`); raises
+    :class:`~linecheck.core.errors.CaseError` (exit 2) above the memory limit and calls
+    ``warn(message)`` above the warning thresholds.  Every job below calls it first."""
+    return budget.guard(case, job, warn, **kwargs)
+
+
+def check_case(case: Case, *, warn: Warn | None = None) -> budget.Estimate:
+    """Checks of ``linecheck check`` beyond the schema: the field file is read and validated,
+    the downburst is scaled to V_ref at p, the record has enough steps, and the run fits the
+    resource limits.  Raises :class:`~linecheck.core.errors.CaseError`."""
+    from .core.errors import CaseError
+    from .core.wind.mean import downburst_field, load_field_table
+
+    if case.wind.type == "downburst":
+        db = case.wind.downburst
+        if db is not None and db.field_path is not None:
+            load_field_table(db.field_path)
+        downburst_field(case)
+    if not case.wind.v_ref > 0:
+        raise CaseError("value 0.0 is not allowed: expected v_ref > 0 for a run (turbulence is scaled by it)",
+                        file=str(case.source) if case.source else None, key="wind.v_ref")
+    est = budget.estimate(case, "run")
+    if est.n_steps < 4:
+        raise CaseError(f"value {case.analysis.time_step!r} gives {est.n_steps} steps: expected at least 4",
+                        file=str(case.source) if case.source else None, key="analysis.time_step")
+    return budget.check(est, case, warn)
 
 
 @dataclass(frozen=True)
@@ -60,8 +91,17 @@ def static_analysis(
     *,
     progress: Progress | None = None,
     cancel: threading.Event | None = None,
+    warn: Warn | None = None,
 ) -> StaticResult:
-    """Step 1 of the method: non-linear static analysis under the running-mean wind."""
+    """Step 1 of the method: non-linear static analysis under the running-mean wind.
+
+    ``warn(message)`` receives resource warnings (:func:`check_budget`)."""
+    check_budget(case, "static", warn=warn)
+    return _static_analysis(case, progress=progress, cancel=cancel)
+
+
+def _static_analysis(case: Case, *, progress: Progress | None = None,
+                     cancel: threading.Event | None = None) -> StaticResult:
     system = LineSystem(case.line)
     wind = mean_wind(case, system, mean_state_times(case))
     gy = mean_loads(case, wind)
@@ -317,6 +357,7 @@ def run_case(
     spectral_check: bool = True,
     progress: Progress | None = None,
     cancel: threading.Event | None = None,
+    warn: Warn | None = None,
 ) -> RunResult:
     """Steps 1-3 of the method for ``case`` and the statistics of Eqs 15-17.
 
@@ -331,11 +372,16 @@ def run_case(
             time-domain steps' only linearly (docs/performance.md).
         progress: ``progress(stage, done, total)``.
         cancel: a :class:`threading.Event`; when set the run stops with ``Cancelled``.
+        warn: ``warn(message)`` receives resource warnings; above the memory limit the run
+            is refused before any work (:func:`check_budget`, CaseError).
     """
     from .core.wind.turbulence import fluctuating_velocity
 
     real = np.arange(case.analysis.realizations) if realizations is None else np.asarray(realizations, dtype=int)
-    st = static_analysis(case, progress=progress, cancel=cancel)
+    warned: list[str] = []
+    check_budget(case, "run", warn=lambda m: (warned.append(m), warn(m) if warn else None),
+                 realizations=int(real.size), spectral_check=spectral_check)
+    st = _static_analysis(case, progress=progress, cancel=cancel)
     system, mean = st.system, st.mean
     t = record_time(case)
     dt = case.analysis.time_step
@@ -354,7 +400,9 @@ def run_case(
     sm = synoptic_model(case, st) if wind.type == "synoptic" else None
     burn = burn_in(case, sm) if sm is not None else BurnIn(
         0.0, 0.0, float("nan"), float("nan"), True, "none: a downburst starts from a weak running mean")
-    if burn.seconds > 0:
+    if burn.seconds > 0:  # the derived burn-in lengthens the record: check the budget again
+        check_budget(case, "run", warn=None if warned else warn, realizations=int(real.size),
+                     burn_in=burn.seconds, spectral_check=spectral_check)
         t = t[0] - dt * np.round(burn.seconds / dt) + dt * np.arange(t.size + int(np.round(burn.seconds / dt)))
     keep = t >= t[0] + burn.seconds - 1e-9  # the analysed record (after the burn-in)
     state_of_step, bracket, weights = _state_of_step(mean.time, t)
@@ -475,6 +523,7 @@ def run_until(
     spectral_check: bool = True,
     progress: Progress | None = None,
     cancel: threading.Event | None = None,
+    warn: Warn | None = None,
 ) -> RunResult:
     """Add realizations in chunks until :func:`relative_standard_error` <= ``target`` [-] or
     ``max_realizations`` have run (issue 18).
@@ -487,7 +536,7 @@ def run_until(
         raise ValueError(f"target {target!r} must be > 0")
     n = max(2, min(case.analysis.realizations, max_realizations))
     parts = [run_case(case, realizations=np.arange(n), interpolate_states=interpolate_states,
-                      spectral_check=spectral_check, progress=progress, cancel=cancel)]
+                      spectral_check=spectral_check, progress=progress, cancel=cancel, warn=warn)]
     while True:
         res = join_runs(parts)
         achieved = relative_standard_error(res)
@@ -498,7 +547,7 @@ def run_until(
         want = done * (achieved / target) ** 2 * UNTIL_OVERSHOOT if np.isfinite(achieved) else 2 * done
         nxt = int(min(max_realizations, max(done + 1, int(np.ceil(want)))))
         parts.append(run_case(case, realizations=np.arange(done, nxt), interpolate_states=interpolate_states,
-                              spectral_check=False, progress=progress, cancel=cancel))
+                              spectral_check=False, progress=progress, cancel=cancel, warn=warn))
 
 
 @dataclass(frozen=True)
@@ -516,11 +565,12 @@ class ModesResult:
     damped: "object" = None  # ComplexModes of the mean state with the case's damping
 
 
-def modes_analysis(case: Case, *, n_modes: int = 20) -> ModesResult:
+def modes_analysis(case: Case, *, n_modes: int = 20, warn: Warn | None = None) -> ModesResult:
     """Natural frequencies and mode shapes of the still-air and the mean state."""
     from .core.modes import natural_modes
 
-    st = static_analysis(case)
+    check_budget(case, "modes", warn=warn)
+    st = _static_analysis(case)
     system, mean = st.system, st.mean
     j = case.line.tower_of_interest - 1
     k = int(np.argmax(np.abs(mean.reactions_wind[:, j, :]).max(axis=1)))
@@ -553,9 +603,11 @@ class WindAtP:
     realization: int
 
 
-def wind_at_p(case: Case, *, realization: int = 0) -> WindAtP:
+def wind_at_p(case: Case, *, realization: int = 0, warn: Warn | None = None) -> WindAtP:
     """Running-mean and total wind speed at point p over the record (paper Fig. 3)."""
     from .core.wind.point import point_series
+
+    check_budget(case, "wind", warn=warn)
 
     p = point_series(case, realization)
     return WindAtP(case, p.time, p.mean_speed, p.total, p.node_x, realization)
@@ -581,7 +633,7 @@ DAVENPORT_TOLERANCE = 0.15  # issue 5: estimate 2 shown only where within 15 % o
 
 
 def spectral_analysis(case: Case, *, static: StaticResult | None = None,
-                      synoptic: SynopticModel | None = None) -> SpectralResult:
+                      synoptic: SynopticModel | None = None, warn: Warn | None = None) -> SpectralResult:
     """Frequency-domain estimates for a synoptic case (same model and damping as the time domain)."""
     from .core.errors import CaseError
     from .core.spectral import davenport_gust_factor, random_vibration
@@ -590,7 +642,9 @@ def spectral_analysis(case: Case, *, static: StaticResult | None = None,
     if case.wind.type != "synoptic":
         raise CaseError("the frequency-domain check is for synoptic cases only (a downburst is non-stationary)",
                         file=str(case.source) if case.source else None, key="wind.type")
-    st = static if static is not None else static_analysis(case)
+    if static is None:
+        check_budget(case, "spectral", warn=warn)
+    st = static if static is not None else _static_analysis(case)
     mean = st.mean
     sm = synoptic if synoptic is not None else synoptic_model(case, st)  # same model as the time domain
     line, wind = case.line, case.wind

@@ -16,6 +16,7 @@ CORE_MODULES = [
     "linecheck.core.results",
     "linecheck.core.extremes",
     "linecheck.core.modes",
+    "linecheck.core.budget",
     "linecheck.core.spectral",
     "linecheck.core.wind.mean",
     "linecheck.core.wind.turbulence",

@@ -29,7 +29,44 @@ Cross-checks: `supports` has `spans + 1` entries and both end towers are `"strai
 `tower_of_interest` ≤ number of towers; `sag` < `span_length`/4; `[wind.downburst]` is
 required for `type = "downburst"` and rejected for `"synoptic"`; `span_speeds` (synoptic only)
 has one entry per span; a `preset` and explicit `jet_diameter`/`distance`/`angle` must agree;
-`time_step` ≤ `duration`/4.
+`time_step` ≤ `duration`/4; `sag` < `height` (the lowest point of a parabola of average
+elevation `height` is `height` − `sag`/3; insulator swing lifts the conductor, so no swing
+allowance is added); with suspension towers, `insulator_length` < `height`.
+
+Hostile input: every key and string value is refused if it holds a control character (C0
+except tab, DEL, C1: they would inject terminal escape sequences and are illegal in Excel),
+e.g. `c.toml:1: name: control character U+001B at position 5 is not allowed: expected
+printable text`; tables and arrays nested more than 16 levels are refused. Only regular
+files are read (a FIFO, a socket or a link to a device such as `/dev/zero` is refused
+before any read, so `check` never hangs), and only up to a size cap checked before reading:
+10 MB for a case file, 200 MB for a field file (`field`; for an NPZ, the uncompressed
+arrays), 1 GB for a saved JSON result read back by `export` or `batch --resume`.
+
+`linecheck check` also reads and validates the field file, scales the downburst to `v_ref`
+at point p and estimates the run's memory and time, so errors that used to appear only at
+`run` appear at `check`.
+
+Resource guard: before any work, `run`, `batch` (per task), `scan`, `static`, `modes`,
+`spectral`, `wind` and `check` estimate the job's peak memory and time from the number of
+steps (`duration`/`time_step`), nodes (`spans` × `elements_per_span`), `realizations` and
+`mean_states`. Above the memory limit the job is refused (exit 2) with the estimate:
+
+```
+error: c.toml: run needs about 4.22 PB of memory and 3.82 years (time histories; 12001 steps,
+27 DOF, 1000000000 realization(s), 250 mean state(s)): above the memory limit of 19 GB
+(default 75% of the physical memory); reduce time_step, duration, realizations, mean_states
+or elements_per_span, or raise the limit with --max-memory SIZE or LINECHECK_MAX_MEMORY=SIZE
+```
+
+The limit is 75 % of the physical memory unless `--max-memory SIZE` (`run`, `batch`, `scan`)
+or the environment variable `LINECHECK_MAX_MEMORY` (every command, and the local batch
+workers) says otherwise (`8GB`, `512MB`, `1.5GiB` or bytes; Dask workers read their own
+environment). Above half the limit, or above an estimated 10 minutes, a one-line warning is
+printed and the job runs. In a batch or a scan each task checks its own estimate (a batch
+task holds one chunk of realizations), and a task above the limit fails that case only. The
+estimate is rough (within about a factor of 2 on the paper
+cases, see docs/performance.md); command-line overrides (`-n`, `--seed`) are checked against
+the same ranges as the file and the message names the option.
 
 Example (paper case 9, single span):
 

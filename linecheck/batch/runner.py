@@ -169,9 +169,11 @@ def json_name_for(path: Path) -> str:
 def saved_result(json_path: Path, digest: str, changes: Mapping[str, Any] | None = None) -> dict[str, Any] | None:
     """The saved document at ``json_path`` if it carries ``digest`` as its case hash
     (and the same key ``changes``, for runs that alter the file's case)."""
-    try:
-        doc = json.loads(json_path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    from ..core.case import MAX_RESULT_BYTES, read_text_file
+
+    try:  # only a regular file of bounded size (a FIFO or /dev/zero there must not hang; issue 14)
+        doc = json.loads(read_text_file(json_path, "a saved JSON result", MAX_RESULT_BYTES))
+    except (CaseError, ValueError):
         return None
     if not isinstance(doc, dict) or doc.get("case_hash") != digest or "reactions" not in doc:
         return None

@@ -20,6 +20,7 @@ from rich.table import Table
 
 from ..core.errors import CaseError
 from .app import CaseArg, app, console, err_console, handle_errors, read_case
+from .limits import MaxMemoryOpt, apply_max_memory
 from .stats_view import MaxRealOpt, UntilOpt, parse_until
 
 JobsOpt = Annotated[int | None, typer.Option(
@@ -172,11 +173,14 @@ def batch(
     force: BatchForceOpt = False,
     template: BatchTemplateOpt = None,
     chunk: ChunkOpt = None,
+    max_memory: MaxMemoryOpt = None,
     until: UntilOpt = None,
     max_realizations: MaxRealOpt = 1000,
 ) -> None:
     """Run many cases (all realizations) in parallel, saving each result as it completes."""
     from ..batch import make_executor, run_batch
+
+    apply_max_memory(max_memory)  # each task checks its memory estimate (workers inherit the limit)
 
     paths = expand_cases(cases)
     target = parse_until(until)
@@ -258,8 +262,10 @@ def scan(
         show_default=False)] = None,
     jobs: JobsOpt = None,
     scheduler: SchedulerOpt = None,
+    max_memory: MaxMemoryOpt = None,
 ) -> None:
     """Find the critical downburst configurations: step 1 over a grid of positions and sizes."""
+    apply_max_memory(max_memory)  # each step-1 task checks its memory estimate
     from ..batch import ScanGrid, make_executor, run_critical, run_scan, write_scan_csv
     from ..io.atomic import check_target
     from .progress import progress_bar

@@ -13,6 +13,7 @@ from ..core.errors import CaseError
 from ..io.atomic import check_target
 from ..io.jsonout import static_to_dict, write_json
 from .app import CaseArg, CasesArg, JsonOpt, app, console, err_console, handle_errors, read_case
+from .limits import warn as limits_warn
 from .progress import progress_bar
 
 
@@ -24,6 +25,7 @@ def check(cases: CasesArg) -> None:
     for path in cases:
         try:
             case = read_case(path)
+            service.check_case(case, warn=limits_warn)  # field file, V_ref at p, resource estimate
         except CaseError as err:
             err_console.print(f"[bold red]error:[/] {escape(str(err))}", highlight=False, soft_wrap=True, emoji=False)
             failed += 1
@@ -42,7 +44,7 @@ def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     if json_out is not None:
         check_target(json_out, what="JSON")
     with progress_bar() as cb:
-        res = service.static_analysis(case, progress=cb)
+        res = service.static_analysis(case, progress=cb, warn=limits_warn)
     doc = static_to_dict(res)
     m = res.mean
     toi = case.line.tower_of_interest - 1

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 from typing import Annotated
 
 import typer
@@ -16,6 +15,8 @@ from ..io.display import SUMMARY_STATS, stat_text
 from ..io.jsonout import _num, run_to_dict, write_json
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .export_cmd import ExcelOpt, ForceOpt, TemplateOpt
+from .limits import MaxMemoryOpt, apply_max_memory
+from .limits import warn as limits_warn
 from .progress import progress_bar
 from .stats_view import MaxRealOpt, UntilOpt, design_table, parse_until
 from .stats_view import notes as stats_notes
@@ -25,15 +26,11 @@ SeedOpt = Annotated[int | None, typer.Option("--seed", help="Random seed (overri
 
 
 def override(case: Case, realizations: int | None, seed: int | None) -> Case:
-    """The case with CLI overrides of [analysis] applied."""
-    changes = {}
-    if realizations is not None:
-        changes["realizations"] = realizations
-    if seed is not None:
-        changes["seed"] = seed
-    if not changes:
-        return case
-    return dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, **changes))
+    """The case with CLI overrides of [analysis] applied, validated like the file (issue 14)."""
+    from ..core.case import with_options
+
+    return with_options(case, {"--realizations": ("analysis.realizations", realizations),
+                               "--seed": ("analysis.seed", seed)})
 
 
 def results_table(doc: dict) -> Table:
@@ -79,10 +76,12 @@ def run(
     template: TemplateOpt = None,
     force: ForceOpt = False,
     no_check: Annotated[bool, typer.Option("--no-check", help="Skip the frequency-domain sanity check of a synoptic case (long lines: its cost grows faster than the number of spans).")] = False,
+    max_memory: MaxMemoryOpt = None,
     until: UntilOpt = None,
     max_realizations: MaxRealOpt = 1000,
 ) -> None:
     """Steps 1-3: mean, background and resonant reactions, gust factors and contributions."""
+    apply_max_memory(max_memory)
     case = override(read_case(case_file), realizations, seed)
     target = parse_until(until)
     if json_out is not None:
@@ -93,10 +92,10 @@ def run(
         check_excel_target(excel, force=force, template=template)
     with progress_bar() as cb:
         if target is None:
-            res = service.run_case(case, progress=cb, spectral_check=not no_check)
+            res = service.run_case(case, progress=cb, spectral_check=not no_check, warn=limits_warn)
         else:
             res = service.run_until(case, target, max_realizations=max_realizations, progress=cb,
-                                    spectral_check=not no_check)
+                                    spectral_check=not no_check, warn=limits_warn)
     doc = run_to_dict(res, full_histories=full_histories)
     console.print(results_table(doc))
     console.print(design_table(doc))
@@ -132,7 +131,7 @@ def modes(
     case = read_case(case_file)
     if json_out is not None:
         check_target(json_out, what="JSON")
-    res = service.modes_analysis(case, n_modes=count)
+    res = service.modes_analysis(case, n_modes=count, warn=limits_warn)
     t = Table(title=f"{case.name}: natural frequencies (Hz)", title_justify="left")
     for c in ("mode", "still air", "direction", "mean state", "direction", "damped (Hz)", "damping ratio"):
         t.add_column(c, justify="right")

@@ -8,6 +8,7 @@ from .. import service
 from ..io.atomic import check_target
 from ..io.jsonout import spectral_to_dict, write_json
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
+from .limits import warn as limits_warn
 
 
 def spectral_table(doc: dict, title: str) -> Table:
@@ -41,7 +42,7 @@ def spectral(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     case = read_case(case_file)
     if json_out is not None:
         check_target(json_out, what="JSON")
-    res = service.spectral_analysis(case)
+    res = service.spectral_analysis(case, warn=limits_warn)
     doc = {"case": case.name, "units": "SI", "tower_of_interest": case.line.tower_of_interest,
            **spectral_to_dict(res)}
     console.print(spectral_table(doc, f"{case.name}: frequency-domain estimate 1 (exact linear random vibration), "

@@ -106,6 +106,10 @@ def wind(
         check_target(csv_out, what="CSV")
     if json_out is not None:
         check_target(json_out, what="JSON")
+    from .. import service
+    from .limits import warn as limits_warn
+
+    service.check_budget(case, "wind", warn=limits_warn)  # resource guard (issue 14)
     s = point_series(case, realization - 1)
     doc = series_summary(case, s)
     table = Table(title=f"{case.name}: wind at point p (x = {s.point_p:.1f} m), realization {realization}",

@@ -15,7 +15,9 @@ import dataclasses
 import difflib
 import hashlib
 import math
+import os
 import re
+import stat
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -93,7 +95,7 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         _f("span_length", "m", "span length L_x (equal spans)", required=True, low=10.0, high=3000.0),
         _f("sag", "m", "still-air mid-span sag S", required=True, low=0.0, high=None, low_open=True),
         _f("weight", "N/m", "conductor weight per unit length W", required=True, low=0.0, high=1000.0, low_open=True),
-        _f("diameter", "m", "projected area per unit length D (m2/m)", required=True, low=0.0, high=1.0, low_open=True),
+        _f("diameter", "m", "projected area per unit length D, i.e. the diameter of a single conductor (paper Table 1)", required=True, low=0.0, high=1.0, low_open=True),
         _f("drag_coefficient", "-", "drag coefficient C_d", default=1.0, low=0.0, high=3.0, low_open=True),
         _f("area", "m2", "conductor cross-section A", required=True, low=0.0, high=0.1, low_open=True),
         _f("elastic_modulus", "Pa", "elastic modulus E", required=True, low=1e8, high=1e12),
@@ -129,7 +131,7 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
     "analysis": (
         _f("duration", "s", "analysed record length (downburst default: 0 to T_f)", low=0.0, high=1e5, low_open=True),
         _f("time_step", "s", "time step", default=0.05, low=0.0, high=1.0, low_open=True),
-        _i("realizations", "-", "number of turbulence realizations", default=10, low=1, high=10000),
+        _i("realizations", "-", "number of turbulence realizations (memory and time bounded by the resource guard)", default=10, low=1, high=1_000_000_000),
         _i("seed", "-", "random seed", default=2015, low=0, high=2**63 - 1),
         _i("mean_states", "-", "downburst: step-1 mean-state instants over the event", default=250, low=2, high=100000),
         FieldSpec("damping", "choice", "-", 'aerodynamic damping: "quasi-steady" (every direction of relative motion) or "paper" (Eq. 13, transverse only)', default="quasi-steady", choices=DAMPING_MODELS),
@@ -158,7 +160,7 @@ class Line:
     span_length: float  # [m]
     sag: float  # [m]
     weight: float  # [N/m]
-    diameter: float  # [m2/m]
+    diameter: float  # [m] (projected area per unit length, m2/m = m)
     drag_coefficient: float  # [-]
     area: float  # [m2]
     elastic_modulus: float  # [Pa]
@@ -387,6 +389,37 @@ def _read_section(data: dict, section: str, ctx: _Ctx) -> dict[str, Any]:
     return out
 
 
+# C0 controls except tab, DEL and the C1 controls: they inject terminal escape sequences and
+# openpyxl refuses them (IllegalCharacterError); no case text needs them (issue 14).
+_CONTROL = re.compile("[\x00-\x08\x0a-\x1f\x7f-\x9f]")
+MAX_NESTING = 16  # deepest table/array nesting a case file needs is 3 ([wind.downburst], a list)
+
+
+def _check_text(data: dict[str, Any], ctx: _Ctx) -> None:
+    """Reject control characters in every key and string value, and absurd nesting."""
+    stack: list[tuple[str, Any, int]] = [("", data, 0)]
+    while stack:
+        where, value, depth = stack.pop()
+        section, _, key = where.rpartition(".")
+        if depth > MAX_NESTING:
+            raise ctx.error(section, key or None, f"value nested {depth} levels deep is not allowed: expected "
+                            f"at most {MAX_NESTING} levels of tables and arrays")
+        if isinstance(value, str):
+            m = _CONTROL.search(value)
+            if m:
+                raise ctx.error(section, key or None, f"control character U+{ord(m.group()):04X} at position "
+                                f"{m.start() + 1} is not allowed: expected printable text")
+        elif isinstance(value, dict):
+            for k, v in value.items():
+                m = _CONTROL.search(k)
+                if m:
+                    raise ctx.error(where, None, f"a key holds control character U+{ord(m.group()):04X}: "
+                                    "expected printable key names")
+                stack.append((f"{where}.{k}" if where else k, v, depth + 1))
+        elif isinstance(value, list):
+            stack.extend((where, v, depth + 1) for v in value)
+
+
 def case_from_dict(
     data: dict[str, Any],
     *,
@@ -400,6 +433,7 @@ def case_from_dict(
     Raises :class:`CaseError` naming file, key, line, value and what is allowed.
     """
     ctx = _Ctx(file, text)
+    _check_text(data, ctx)
     top = _read_section(data, "", ctx)
     for required in ("line", "wind"):
         if required not in data:
@@ -425,6 +459,15 @@ def case_from_dict(
         raise ctx.error("line", "tower_of_interest", f"value {toi} is out of range: expected an integer from 1 to {n_towers} (number of towers)")
     if line_d["sag"] >= 0.25 * line_d["span_length"]:
         raise ctx.error("line", "sag", f"value {line_d['sag']!r} is out of range: expected a sag below span_length/4 = {0.25 * line_d['span_length']:g} m (shallow-cable method)")
+    # physically meaningful geometry (issue 14): the lowest conductor point of a parabola whose
+    # average elevation is `height` is height - sag/3; requiring sag < height keeps it at least
+    # 2/3 sag above ground.  Insulator swing lifts the conductor, so no allowance is added.
+    if line_d["sag"] >= line_d["height"]:
+        raise ctx.error("line", "sag", f"value {line_d['sag']!r} is not allowed with height = {line_d['height']!r}: "
+                        "expected sag < height (the conductor would reach the ground)")
+    if "suspension" in sup and line_d["insulator_length"] >= line_d["height"]:
+        raise ctx.error("line", "insulator_length", f"value {line_d['insulator_length']!r} is not allowed with "
+                        f"height = {line_d['height']!r} and suspension towers: expected insulator_length < height")
     line = Line(**line_d)
 
     # ---- wind cross-checks
@@ -479,20 +522,67 @@ def _build_downburst(d: dict[str, Any], line: Line, ctx: _Ctx, base_dir: Path | 
     return Downburst(field_path=path, **d)
 
 
-def read_text_file(path: str | Path, expected: str) -> str:
-    """UTF-8 text of a user file; one-line :class:`CaseError` naming the file and ``expected``
-    (e.g. "a TOML case file") when it is missing, a folder, unreadable or not UTF-8."""
+MAX_CASE_BYTES = 10 * 2**20  # [bytes] size cap of a TOML case file (docs/case-files.md)
+MAX_RESULT_BYTES = 2**30  # [bytes] size cap of a saved JSON result read back (export, batch --resume)
+
+
+def _size_text(n: int) -> str:
+    return f"{n / 2**20:.1f} MB" if n >= 2**20 else f"{n} bytes"
+
+
+def read_regular_file(path: str | Path, expected: str, max_bytes: int) -> bytes:
+    """Bytes of a user file, read only if it is a regular file of at most ``max_bytes``.
+
+    The file is opened without blocking (a FIFO never hangs), checked with ``fstat`` after
+    opening (a symlink to /dev/zero or a device is refused before any read), its size is
+    checked before reading, and at most ``max_bytes + 1`` bytes are read (a file growing
+    while read is still refused).  One-line :class:`CaseError` naming the file otherwise.
+    """
     p = Path(path)
     try:
-        return p.read_bytes().decode("utf-8")
+        fd = os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0))
     except FileNotFoundError:
         raise CaseError(f"file not found (expected {expected})", file=str(p)) from None
     except IsADirectoryError:
         raise CaseError(f"is a directory, expected {expected}", file=str(p)) from None
-    except UnicodeDecodeError:
-        raise CaseError(f"not a UTF-8 text file (expected {expected})", file=str(p)) from None
     except OSError as exc:
         raise CaseError(f"cannot read: {exc.strerror}", file=str(p)) from None
+    try:
+        st = os.fstat(fd)
+        if stat.S_ISDIR(st.st_mode):
+            raise CaseError(f"is a directory, expected {expected}", file=str(p))
+        if not stat.S_ISREG(st.st_mode):
+            raise CaseError(f"is not a regular file (a pipe, socket or device), expected {expected}", file=str(p))
+        if st.st_size > max_bytes:
+            raise CaseError(f"file size {_size_text(st.st_size)} is too large: expected at most "
+                            f"{_size_text(max_bytes)} ({expected})", file=str(p))
+        chunks: list[bytes] = []
+        left = max_bytes + 1
+        while left > 0:
+            b = os.read(fd, min(left, 2**20))
+            if not b:
+                break
+            chunks.append(b)
+            left -= len(b)
+        if left <= 0:
+            raise CaseError(f"file grew beyond {_size_text(max_bytes)} while read: expected at most "
+                            f"{_size_text(max_bytes)} ({expected})", file=str(p))
+        return b"".join(chunks)
+    except OSError as exc:
+        raise CaseError(f"cannot read: {exc.strerror}", file=str(p)) from None
+    finally:
+        os.close(fd)
+
+
+def read_text_file(path: str | Path, expected: str, max_bytes: int = MAX_CASE_BYTES) -> str:
+    """UTF-8 text of a user file; one-line :class:`CaseError` naming the file and ``expected``
+    (e.g. "a TOML case file") when it is missing, a folder, not a regular file (FIFO, device),
+    larger than ``max_bytes``, unreadable or not UTF-8."""
+    data = read_regular_file(path, expected, max_bytes)
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise CaseError(f"not a UTF-8 text file (expected {expected})", file=str(path)) from None
 
 
 def load_case(path: str | Path) -> Case:
@@ -504,6 +594,9 @@ def load_case(path: str | Path) -> Case:
     text = read_text_file(p, "a .toml case file")
     try:
         data = tomllib.loads(text)
+    except RecursionError:  # tomllib recurses per nesting level (e.g. a = [[[[...]]]])
+        raise CaseError(f"arrays or tables nested too deeply: expected at most {MAX_NESTING} levels",
+                        file=str(p)) from None
     except tomllib.TOMLDecodeError as exc:
         m = re.search(r"\(at line (\d+), column (\d+)\)", str(exc))
         msg = re.sub(r"\s*\(at line \d+, column \d+\)", "", str(exc))
@@ -515,7 +608,7 @@ def load_case(path: str | Path) -> Case:
 
 def case_hash(path: str | Path) -> str:
     """SHA-256 of the case file's bytes (batch --resume)."""
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    return hashlib.sha256(read_regular_file(path, "a .toml case file", MAX_CASE_BYTES)).hexdigest()
 
 
 # --------------------------------------------------------------------------- editing / writing
@@ -603,6 +696,24 @@ def with_values(case: Case, changes: dict[str, Any]) -> Case:
             table[key] = value
     base = case.source.parent if case.source else None
     return case_from_dict(doc, file=str(case.source) if case.source else None, default_name=case.name, base_dir=base)
+
+
+def with_options(case: Case, options: dict[str, tuple[str, Any]]) -> Case:
+    """A validated copy of ``case`` with command-line overrides, e.g.
+    ``{"--realizations": ("analysis.realizations", 20)}``: each value is checked against the
+    :data:`SCHEMA` range with a message naming the option, then the case is re-validated."""
+    changes: dict[str, Any] = {}
+    for option, (dotted, value) in options.items():
+        if value is None:
+            continue
+        section, _, key = dotted.rpartition(".")
+        ctx = _Ctx(None, None)
+        try:
+            _check_value(field_spec(section, key), value, ctx, section)
+        except CaseError as err:
+            raise CaseError(err.message.split(": ", 1)[1] + f" (overrides {dotted})", key=option) from None
+        changes[dotted] = value
+    return with_values(case, changes)
 
 
 def replace(obj: Any, **changes: Any) -> Any:

@@ -591,7 +591,8 @@ def random_vibration(
     with np.errstate(divide="ignore", invalid="ignore"):
         gf_dy = np.where(defined, pk_dy / mabs, np.nan)
         gf_qs = np.where(defined, pk_qs / mabs, np.nan)
-    cont_r = (pk_dy - pk_qs) / pk_dy
+        # Cont_R undefined (NaN, shown "**") where the peak is zero, e.g. turbulence_intensity = 0
+        cont_r = np.where(pk_dy > 0, (pk_dy - pk_qs) / np.where(pk_dy > 0, pk_dy, 1.0), np.nan)
     return SpectralEstimate(
         mean=np.asarray(mean_reaction, dtype=float), rms_background=sB, rms_resonant=sR, rms_fluctuating=sF,
         nu_background=nuB, nu_fluctuating=nuF, peak_quasi_static=pk_qs, peak_dynamic=pk_dy,

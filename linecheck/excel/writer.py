@@ -33,7 +33,7 @@ from typing import Any
 
 from openpyxl import Workbook
 
-from ..core.case import read_text_file
+from ..core.case import MAX_RESULT_BYTES, read_text_file
 from ..core.errors import CaseError
 from ..io.atomic import atomic_path, check_target
 from . import template as tpl
@@ -184,7 +184,7 @@ def load_result_docs(paths: Iterable[str | Path]) -> list[dict[str, Any]]:
     docs: list[dict[str, Any]] = []
     for path in paths:
         p = Path(path)
-        text = read_text_file(p, "a JSON result of `linecheck run --json`")
+        text = read_text_file(p, "a JSON result of `linecheck run --json`", MAX_RESULT_BYTES)
         try:
             data = json.loads(text)
         except json.JSONDecodeError as exc:

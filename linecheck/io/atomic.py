@@ -8,12 +8,40 @@ true.
 from __future__ import annotations
 
 import contextlib
+import glob
 import os
+import stat
 import tempfile
+import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from ..core.errors import CaseError
+
+
+# Temporary files of a killed writer (SIGKILL, power loss) stay behind as ".NAME.XXXX.tmp";
+# the next write of NAME removes those older than this process (a live writer in another
+# process that started earlier is racing for the same file anyway).
+_PROCESS_START = time.time()
+
+
+def clean_stale_temporaries(path: str | Path) -> list[Path]:
+    """Remove ``.NAME.*.tmp`` files left next to ``path`` by writers that died (returns them)."""
+    p = Path(path)
+    parent = p.parent if str(p.parent) else Path(".")
+    removed = []
+    try:
+        candidates = list(parent.glob(f".{glob.escape(p.name)}.*.tmp"))
+    except OSError:
+        return removed
+    for tmp in candidates:
+        with contextlib.suppress(OSError):
+            st = tmp.lstat()
+            if (stat.S_ISREG(st.st_mode) and st.st_mtime < _PROCESS_START
+                    and getattr(os, "getuid", lambda: st.st_uid)() == st.st_uid):
+                tmp.unlink()
+                removed.append(tmp)
+    return removed
 
 
 def check_target(path: str | Path, *, force: bool = True, what: str = "output") -> Path:
@@ -35,6 +63,7 @@ def check_target(path: str | Path, *, force: bool = True, what: str = "output") 
 def atomic_path(path: str | Path, *, force: bool = True, what: str = "output") -> Iterator[Path]:
     """Yield a temporary path next to ``path``; rename it over ``path`` on success."""
     p = check_target(path, force=force, what=what)
+    clean_stale_temporaries(p)
     fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent if str(p.parent) else ".")
     os.close(fd)
     tmp_path = Path(tmp)

@@ -23,10 +23,12 @@ from textual.worker import Worker, WorkerState
 from ..core.case import Case, load_case
 from ..core.errors import Cancelled, LinecheckError
 from . import files, runner
+from .formatting import case_differences
 from .catalog import discover
 from .commands import LinecheckCommands
 from .messages import (CaseOpened, Exported, OpenCaseRequested, ParameterChanged, RunCancelled, RunFailed,
                        RunFinished, RunProgress, RunStarted)
+from .screens.confirm import ConfirmScreen
 from .screens.error import ErrorScreen
 from .screens.help import HelpScreen
 from .screens.prompt import PathPrompt
@@ -73,6 +75,8 @@ class LinecheckApp(App[None]):
         self.case: Case | None = None
         self.original: Case | None = None
         self.output: runner.RunOutput | None = None
+        self.output_original: Case | None = None  # the file's case the output's case was edited from
+        self._run_original: Case | None = None
         self.pinned: runner.RunOutput | None = None
         self.running = False
         self._cancel: threading.Event | None = None
@@ -100,9 +104,14 @@ class LinecheckApp(App[None]):
         if len(files) == 1 and len(self.paths) == 1:
             self.open_case(files[0])
 
+    @property
+    def edited(self) -> bool:
+        """The current case differs from the file it was opened from (unsaved edits)."""
+        return self.case is not None and self.original is not None and self.case != self.original
+
     async def action_quit(self) -> None:
         """Quit; with unsaved edits, only on the second ctrl+q within 5 s."""
-        edited = self.case is not None and self.original is not None and self.case != self.original
+        edited = self.edited
         now = time.monotonic()
         if edited and now - self._quit_warned > 5.0:
             self._quit_warned = now
@@ -159,8 +168,29 @@ class LinecheckApp(App[None]):
     def _open_requested(self, event: OpenCaseRequested) -> None:
         self.open_case(event.path)
 
-    def open_case(self, path: Path, *, run: bool = False) -> None:
-        """Load and validate ``path``; it becomes the current case (errors go to a dialog)."""
+    def open_case(self, path: Path, *, run: bool = False, discard: bool = False) -> None:
+        """Load and validate ``path``; it becomes the current case (errors go to a dialog).
+
+        With unsaved edits a dialog asks first (unless ``discard``): opening another case
+        (browser, palette) never drops them silently.
+        """
+        if self.edited and not discard:
+            assert self.case is not None and self.original is not None
+            keys = [k for k, _a, _b in case_differences(self.original, self.case)]
+            shown = ", ".join(keys[:4]) + (f" and {len(keys) - 4} more" if len(keys) > 4 else "")
+
+            def answer(yes: bool | None) -> None:
+                if yes:
+                    self.open_case(path, run=run, discard=True)
+                else:
+                    self.notify("kept the edited case: s saves it", timeout=3)
+
+            self.push_screen(ConfirmScreen(
+                "Unsaved edits",
+                f"{self.case.name} has unsaved edits ({shown}).\n"
+                f"Opening {Path(path).name} discards them; s (save as) keeps them in a new file.",
+                "Discard the edits and open", "Keep editing"), answer)
+            return
         try:
             case = load_case(path)
         except LinecheckError as err:
@@ -171,6 +201,8 @@ class LinecheckApp(App[None]):
         self.query_one(CaseBrowser).select_path(Path(path))
         self._results_stale()
         self._state_changed()
+        if not self.running:  # the last run's status line belongs to the previous case
+            self.query_one(RunPanel).status(f"opened {case.name} - r runs it", style="dim")
         self.post_message(CaseOpened(case, Path(path)))
         self.action_show_tab("params")
         if run:
@@ -206,8 +238,7 @@ class LinecheckApp(App[None]):
         case = self.case
         if case is None:
             return
-        folder = case.source.parent if case.source is not None else Path.cwd()
-        default = files.free_path(folder / f"{case.name}-edited.toml")
+        default = files.save_as_default(case.name)  # the working directory, not cases/paper/
 
         def done(answer: tuple[Path, bool] | None) -> None:
             if answer is None or self.case is None:
@@ -225,9 +256,10 @@ class LinecheckApp(App[None]):
             self.notify(f"saved {path}")
             self.catalog = discover(self.paths)
             self.query_one(CaseBrowser).reload(self.catalog)
-            self.open_case(path)
+            self.open_case(path, discard=True)  # the edits are in the saved file
 
-        self.push_screen(PathPrompt("Save the case as a new TOML file", default, ".toml"), done)
+        self.push_screen(PathPrompt("Save the case as a new TOML file", default, ".toml",
+                                    caution=files.in_shipped_folder), done)
 
     # ------------------------------------------------------------------ run
     def action_run(self) -> None:
@@ -243,6 +275,7 @@ class LinecheckApp(App[None]):
             self.notify("Unapplied edit discarded (enter applies an edit).", severity="warning")
         self._cancel = threading.Event()
         self.running = True
+        self._run_original = self.original
         self.query_one(RunPanel).start(self.case)
         self.post_message(RunStarted(self.case))
         self.run_job(self.case, self._cancel)
@@ -301,9 +334,9 @@ class LinecheckApp(App[None]):
     def _finished(self, event: RunFinished) -> None:
         self._run_ended()
         out = event.output
-        self.output = out
+        self.output, self.output_original = out, self._run_original
         self.query_one(RunPanel).finish(f"done: {out.case.name} in {out.seconds:.1f} s - "
-                                        "3 results, [ ] result tabs, p pins for compare, x/j export")
+                                        "tab 3 Results ([ ] steps through its views), p pins for compare, x/j export")
         try:
             self.query_one(ResultsView).show(out, self.pinned, stale=self._stale_note(out))
             self.query_one(CompareView).show(self.pinned, out)
@@ -342,7 +375,9 @@ class LinecheckApp(App[None]):
         if self.output is None:
             self.notify("Nothing to export yet: run a case first (r).", severity="warning")
             return
-        doc = self.output.doc
+        out = self.output
+        # an edited case's description is marked with the edits (it describes the file's values)
+        doc = files.doc_for_export(out.doc, out.case, self.output_original)
         default = files.free_path(Path(f"{doc['case']}{suffix}"))
 
         def done(answer: tuple[Path, bool] | None) -> None:

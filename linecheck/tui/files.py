@@ -13,6 +13,31 @@ from ..io.atomic import write_text_atomic
 from .formatting import case_differences
 
 
+def shipped_case_folders() -> list[Path]:
+    """The case folders shipped with linecheck (``cases/`` of the checkout the package runs
+    from): ``linecheck batch cases/paper/*.toml`` must find only the shipped cases there."""
+    folder = Path(__file__).resolve().parents[2] / "cases"
+    return [folder] if folder.is_dir() else []
+
+
+def in_shipped_folder(path: Path) -> str | None:
+    """A warning when ``path`` lies in a shipped case folder, else None."""
+    p = Path(path).expanduser().resolve()
+    for folder in shipped_case_folders():
+        if p.is_relative_to(folder):
+            return f"{p.parent} is a shipped case folder (batch cases/paper/*.toml would run this file)"
+    return None
+
+
+def save_as_default(name: str) -> Path:
+    """Where "save as" proposes to write an edited case: the working directory, never a shipped
+    case folder (the home directory when the working directory is one)."""
+    folder = Path.cwd()
+    if in_shipped_folder(folder / "x.toml"):
+        folder = Path.home()
+    return free_path(folder / f"{name}-edited.toml")
+
+
 def free_path(path: Path) -> Path:
     """``path``, or ``stem-2.ext``, ``stem-3.ext``... the first that does not exist."""
     if not path.exists():
@@ -41,6 +66,32 @@ def case_for_saving(case: Case, original: Case | None, path: Path) -> Case:
             note = f"edited from {original.name}: " + ", ".join(edits)
             out = with_value(out, "description", f"{out.description} ({note})" if out.description else note)
     return out
+
+
+def edit_note(case: Case, original: Case | None) -> str | None:
+    """``"edited: wind.v_ref 40 → 30, ..."`` for the value keys of ``case`` that differ from the
+    file it was opened from (None when none differ)."""
+    if original is None:
+        return None
+    edits = [f"{k} {a} → {b}" for k, a, b in case_differences(original, case) if k not in ("name", "description")]
+    return "edited: " + ", ".join(edits) if edits else None
+
+
+def doc_for_export(doc: dict[str, Any], case: Case, original: Case | None) -> dict[str, Any]:
+    """The run document as exported (Excel, JSON) from the TUI.
+
+    A case's description is free text written for the values of its file ("Vref = 40 m/s");
+    the TUI cannot re-derive it from new values.  So when value keys were edited and the
+    description was not, the exported description is marked with the edits
+    ("Vref = 40 m/s (edited: wind.v_ref 40 → 30)"); a description the user edited is theirs.
+    """
+    if original is None or case.description != original.description:
+        return doc
+    note = edit_note(case, original)
+    if note is None:
+        return doc
+    text = doc.get("description") or ""
+    return {**doc, "description": f"{text} ({note})" if text else note}
 
 
 def save_case(case: Case, path: Path, *, replace: bool) -> Path:

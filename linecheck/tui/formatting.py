@@ -70,33 +70,49 @@ def cont_r_flags(doc: dict[str, Any], state: str = "recommended") -> list[str]:
 
 
 # --------------------------------------------------------------------------- compare
-def _delta(a: float | None, b: float | None, stat: Stat) -> str:
-    """Change from ``a`` to ``b``: relative (%), or in percentage points for Cont_*;
-    empty when undefined or when both values show as zero at the table's precision."""
+# Relative differences only from a pinned value of at least this share of the largest pinned
+# value of the same unit in the table (the rule that makes a GF "**": a mean below 1 % of the
+# largest mean is zero by symmetry, e.g. Rz of a level span, 1e-13 kN).  Below it the relative
+# change of a value about zero is meaningless (+2.5e15 %) and Δ is the absolute difference.
+REL_FLOOR = 0.01
+
+
+def _delta(a: float | None, b: float | None, stat: Stat, floor: float = 0.0) -> str:
+    """Change from ``a`` to ``b``: relative (%) when ``|a| >= floor`` [SI units of the row], else
+    absolute in the row's unit ("+0.012 kN"); in percentage points for Cont_*; empty when
+    undefined or when both values show as zero at the table's precision."""
     if a is None or b is None:
         return ""
     if stat.unit == "%":  # contributions: difference in percentage points
         return f"{(b - a) * stat.scale:+.1f} pp"
-    shown_zero = 0.5 * 10.0 ** -int(stat.fmt[-3])  # "{:.3f}" -> 0.0005
+    shown_zero = 0.5 * 10.0 ** -int(stat.fmt[-3])  # "{:.3f}" -> 0.0005, in display units
     if abs(a * stat.scale) < shown_zero and abs(b * stat.scale) < shown_zero:
         return ""
-    if a == 0:
-        return "new"
+    if a == 0 or abs(a) < floor:
+        unit = "" if stat.unit in ("-", "") else f" {stat.unit}"
+        return stat.fmt.replace("{:", "{:+").format((b - a) * stat.scale) + unit
     return f"{(b - a) / abs(a) * 100:+.1f} %"
 
 
 def compare_rows(pinned: dict[str, Any], current: dict[str, Any]) -> list[tuple[str, ...]]:
     """Rows ``(reaction, statistic, unit, pinned, current, Δ)``, grouped by reaction.
 
-    Δ is relative (%) for forces and ratios, in percentage points for Cont_*.
+    Δ is relative (%) for forces and ratios, absolute where the pinned value is below
+    :data:`REL_FLOOR` of the largest pinned value of its unit, in percentage points for Cont_*.
     """
     na, nb = int(pinned.get("realizations", 1)), int(current.get("realizations", 1))
+    largest: dict[str, float] = {}
+    for r in REACTIONS:
+        for st in SUMMARY_STATS:
+            v = pinned["reactions"][r][st.key].get("mean")
+            if v is not None and math.isfinite(v):
+                largest[st.unit] = max(largest.get(st.unit, 0.0), abs(v))
     rows = []
     for r in REACTIONS:
         for st in SUMMARY_STATS:
             ea, eb = pinned["reactions"][r][st.key], current["reactions"][r][st.key]
             rows.append((r, st.label, st.unit, stat_text(ea, st, na), stat_text(eb, st, nb),
-                         _delta(ea.get("mean"), eb.get("mean"), st)))
+                         _delta(ea.get("mean"), eb.get("mean"), st, REL_FLOOR * largest.get(st.unit, 0.0))))
     return rows
 
 
@@ -108,6 +124,18 @@ def iter_fields() -> list[tuple[str, FieldSpec]]:
         for spec in specs:
             out.append((f"{section}.{spec.name}" if section else spec.name, spec))
     return out
+
+
+# keys that mean something for one wind type only (the other type's table hides them)
+ONLY_FOR = {"downburst": ("wind.downburst.", "analysis.mean_states"),
+            "synoptic": ("wind.span_speeds", "analysis.burn_in")}
+
+
+def fields_for(wind_type: str) -> list[tuple[str, FieldSpec]]:
+    """:func:`iter_fields` without the keys of the other wind type (a synoptic case does not
+    list the downburst keys)."""
+    hidden = tuple(p for t, prefixes in ONLY_FOR.items() if t != wind_type for p in prefixes)
+    return [(k, spec) for k, spec in iter_fields() if not k.startswith(hidden)]
 
 
 def get_value(case: Case, dotted: str) -> Any:

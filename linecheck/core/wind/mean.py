@@ -47,7 +47,7 @@ from scipy.interpolate import RegularGridInterpolator
 from scipy.optimize import brentq, minimize_scalar
 from scipy.special import erf
 
-from ..case import Case, Downburst
+from ..case import Case, Downburst, read_regular_file
 from ..errors import CaseError
 from ..system import LineSystem
 
@@ -232,13 +232,15 @@ def _check_axes(path: Path, r: np.ndarray, z: np.ndarray, t: np.ndarray) -> None
         raise _field_error(path, f"column z_over_dj has value {z[0]:g}: expected z_over_dj >= 0")
 
 
+MAX_FIELD_BYTES = 200 * 2**20  # [bytes] size cap of a field file (docs/wind.md, docs/case-files.md)
+
+
 def _read_csv(path: Path) -> FieldTable:
+    raw = read_regular_file(path, "a CSV running-mean field file", MAX_FIELD_BYTES)  # bounded read (issue 14)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = raw.decode("utf-8")
     except UnicodeDecodeError:
         raise _field_error(path, "not a UTF-8 text file: expected a CSV running-mean field (see docs/wind.md)") from None
-    except OSError as exc:
-        raise _field_error(path, f"cannot read field file: {exc.strerror}") from None
     header: list[str] | None = None
     header_line = 0
     rows: list[list[float]] = []
@@ -293,6 +295,11 @@ def _read_csv(path: Path) -> FieldTable:
 def _read_npz(path: Path) -> FieldTable:
     try:
         with np.load(path, allow_pickle=False) as npz:
+            # uncompressed size of the members checked before any is read (a zip bomb; issue 14)
+            inflated = sum(info.file_size for info in npz.zip.infolist())
+            if inflated > MAX_FIELD_BYTES:
+                raise _field_error(path, f"arrays of {inflated / 2**20:.0f} MB uncompressed are too large: expected "
+                                   f"at most {MAX_FIELD_BYTES / 2**20:.0f} MB")
             arrays = {k: np.asarray(npz[k]) for k in npz.files}
     except (OSError, ValueError) as exc:
         raise _field_error(path, f"not a readable NPZ file ({exc}): expected arrays {_ALLOWED_TEXT}") from None
@@ -360,7 +367,10 @@ def load_field_table(path: str | Path) -> FieldTable:
     except OSError as exc:
         raise _field_error(p, f"cannot read field file: {exc.strerror}") from None
     if not p.is_file():
-        raise _field_error(p, "is not a file: expected a CSV or NPZ running-mean field")
+        raise _field_error(p, "is not a regular file: expected a CSV or NPZ running-mean field")
+    if st.st_size > MAX_FIELD_BYTES:
+        raise _field_error(p, f"file size {st.st_size / 2**20:.0f} MB is too large: expected at most "
+                           f"{MAX_FIELD_BYTES / 2**20:.0f} MB (a CSV or NPZ running-mean field)")
     return _load_cached(str(p.resolve()), st.st_mtime_ns, st.st_size)
 
 

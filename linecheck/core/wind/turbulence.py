@@ -291,7 +291,8 @@ def unit_field(case: Case, system: LineSystem, n_steps: int, dt: float, realizat
     x = system.node_x0
     v = float(case.wind.v_ref)
     if not v > 0:
-        raise CaseError("value 0.0 is not allowed for turbulence synthesis: expected v_ref > 0", key="wind.v_ref")
+        raise CaseError("value 0.0 is not allowed for turbulence synthesis: expected v_ref > 0",
+                        file=str(case.source) if case.source else None, key="wind.v_ref")
     grid = spectral_grid(int(n_steps), float(dt), length_scale(case), v)
     phases = random_phases(case.analysis.seed, realization, x.size, grid.n_freq)
     return synthesize(x, grid, phases, case.wind.coherence_decay, v)

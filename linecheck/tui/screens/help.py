@@ -19,7 +19,8 @@ Design check of conductor reactions under downburst and synoptic winds
 - `1` `2` `3` `4`: tabs Cases, Parameters, Results, Compare
 - arrows, `enter`: move; open a case (Cases) or edit a parameter (Parameters)
 - `e`: edit the highlighted parameter; `enter` applies, `esc` cancels
-- `s`: save the edited case as a new TOML file (an existing file is never replaced silently)
+- `s`: save the edited case as a new TOML file in the working folder (an existing file is never
+  replaced silently; a shipped case folder such as `cases/paper/` needs a second `enter`)
 - `r`: run the case (steps 1-3, natural frequencies, wind at p); `c` cancels the run
 - `[` `]`: previous / next result tab
 - `p`: pin the result for Compare
@@ -29,7 +30,7 @@ Design check of conductor reactions under downburst and synoptic winds
 
 ## A typical session
 
-1. `1` Cases: arrows to a case, `enter` opens it.
+1. `1` Cases: arrows to a case, `enter` opens it (with unsaved edits it asks first).
 2. `2` Parameters: arrows to `wind.v_ref`, `enter`, type `20`, `enter`.
    A bad value is refused with the same message as `linecheck check`.
 3. `r` runs it; the bars show each stage; `c` cancels.

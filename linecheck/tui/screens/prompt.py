@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 from rich.text import Text
@@ -13,25 +14,38 @@ from textual.screen import ModalScreen
 from textual.widgets import Checkbox, Input, Static
 
 
+class TickBox(Checkbox):
+    """A checkbox that shows ``X`` only when ticked (Textual's shows it always, only recoloured)."""
+
+    @property
+    def _button(self):  # noqa: ANN202 - Textual's Content
+        self.BUTTON_INNER = "X" if self.value else " "
+        return super()._button
+
+
 class PathPrompt(ModalScreen[tuple[Path, bool] | None]):
     """Ask for a file name; dismiss with ``(path, replace)`` or ``None`` (esc).
 
-    An existing file is accepted only with "replace it" ticked.
+    An existing file is accepted only with "replace it" ticked.  ``caution(path)`` returns a
+    warning for paths that need a second enter (e.g. a shipped case folder), or None.
     """
 
     BINDINGS = [Binding("escape", "cancel", "Cancel")]
 
-    def __init__(self, title: str, default: Path, suffix: str) -> None:
+    def __init__(self, title: str, default: Path, suffix: str,
+                 caution: Callable[[Path], str | None] | None = None) -> None:
         super().__init__()
         self.title_text = title
         self.default = default
         self.suffix = suffix
+        self.caution = caution
+        self._confirmed: Path | None = None  # the cautioned path entered twice
 
     def compose(self) -> ComposeResult:
         with Vertical(id="prompt-box", classes="dialog"):
             yield Static(Text(self.title_text, style="bold"), id="prompt-title")
             yield Input(str(self.default), id="prompt-input")
-            yield Checkbox("replace the file if it exists", id="prompt-replace")
+            yield TickBox("replace the file if it exists", id="prompt-replace")
             yield Static("", id="prompt-message")
             yield Static(Text("enter writes, esc cancels", style="dim"))
 
@@ -60,8 +74,12 @@ class PathPrompt(ModalScreen[tuple[Path, bool] | None]):
             msg.update(Text(problem, style="bold red"))
         else:
             exists = p is not None and p.exists()
-            msg.update(Text("will replace the existing file" if exists else "new file",
-                            style="yellow" if exists else "green"))
+            warning = self.caution(p) if self.caution is not None and p is not None else None
+            if warning:
+                msg.update(Text(warning + ": enter again to write there anyway", style="bold yellow"))
+            else:
+                msg.update(Text("will replace the existing file" if exists else "new file",
+                                style="yellow" if exists else "green"))
         return problem
 
     @on(Input.Changed)
@@ -75,10 +93,15 @@ class PathPrompt(ModalScreen[tuple[Path, bool] | None]):
     @on(Input.Submitted)
     def _submitted(self, event: Input.Submitted) -> None:
         event.stop()
-        if self.check(event.value) is None:
-            self.dismiss((Path(event.value.strip()).expanduser(), self.query_one(Checkbox).value))
-        else:
+        if self.check(event.value) is not None:
             self.app.bell()
+            return
+        path = Path(event.value.strip()).expanduser()
+        if self.caution is not None and self.caution(path) and self._confirmed != path:
+            self._confirmed = path  # asked (the message says so): a second enter writes
+            self.app.bell()
+            return
+        self.dismiss((path, self.query_one(Checkbox).value))
 
     def action_cancel(self) -> None:
         self.dismiss(None)

@@ -7,7 +7,7 @@ from textual.app import ComposeResult
 from textual.containers import Vertical
 from textual.widgets import DataTable, Static
 
-from ..formatting import case_differences, compare_rows
+from ..formatting import case_differences, compare_rows, cont_r_flags
 from ..runner import RunOutput
 
 HELP = ("Nothing pinned. Run a case, press p to pin its result, edit a parameter (tab 2), "
@@ -67,11 +67,16 @@ class CompareView(Vertical):
         params.update(p)
         table.display = True
         previous = None
+        flagged = {"pinned": cont_r_flags(pinned.doc), "current": cont_r_flags(current.doc)}
         for row in compare_rows(pinned.doc, current.doc):
             cells: list = list(row)
+            if row[1] == "Cont_R":  # a flagged Cont_R (> 10 %) as in the Results summary
+                for col, which in ((3, "pinned"), (4, "current")):
+                    if row[0] in flagged[which]:
+                        cells[col] = Text(cells[col], style="bold black on yellow")
             if cells[0] == previous:
                 cells[0] = ""  # reaction named once per group
             previous = row[0]
-            if cells[-1] and cells[-1] not in ("+0.0 %", "+0.0 pp", "-0.0 %", "-0.0 pp"):
+            if any(ch in "123456789" for ch in cells[-1]):  # a non-zero change
                 cells[-1] = Text(cells[-1], style="bold yellow")
             table.add_row(*cells)

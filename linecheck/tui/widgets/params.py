@@ -19,11 +19,12 @@ from textual.widgets import DataTable, Input, Static
 from ...core.case import Case, FieldSpec, with_value
 from ...core.errors import CaseError
 from ..catalog import shown_path
-from ..formatting import get_value, iter_fields, parse_value, value_text
+from ..formatting import fields_for, get_value, iter_fields, parse_value, value_text
 from ..messages import ParameterChanged, ParameterRejected
 
 COLUMNS = ("", "parameter", "value", "unit", "description")
-WIDTHS = (1, 28, 26, 6, None)
+# the parameter column fits the longest key (wind.downburst.translation_direction)
+WIDTHS = (1, max(len(k) for k, _ in iter_fields()), 22, 6, None)
 
 
 class ParameterEditor(Vertical):
@@ -66,7 +67,7 @@ class ParameterEditor(Vertical):
         table = self.query_one(DataTable)
         row = table.cursor_row
         table.clear()
-        for key, spec in self.specs.items():
+        for key, spec in fields_for(case.wind.type):
             table.add_row(*self._cells(key, spec), key=key)
         if table.row_count:
             table.move_cursor(row=min(max(row, 0), table.row_count - 1))
@@ -175,7 +176,7 @@ class ParameterEditor(Vertical):
         self.stop_editing()
         self.case = new
         table = self.query_one(DataTable)
-        for k, spec in self.specs.items():  # a change can alter derived values (e.g. presets)
+        for k, spec in fields_for(new.wind.type):  # a change can alter derived values (e.g. presets)
             for col, cell in zip(COLUMNS, self._cells(k, spec)):
                 table.update_cell(k, col or "mark", cell)
         self._update_title()

@@ -125,8 +125,9 @@ class ResultsView(Vertical):
         for row in summary_rows(doc):
             cells = list(row)
             if row[0] == "Cont_R":
-                cells = [cells[0], cells[1]] + [Text(c, style="bold yellow") if r in flagged else c
-                                                for r, c in zip(REACTIONS, cells[2:])]
+                # flagged cells in reverse video: visible on the cursor row and the zebra stripes
+                cells = [Text(cells[0], style="bold yellow") if flagged else cells[0], cells[1]] + [
+                    Text(c, style="bold black on yellow") if r in flagged else c for r, c in zip(REACTIONS, cells[2:])]
             t.add_row(*cells, key=row[0])
         notes = Text()
         notes.append("Wind-induced reactions (still air removed) at the tower of interest; "

@@ -141,7 +141,7 @@ def test_summary_numbers():
 
 
 def test_flag_three_states():
-    sa = np.array([[0.0, 0.0, 10_000.0]])  # still air 10 kN (vertical)
+    sa = np.array([[0.0, 0.0, 10_000.0]])  # still air 10 kN, vertical only
     low = np.array([[0.12, 0.05, 0.12]])
     high = np.array([[0.20, 0.15, 0.20]])
     peak = np.array([[5000.0, 5000.0, 0.9 * MIN_WIND_SHARE * 10_000.0]])

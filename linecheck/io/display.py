@@ -85,3 +85,25 @@ def how_to_read(doc: dict[str, Any]) -> list[str]:
     if bg_neg:
         notes.append(HOW_TO_READ_NEGATIVE_CONT_BG)
     return notes
+
+
+def flag_state(doc: dict[str, Any], reaction: str, threshold: float | None = None) -> str | None:
+    """The Cont_R flag state of ``reaction`` at the tower of interest: the document's
+    ``"dynamic_analysis"``, or -- with a ``threshold`` other than 10 % (``export
+    --cont-r-threshold``) -- the same three-state rule recomputed at that threshold from the
+    interval (docs/method.md).  None for a document without intervals (schema 1)."""
+    from ..core.extremes import CONT_R_THRESHOLD, MIN_WIND_SHARE
+
+    block = (doc.get("reactions") or {}).get(reaction) or {}
+    if threshold is None or threshold == CONT_R_THRESHOLD:
+        return block.get("dynamic_analysis")
+    ci = (block.get("Cont_R") or {}).get("ci")
+    if not ci or ci[0] is None or ci[1] is None or (block.get("GF_Dy") or {}).get("mean") is None:
+        return None
+    sa = ((doc.get("still_air") or {}).get("reactions") or {}).get(reaction) or 0.0
+    peak = (block.get("peak_dynamic") or {}).get("mean")
+    if peak is None or peak < MIN_WIND_SHARE * abs(float(sa)):
+        return None
+    if ci[0] > threshold:
+        return "recommended"
+    return "inconclusive" if ci[1] > threshold else None

@@ -36,8 +36,8 @@ EULER_GAMMA = 0.5772156649015329  # Euler-Mascheroni constant (Gumbel mean = u +
 CI_LEVEL = 0.95
 FRACTILES = (5.0, 50.0, 95.0)
 CONT_R_THRESHOLD = 0.10  # paper Sec. 5: dynamic analysis recommended where Cont_R > 10 %
-# No flag where the wind-induced peak is below this share of the still-air reaction of the same
-# component at that tower: the reaction is then governed by the still-air load, not the wind.
+# No flag where the wind-induced peak is below this share of the still-air load of the tower
+# (magnitude of its (R_x, R_y, R_z) still-air reaction): such a reaction does not govern the design.
 MIN_WIND_SHARE = 0.05
 
 
@@ -151,14 +151,14 @@ def dynamic_analysis_flag(
         gf_defined: whether GF_Dy is defined (mean not negligible), shape (..., 3).
         wind_peak: [N] mean wind-induced peak, shape (..., 3).
         still_air: [N] still-air reactions, shape (..., 3); the share is taken of the
-            same component (a zero still-air component never suppresses the flag).
+            magnitude of the (R_x, R_y, R_z) vector at the tower.
 
     "recommended" when the lower bound exceeds :data:`CONT_R_THRESHOLD`, "inconclusive" when the
     interval straddles it (pass (-inf, inf) when there is no interval, one realization), None otherwise and wherever GF is undefined or the wind-induced peak
     is below :data:`MIN_WIND_SHARE` of the still-air reaction.
     """
     low, high = np.asarray(cont_r_low, float), np.asarray(cont_r_high, float)
-    sa = np.abs(np.asarray(still_air, float))
+    sa = np.linalg.norm(np.asarray(still_air, float), axis=-1, keepdims=True)
     relevant = np.asarray(gf_defined, bool) & (np.asarray(wind_peak, float) >= MIN_WIND_SHARE * sa)
     out = np.full(low.shape, None, dtype=object)
     out[relevant & (low > CONT_R_THRESHOLD)] = "recommended"

@@ -100,9 +100,10 @@ def flag_state(doc: dict[str, Any], reaction: str, threshold: float | None = Non
     ci = (block.get("Cont_R") or {}).get("ci")
     if not ci or ci[0] is None or ci[1] is None or (block.get("GF_Dy") or {}).get("mean") is None:
         return None
-    sa = ((doc.get("still_air") or {}).get("reactions") or {}).get(reaction) or 0.0
+    sa = (doc.get("still_air") or {}).get("reactions") or {}
+    norm = sum(float(v) ** 2 for v in sa.values() if v is not None) ** 0.5
     peak = (block.get("peak_dynamic") or {}).get("mean")
-    if peak is None or peak < MIN_WIND_SHARE * abs(float(sa)):
+    if peak is None or peak < MIN_WIND_SHARE * norm:
         return None
     if ci[0] > threshold:
         return "recommended"

@@ -152,3 +152,22 @@ def test_flag_three_states():
     flags = dynamic_analysis_flag(low - 0.1, high - 0.05, np.ones((1, 3), bool), 2 * peak, sa)
     assert flags.tolist() == [["inconclusive", None, "inconclusive"]]  # Ry: upper bound exactly 10 %
     assert CONT_R_THRESHOLD == 0.10
+
+
+def test_flag_state_at_another_threshold():
+    """export --cont-r-threshold: the three-state rule recomputed from the interval in the JSON."""
+    from linecheck.io.display import flag_state
+
+    def block(lo, hi, gf=1.3, peak=2000.0, state="x"):
+        return {"Cont_R": {"ci": [lo, hi]}, "GF_Dy": {"mean": gf}, "peak_dynamic": {"mean": peak},
+                "dynamic_analysis": state}
+
+    doc = {"still_air": {"reactions": {"Rx": 30_000.0, "Ry": 0.0, "Rz": 40_000.0}},  # |still air| 50 kN
+           "reactions": {"Rx": block(0.06, 0.09), "Ry": block(0.03, 0.07), "Rz": block(0.06, 0.09, peak=2400.0)}}
+    assert flag_state(doc, "Rx") == "x"  # 10 %: the document's own state
+    assert flag_state(doc, "Rx", 0.05) is None  # peak 2 kN < 5 % of 50 kN
+    assert flag_state(doc, "Rz", 0.05) is None  # 2.4 kN < 2.5 kN
+    doc["still_air"]["reactions"] = {"Rx": 0.0, "Ry": 0.0, "Rz": 10_000.0}
+    assert flag_state(doc, "Rx", 0.05) == "recommended"
+    assert flag_state(doc, "Ry", 0.05) == "inconclusive"
+    assert flag_state(doc, "Ry", 0.08) is None

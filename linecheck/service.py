@@ -725,3 +725,137 @@ def sanity_check(res: RunResult) -> list[SanityItem]:
             items.append(SanityItem(r, q, float(td[c]), float(sd[c]), float(fd[c]), float(allowed),
                                     bool(abs(td[c] - fd[c]) <= allowed)))
     return items
+
+
+# --------------------------------------------------------------------------- design codes (issue 19)
+@dataclass(frozen=True)
+class ReactionCheck:
+    """One reaction against one code: loads [N], ratio = linecheck_peak / code_load [-]."""
+
+    code_load: float | None
+    linecheck_peak: float | None
+    ratio: float | None
+    verdict: str
+
+
+@dataclass(frozen=True)
+class TowerCheck:
+    """A tower's checks; ``reactions`` maps a reaction name ("Ry") to its check."""
+
+    index: int  # 1-based
+    reactions: dict
+
+
+@dataclass(frozen=True)
+class CodeCheck:
+    """One code's conductor wind load at every tower of the section, beside linecheck's peaks.
+
+    ``load_per_length`` [N/m] on the wind span at ``v_ref`` (None: no provision or outside the
+    code's validity, see ``note``); ``towers`` per tower (1-based ``index``).
+    """
+
+    code: str
+    edition: str
+    verified: bool
+    provision: str
+    load_per_length: float | None
+    inputs: dict
+    note: str
+    towers: tuple
+
+
+@dataclass(frozen=True)
+class CodesResult:
+    """The four codes side by side (docs/codes.md); ``peak`` says what ``linecheck_peak`` is."""
+
+    case: Case
+    checks: tuple
+    peak: str
+
+
+CODES_PEAK = ("mean over realizations of peak_dynamic (the wind-induced peak |M + B + R| of the reaction, "
+              "still air excluded), the same wind-induced quantity as the code's conductor wind load")
+
+
+def code_loads(case: Case, *, strict: bool = True) -> list:
+    """Each code's :class:`~linecheck.core.codes.CodeLoad` for ``case`` (at ``v_ref``).
+
+    ``strict``: a value outside a code's validity raises :class:`CaseError`; otherwise the
+    code is reported with no load and the message in its note.
+    """
+    from .core import codes as C
+    from .core.errors import CaseError
+
+    line, wind, cc = case.line, case.wind, case.codes
+    src = str(case.source) if case.source else None
+    if wind.type == "downburst":
+        return [C.downburst_load(code) for code in C.CODES]
+    args = (wind.v_ref, line.height, line.span_length, line.diameter, line.drag_coefficient)
+    calls = {
+        "ASCE74": lambda: C.asce74_wire_load(*args, cc.asce74_exposure or C.TERRAIN_MAP["ASCE74"][cc.terrain],
+                                             source=src),
+        "IEC60826": lambda: C.iec60826_conductor_load(
+            *args, cc.iec60826_terrain or C.TERRAIN_MAP["IEC60826"][cc.terrain], source=src),
+        "EN50341": lambda: C.en50341_conductor_load(*args, cc.en50341_terrain or C.TERRAIN_MAP["EN50341"][cc.terrain],
+                                                    source=src),
+        "ASNZS7000": lambda: C.asnzs7000_conductor_load(*args, turbulence_intensity=wind.turbulence_intensity,
+                                                        source=src),
+    }
+    out = []
+    for code in C.CODES:
+        try:
+            out.append(calls[code]())
+        except CaseError as err:
+            if strict:
+                raise
+            out.append(C.CodeLoad(code, C.EDITIONS[code], False, "synoptic", None, {}, f"not applied: {err}"))
+    return out
+
+
+def codes_analysis(case: Case, run: RunResult | None = None, *, strict: bool = True) -> CodesResult:
+    """Design-code conductor wind loads beside linecheck's peaks, per tower (issue 19).
+
+    Ry at tower j: code load = sum over the adjacent spans of w(v_n) L_n / 2, w the code's
+    load per length scaled by (v_n / v_ref)^2 for per-span synoptic speeds.  ``run``: the run
+    whose peaks are compared (None: the code loads only).  Verdict "code covers" when
+    linecheck's peak is at most the code load, else "code exceeded by x %"; unverified codes
+    get no verdict.
+    """
+    import math
+
+    line, wind = case.line, case.wind
+    n_spans = line.spans
+    speeds = np.asarray(wind.span_speeds if wind.span_speeds is not None else [wind.v_ref] * n_spans, dtype=float)
+    scale = (speeds / wind.v_ref) ** 2 if wind.v_ref > 0 else np.ones(n_spans)
+    half = 0.5 * line.span_length * scale  # [m] equivalent half spans at v_ref
+    eq_span = np.zeros(n_spans + 1)
+    eq_span[:-1] += half
+    eq_span[1:] += half
+    peaks = run.stats.mean("peak_dynamic")[:, 1] if run is not None else None  # (n_towers,) Ry
+    checks = []
+    for load in code_loads(case, strict=strict):
+        towers = []
+        for j in range(n_spans + 1):
+            peak = float(peaks[j]) if peaks is not None else None
+            if load.load_per_length is None:
+                verdict = {"none": "no provision", "not established": "provision not established"}.get(
+                    load.provision, "outside the code's validity")
+                rc = ReactionCheck(None, peak, None, verdict)
+            else:
+                F = float(load.load_per_length * eq_span[j])
+                ratio = peak / F if (peak is not None and F > 0) else None
+                if ratio is None:
+                    verdict = "no linecheck run"
+                elif not load.verified:
+                    verdict = "unverified: not judged"
+                elif ratio <= 1.0:
+                    verdict = "code covers"
+                else:
+                    verdict = f"code exceeded by {100 * (ratio - 1):.0f} %"
+                if ratio is not None and not math.isfinite(ratio):
+                    ratio = None
+                rc = ReactionCheck(F, peak, ratio, verdict)
+            towers.append(TowerCheck(j + 1, {"Ry": rc}))
+        checks.append(CodeCheck(load.code, load.edition, load.verified, load.provision, load.load_per_length,
+                                dict(load.inputs), load.note, tuple(towers)))
+    return CodesResult(case, tuple(checks), CODES_PEAK)

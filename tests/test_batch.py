@@ -312,3 +312,269 @@ def test_paper_batch_pool_equals_sequential(tmp_path):
     assert r1.exit_code == r2.exit_code == 0
     for p in cases:
         assert (tmp_path / "a" / f"{p.stem}.json").read_bytes() == (tmp_path / "b" / f"{p.stem}.json").read_bytes()
+
+
+# --------------------------------------------------------------------------- faults (issue 14)
+def test_killed_worker_fails_only_the_case_it_held(short_cases, tmp_path, monkeypatch):
+    """An out-of-memory kill of one pool worker (SIGKILL, here by the test hook in the worker
+    running case09-single): the pool is replaced, the other cases -- running or pending --
+    are re-run and saved bit for bit; only the held case fails, with a message saying so."""
+    from linecheck.batch.tasks import KILL_HOOK_ENV
+
+    victim = short_cases[1]
+    monkeypatch.setenv(KILL_HOOK_ENV, victim.stem)  # inherited by the workers spawned below
+    out = tmp_path / "res"
+    with ProcessPool(2) as pool:
+        rep = run_batch(short_cases, executor=pool, json_dir=out, chunk_size=10)
+    monkeypatch.delenv(KILL_HOOK_ENV)
+    assert [o.status for o in rep.outcomes] == ["done", "failed", "done"]
+    err = rep.outcomes[1].error
+    assert err == f"worker died (killed by signal 9, SIGKILL: out of memory?) while running {rep.outcomes[1].name}"
+    assert rep.exit_code == 1
+    assert sorted(p.name for p in out.glob("*.json")) == sorted(f"{p.stem}.json" for p in (short_cases[0], short_cases[2]))
+    ref = run_batch([short_cases[0]], json_dir=tmp_path / "ref")  # sequential, no kill
+    assert ref.exit_code == 0
+    for p in short_cases[:1]:  # re-run on the new pool (or finished before the kill): the same bytes
+        assert (out / f"{p.stem}.json").read_bytes() == (tmp_path / "ref" / f"{p.stem}.json").read_bytes()
+
+
+COORDINATOR = """
+import sys, time
+from multiprocessing import resource_tracker
+from linecheck.batch import ProcessPool
+
+if __name__ == "__main__":
+    pool = ProcessPool(2)
+    busy = pool.submit(time.sleep, 3600)  # one worker busy, one idle
+    pool.submit(int, 1).result()  # both workers up and running their initializer
+    print(*pool._pool._processes, resource_tracker._resource_tracker._pid, flush=True)
+    busy.result()
+"""
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "pidfd_open"), reason="waits on Linux pidfds")
+@pytest.mark.parametrize("sig", ["SIGKILL", pytest.param("SIGTERM", marks=pytest.mark.slow)])
+def test_workers_exit_when_the_coordinator_dies(sig):
+    """Kill the coordinating process: its pool workers (busy and idle) and the resource
+    tracker exit instead of waiting forever.  Waits on process-exit events (pidfds); the
+    120 s bound only stops a hang (the watchdog polls every second; PR_SET_PDEATHSIG is
+    immediate), it does not decide the outcome on a slow machine."""
+    import os
+    import select
+    import signal
+
+    proc = subprocess.Popen([sys.executable, "-c", COORDINATOR], stdout=subprocess.PIPE, text=True)
+    try:
+        line = proc.stdout.readline()
+        pids = [int(x) for x in line.split()]
+        assert len(pids) == 3, line  # two workers, the resource tracker
+        fds = []
+        for pid in pids:
+            try:
+                fds.append(os.pidfd_open(pid))
+            except ProcessLookupError:  # pragma: no cover - already gone
+                pass
+        proc.send_signal(getattr(signal, sig))
+        proc.wait()
+        try:
+            waiting = list(fds)
+            while waiting:
+                ready, _, _ = select.select(waiting, [], [], 120.0)
+                assert ready, f"processes still alive 120 s after the coordinator died: {pids}"
+                waiting = [fd for fd in waiting if fd not in ready]
+        finally:
+            for fd in fds:
+                os.close(fd)
+    finally:
+        if proc.poll() is None:  # pragma: no cover
+            proc.kill()
+            proc.wait()
+
+
+@pytest.mark.parametrize("answer", [None, b"HTTP/1.1 400 Bad Request\r\n\r\n"], ids=["silent", "http"])
+def test_scheduler_that_never_handshakes_exits_2(short_cases, answer):
+    """A TCP peer on the loopback that accepts and stays silent (a hung process) or answers
+    something else (an HTTP server): one line, exit 2, after --connect-timeout.  The 120 s
+    bound of the join only stops a hang (before the fix: > 120 s, or a 3 EiB
+    MemoryError); the verdict is the exit code and the message."""
+    import socket
+
+    with socket.socket() as srv:
+        srv.bind(("127.0.0.1", 0))
+        srv.listen(4)
+        port = srv.getsockname()[1]
+        stop = threading.Event()
+        conns = []
+
+        def serve() -> None:
+            srv.settimeout(0.2)
+            while not stop.is_set():
+                try:
+                    c, _ = srv.accept()
+                except OSError:
+                    continue
+                conns.append(c)
+                if answer is not None:
+                    c.sendall(answer)
+
+        t = threading.Thread(target=serve, daemon=True)
+        t.start()
+        box = {}
+
+        def invoke() -> None:
+            box["r"] = runner.invoke(app, ["batch", str(short_cases[0]), "--scheduler", f"tcp://127.0.0.1:{port}",
+                                           "--connect-timeout", "1"])
+
+        cli = threading.Thread(target=invoke, daemon=True)
+        try:
+            cli.start()
+            cli.join(120.0)  # only stops a hang; the verdict is below
+        finally:
+            stop.set()
+            t.join()
+            for c in conns:
+                c.close()
+    assert not cli.is_alive(), "--scheduler still waiting 120 s after connecting to a silent peer"
+    r = box["r"]
+    assert r.exit_code == 2, r.output
+    lines = r.output.strip().splitlines()
+    assert len(lines) == 1, lines
+    if answer is None:
+        assert "no Dask handshake within 1 s" in lines[0] and f"tcp://127.0.0.1:{port}" in lines[0]
+    else:
+        assert "not a Dask handshake" in lines[0]
+
+
+def test_scheduler_address_schemes_are_checked():
+    for bad in ("tls://127.0.0.1:8786", "ucx://127.0.0.1:8786", "http://x", "inproc://x"):
+        with pytest.raises(CaseError, match=r"is not supported, expected an address like tcp://HOST:PORT"):
+            make_executor(None, bad)
+    with pytest.raises(CaseError, match="bad port"):
+        make_executor(None, "tcp://127.0.0.1:99999")
+    with pytest.raises(CaseError, match="--connect-timeout"):
+        make_executor(None, "tcp://127.0.0.1:8786", connect_timeout=0)
+
+
+def test_unwritable_results_folder_is_refused_before_computing(short_cases, tmp_path, monkeypatch):
+    """A read-only --json-dir is a usage error (exit 2) before any case runs.  As root, mode
+    0o555 does not stop writes, so the probe's file creation is made to fail as on a
+    read-only folder; the run_case spy shows nothing was computed."""
+    import errno
+    import tempfile
+
+    calls = []
+    monkeypatch.setattr(service, "run_case", lambda *a, **k: calls.append(1))
+    real_mkstemp = tempfile.mkstemp
+
+    def read_only(*a, **k):
+        if str(k.get("dir", "")).endswith("ro"):
+            raise PermissionError(errno.EACCES, "Permission denied")
+        return real_mkstemp(*a, **k)
+
+    monkeypatch.setattr(tempfile, "mkstemp", read_only)
+    r = runner.invoke(app, ["batch", str(short_cases[1]), "--jobs", "1", "--json-dir", str(tmp_path / "ro")])
+    assert r.exit_code == 2, r.output
+    assert "results folder is not writable: Permission denied" in r.output and str(tmp_path / "ro") in r.output
+    assert calls == []
+
+
+def test_disk_full_stops_with_exit_2_keeps_saved_results_and_prints_summary(short_cases, tmp_path, monkeypatch):
+    """ENOSPC while saving the second case (the JSON writer patched to raise it): exit 2 with
+    one clear error line, the first case's result kept, the summary printed."""
+    import errno
+
+    from linecheck.io import jsonout
+
+    real = jsonout.write_json
+    written = []
+
+    def full_disk(path, doc, **kw):
+        if written:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        written.append(path)
+        return real(path, doc, **kw)
+
+    monkeypatch.setattr(jsonout, "write_json", full_disk)
+    out = tmp_path / "res"
+    r = runner.invoke(app, ["batch", *map(str, short_cases), "--jobs", "1", "--json-dir", str(out)])
+    assert r.exit_code == 2, r.output
+    assert "batch summary" in r.output and "1 run, 0 skipped, 1 failed" in r.output
+    errors = [ln for ln in r.output.splitlines() if ln.startswith("error:")]
+    assert len(errors) == 1 and "No space left on device" in errors[0] and "--resume" in errors[0]
+    assert "1 result(s) saved" in errors[0]
+    assert [p.name for p in out.glob("*.json")] == [f"{short_cases[0].stem}.json"]
+    assert json.loads((out / f"{short_cases[0].stem}.json").read_text())["realizations"] == 3
+    assert "internal error" not in r.output
+
+
+def test_pool_progress_moves_within_a_chunk_per_realization(short_cases, pool):
+    """Workers report progress to the coordinator while a chunk runs: with one task of all 3
+    realizations, events arrive inside every realization (1.x, 2.x) before the result, and
+    the piped display prints plain progress lines from them."""
+    import io
+
+    from rich.console import Console
+
+    from linecheck.cli.batch_cmd import BatchDisplay
+
+    events: list[BatchEvent] = []
+    rep = run_batch([short_cases[0]], executor=pool, chunk_size=3, progress=events.append)
+    assert rep.exit_code == 0
+    kinds = [e.kind for e in events]
+    before = [e.overall_done for e in events[:kinds.index("case_done")] if e.kind == "case_progress"]
+    assert {int(d) for d in before if d < 3} >= {1, 2}, before  # at least once per realization
+    assert before == sorted(before) and before[-1] == 3
+    assert events[-1].cases_done == events[-1].cases_total == 1
+
+    buf = io.StringIO()
+    display = BatchDisplay(interval=0.0, live=False, console=Console(file=buf, width=200))
+    for ev in events:
+        display(ev)
+    lines = buf.getvalue().splitlines()
+    assert lines[0] == "batch: 1 case(s), 3 realizations on process pool (2 workers)"
+    progress = [ln for ln in lines if ln.startswith("progress: cases 0/1, realizations ")]
+    assert len(progress) >= 2 and all("elapsed 0:" in ln and "ETA " in ln for ln in progress)
+    assert lines[-1].startswith(f"done    {rep.outcomes[0].name}  [cases 1/1, realizations 3/3 (100 %)")
+
+
+def test_summary_flags_cont_r_and_failed_sanity_check(short_cases):
+    """Cont_R above 10 % and a failed time- vs frequency-domain check are marked in the
+    batch summary and explained below it; a clean result gets neither."""
+    import copy
+    import io
+
+    from rich.console import Console
+
+    from linecheck.batch import BatchReport
+    from linecheck.cli.batch_cmd import summary_notes, summary_table
+
+    clean = run_batch([short_cases[1]]).outcomes[0]  # synoptic: has the sanity check
+    assert clean.doc["spectral"]["sanity_check"], "synoptic results carry the sanity check"
+    flagged = copy.deepcopy(clean)
+    flagged.name = "flagged"
+    flagged.doc["reactions"]["Ry"]["Cont_R"]["mean"] = 0.25
+    flagged.doc["reactions"]["Ry"]["dynamic_analysis"] = "recommended"  # interval above 10 % (issue 18)
+    flagged.doc["spectral"]["sanity_check"][0].update(reaction="Rz", quantity="rms_fluctuating", time_domain=176.0,
+                                                      frequency_domain=212.0, allowed_difference=20.0, ok=False)
+    for item in clean.doc["spectral"]["sanity_check"]:
+        item["ok"] = True
+    clean.doc["reactions"]["Ry"]["Cont_R"]["mean"] = 0.05
+    for r in ("Rx", "Ry", "Rz"):
+        clean.doc["reactions"][r]["dynamic_analysis"] = None
+    report = BatchReport([clean, flagged])
+
+    def render(obj) -> str:
+        buf = io.StringIO()
+        Console(file=buf, width=250).print(obj)
+        return buf.getvalue()
+
+    table = render(summary_table(report)).splitlines()
+    row = next(ln for ln in table if "flagged" in ln)
+    assert "25.0" in row and "Cont_R>10% Ry" in row and "t/f check" in row
+    clean_row = next(ln for ln in table if clean.name in ln)
+    assert "5.0" in clean_row and "Cont_R>10%" not in clean_row and "t/f" not in clean_row
+    notes = summary_notes(report)
+    assert len(notes) == 2
+    assert "dynamic analysis recommended" in notes[0]
+    assert "flagged: Rz fluctuating r.m.s. 0.176 vs 0.212 kN (allowed difference 0.020)" in notes[1]
+    assert summary_notes(BatchReport([clean])) == []

@@ -18,6 +18,7 @@ CORE_MODULES = [
     "linecheck.core.modes",
     "linecheck.core.budget",
     "linecheck.core.spectral",
+    "linecheck.core.codes",
     "linecheck.core.wind.mean",
     "linecheck.core.wind.turbulence",
     "linecheck.core.wind.point",

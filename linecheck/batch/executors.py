@@ -9,7 +9,10 @@ All three share one small interface used by the batch and scan runners:
   when the task raised (a bug, a killed worker, a broken pool);
 - ``running(handle)`` -> best-effort "has started" flag (progress display only);
 - ``abort(handles)`` -> cancel what has not run and stop what is running;
-- ``close()``.
+- ``close()``;
+- process pool only (``reporting``): ``reports()`` -> start/progress messages sent by the
+  tasks from inside the workers; ``broken()``/``restart()`` -> a worker died, start a new
+  pool and learn which workers died on their own.
 
 The sequential executor runs one task per ``wait`` call in the calling process and
 passes it the batch's ``cancel`` event and a progress callback (``in_process``).
@@ -24,6 +27,8 @@ from __future__ import annotations
 import contextlib
 import multiprocessing
 import os
+import signal
+import threading
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor
@@ -31,7 +36,7 @@ from concurrent.futures import wait as futures_wait
 from typing import Any
 
 from ..core.errors import Cancelled, CaseError
-from .tasks import Failure, ignore_sigint, noop
+from .tasks import Failure, init_pool_worker, noop
 
 
 def default_jobs() -> int:
@@ -65,6 +70,22 @@ class Executor(ABC):
 
     def running(self, handle: Any) -> bool:
         return False
+
+    #: tasks accept ``report_key=`` and report start/progress through :meth:`reports`
+    reporting: bool = False
+
+    def reports(self) -> list[tuple]:
+        """Start/progress messages of the tasks received since the last call (see :attr:`reporting`)."""
+        return []
+
+    def broken(self) -> bool:
+        """True when the executor lost a worker and must be :meth:`restart`-ed to run more tasks."""
+        return False
+
+    def restart(self) -> dict[int, int]:
+        """Replace a broken executor's workers; returns ``{pid: exit code}`` of the workers that
+        died on their own (not stopped by the executor).  Only where :meth:`broken` can be true."""
+        raise NotImplementedError
 
     @abstractmethod
     def cancel(self, handles: Sequence[Any]) -> None:
@@ -167,16 +188,31 @@ class ProcessPool(Executor):
     Workers are started at once with the ``spawn`` method -- they never inherit the
     coordinator's threads (progress display, Dask) -- and with one BLAS thread each
     (:data:`WORKER_ENV`, unless set by the user).  Ctrl-C is left to the coordinator.
+    Workers exit when the coordinator dies (:func:`~.tasks.init_pool_worker`).
+
+    Tasks report their start (with the worker's pid) and progress on a queue
+    (:meth:`reports`).  When a worker dies (an out-of-memory kill, a crash) the pool is
+    *broken*: every unfinished task fails with ``BrokenProcessPool`` and the other workers
+    are stopped; :meth:`restart` starts a new pool and says which workers died on their
+    own, so the runner can fail only the tasks those held and re-run the others.
     """
 
     name = "process pool"
+    reporting = True
 
     def __init__(self, jobs: int | None = None) -> None:
         if jobs is not None and jobs < 1:
             raise CaseError(f"--jobs: value {jobs} is not allowed: expected an integer >= 1")
         self._jobs = jobs or default_jobs()
-        self._pool = ProcessPoolExecutor(max_workers=self._jobs, mp_context=multiprocessing.get_context("spawn"),
-                                         initializer=ignore_sigint)
+        self._start()
+
+    def _start(self) -> None:
+        ctx = multiprocessing.get_context("spawn")
+        self._queue = ctx.SimpleQueue()
+        # PR_SET_PDEATHSIG follows the thread that starts a worker: only from the main thread
+        pdeathsig = threading.current_thread() is threading.main_thread()
+        self._pool = ProcessPoolExecutor(max_workers=self._jobs, mp_context=ctx, initializer=init_pool_worker,
+                                         initargs=(self._queue, os.getpid(), pdeathsig))
         with _worker_environment():  # each submit starts one worker while none is idle
             for _ in range(self._jobs):
                 self._pool.submit(noop)
@@ -192,6 +228,14 @@ class ProcessPool(Executor):
         futures_wait(handles, timeout=timeout, return_when=FIRST_COMPLETED)
         return [i for i, f in enumerate(handles) if f.done()]
 
+    def reports(self) -> list[tuple]:
+        out = []
+        q = self._queue
+        with contextlib.suppress(OSError, EOFError, ValueError):
+            while not q.empty():
+                out.append(q.get())
+        return out
+
     def outcome(self, handle: Future) -> Any:
         if handle.cancelled():
             return Failure("Cancelled", "cancelled", 130)
@@ -202,6 +246,21 @@ class ProcessPool(Executor):
 
     def running(self, handle: Future) -> bool:
         return handle.running() or handle.done()
+
+    def broken(self) -> bool:
+        return bool(getattr(self._pool, "_broken", False))
+
+    def restart(self) -> dict[int, int]:
+        processes = dict(getattr(self._pool, "_processes", None) or {})
+        self._pool.shutdown(wait=True, cancel_futures=True)  # the broken pool stops and joins its workers
+        for p in processes.values():
+            p.join()
+        dead = {pid: p.exitcode for pid, p in processes.items()
+                if p.exitcode not in (0, None, -signal.SIGTERM)}  # SIGTERM: stopped by the pool itself
+        with contextlib.suppress(OSError):
+            self._queue.close()
+        self._start()
+        return dead
 
     def cancel(self, handles: Sequence[Future]) -> None:
         for f in handles:
@@ -219,6 +278,22 @@ class ProcessPool(Executor):
 
     def close(self) -> None:
         self._pool.shutdown(wait=True, cancel_futures=True)
+        with contextlib.suppress(OSError):
+            self._queue.close()
+
+
+def describe_exit(code: int | None) -> str:
+    """How a worker process ended, for messages: ``killed by signal 9, SIGKILL: out of memory?``."""
+    if code is None:
+        return "ended"
+    if code < 0:
+        try:
+            name = signal.Signals(-code).name
+        except ValueError:
+            name = "unknown signal"
+        hint = ": out of memory?" if -code == getattr(signal, "SIGKILL", 9) else ""
+        return f"killed by signal {-code}, {name}{hint}"
+    return f"exited with code {code}"
 
 
 # --------------------------------------------------------------------------- Dask
@@ -226,12 +301,130 @@ DASK_MISSING = ("--scheduler needs Dask distributed, which is not installed: "
                 "pip install 'linecheck[dask]' (or: pip install 'dask[distributed]')")
 
 
-def check_scheduler_address(address: str) -> str:
-    """Validate a scheduler address (``tcp://HOST:PORT``, ``tls://...``, ``inproc://...``)."""
+DEFAULT_CONNECT_TIMEOUT = 10.0  # [s] --connect-timeout: TCP connection, then the scheduler's handshake
+MAX_HANDSHAKE_BYTES = 1 << 20  # a Dask handshake is a few hundred bytes; more is not a Dask scheduler
+
+
+def check_scheduler_address(address: str) -> tuple[str, int]:
+    """Validate a scheduler address ``tcp://HOST:PORT`` (port default 8786); returns (host, port).
+
+    Only ``tcp://`` is accepted: ``tls://`` needs certificates this command cannot take,
+    ``ucx://``/``inproc://`` are not reachable from a separate process.
+    """
+    from urllib.parse import urlsplit
+
+    expected = "expected an address like tcp://HOST:PORT"
     scheme, sep, rest = address.partition("://")
     if not sep or not scheme or not rest:
-        raise CaseError(f"--scheduler: value {address!r} is not allowed: expected an address like tcp://HOST:PORT")
-    return address
+        raise CaseError(f"--scheduler: value {address!r} is not allowed: {expected}")
+    if scheme.lower() != "tcp":
+        raise CaseError(f"--scheduler: value {address!r} is not allowed: scheme {scheme}:// is not supported, "
+                        f"{expected}")
+    try:
+        parts = urlsplit(address)
+        host, port = parts.hostname, parts.port
+    except ValueError:
+        raise CaseError(f"--scheduler: value {address!r} is not allowed: bad port, {expected}") from None
+    if not host or parts.path not in ("", "/") or parts.query or parts.fragment or parts.username:
+        raise CaseError(f"--scheduler: value {address!r} is not allowed: {expected}")
+    return host, port if port is not None else 8786
+
+
+def check_connect_timeout(timeout: float) -> float:
+    if not (timeout > 0 and timeout <= 3600):
+        raise CaseError(f"--connect-timeout: value {timeout!r} is not allowed: expected seconds in (0, 3600]")
+    return float(timeout)
+
+
+def probe_scheduler(address: str, timeout: float = DEFAULT_CONNECT_TIMEOUT) -> None:
+    """Connect to a Dask scheduler and read its handshake, all within ``timeout`` [s].
+
+    A Dask scheduler speaks first: on a new connection it sends its handshake, a message
+    framed by an 8-byte little-endian length (distributed ``comm/tcp.py``).  A peer that
+    accepts and stays silent (a hung process, an HTTP server) or answers something else
+    would make ``distributed.Client`` wait without bound or try to allocate a huge buffer,
+    so it is refused here with a one-line CaseError (exit 2).
+    """
+    import socket
+    import struct
+    import time
+
+    host, port = check_scheduler_address(address)
+    where = f"--scheduler: {address}"
+    deadline = time.monotonic() + timeout
+    try:
+        sock = socket.create_connection((host, port), timeout=timeout)
+    except socket.timeout:
+        raise CaseError(f"{where}: no connection within {timeout:g} s (--connect-timeout)") from None
+    except socket.gaierror as exc:
+        raise CaseError(f"{where}: unknown host {host!r} ({exc.strerror})") from None
+    except OSError as exc:
+        raise CaseError(f"{where}: cannot connect: {exc.strerror or exc}") from None
+
+    def read(n: int) -> bytes:
+        buf = b""
+        while len(buf) < n:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                raise socket.timeout
+            sock.settimeout(left)
+            got = sock.recv(n - len(buf))
+            if not got:
+                raise ConnectionResetError("connection closed by the peer")
+            buf += got
+        return buf
+
+    try:
+        with sock:
+            (n,) = struct.unpack("<Q", read(8))
+            if not 0 < n <= MAX_HANDSHAKE_BYTES:
+                raise CaseError(f"{where}: the peer's answer is not a Dask handshake: is a Dask scheduler "
+                                "listening there?")
+            read(n)
+    except socket.timeout:
+        raise CaseError(f"{where}: connected, but no Dask handshake within {timeout:g} s (--connect-timeout): "
+                        "is a Dask scheduler listening there?") from None
+    except OSError as exc:
+        raise CaseError(f"{where}: connection lost during the Dask handshake: {exc.strerror or exc}") from None
+
+
+@contextlib.contextmanager
+def _quiet_unraisable() -> Iterator[None]:
+    """Swallow destructor noise (``Client.__del__`` of a client that failed to start)."""
+    import gc
+    import sys
+
+    old = sys.unraisablehook
+    sys.unraisablehook = lambda *_: None
+    try:
+        yield
+    finally:
+        gc.collect()
+        sys.unraisablehook = old
+
+
+def _open_client(distributed: Any, address: str, timeout: float) -> Any:
+    """``distributed.Client(address)`` with a bound on the whole start-up (``2 * timeout`` + 5 s)."""
+    box: dict[str, Any] = {}
+
+    def start() -> None:
+        try:
+            box["client"] = distributed.Client(address, timeout=timeout, set_as_default=False)
+        except BaseException as exc:  # noqa: BLE001 - reported below as one line
+            box["error"] = exc
+
+    with _quiet_unraisable():
+        t = threading.Thread(target=start, name="linecheck-dask-connect", daemon=True)
+        t.start()
+        t.join(2 * timeout + 5.0)
+        if t.is_alive():
+            raise CaseError(f"--scheduler: {address}: the Dask client did not start within "
+                            f"{2 * timeout + 5.0:g} s (--connect-timeout {timeout:g})")
+        if "error" in box:
+            exc = box["error"]
+            msg = " ".join(str(exc).split()) or type(exc).__name__
+            raise CaseError(f"--scheduler: cannot connect to the Dask scheduler at {address}: {msg}") from None
+    return box["client"]
 
 
 class DaskExecutor(Executor):
@@ -244,9 +437,11 @@ class DaskExecutor(Executor):
 
     name = "dask"
 
-    def __init__(self, address: str | None = None, *, client: Any = None, timeout: float = 10.0) -> None:
+    def __init__(self, address: str | None = None, *, client: Any = None,
+                 timeout: float = DEFAULT_CONNECT_TIMEOUT) -> None:
         if client is None and address is not None:
             check_scheduler_address(address)  # a usage error first, whether or not Dask is installed
+            check_connect_timeout(timeout)
         try:
             import distributed
         except ImportError:
@@ -256,11 +451,8 @@ class DaskExecutor(Executor):
         if client is None:
             if address is None:
                 raise CaseError("--scheduler: no address given")
-            check_scheduler_address(address)
-            try:
-                client = distributed.Client(address, timeout=timeout, set_as_default=False)
-            except (OSError, TimeoutError, ValueError) as exc:
-                raise CaseError(f"--scheduler: cannot connect to the Dask scheduler at {address}: {exc}") from None
+            probe_scheduler(address, timeout)  # bounded: a silent or foreign peer is refused here
+            client = _open_client(distributed, address, timeout)
         self.client = client
         self.address = address or getattr(client.scheduler, "address", "")
 
@@ -311,12 +503,13 @@ class DaskExecutor(Executor):
             self.client.close()
 
 
-def make_executor(jobs: int | None = None, scheduler: str | None = None) -> Executor:
-    """The executor for ``--jobs`` / ``--scheduler`` (CaseError for bad values)."""
+def make_executor(jobs: int | None = None, scheduler: str | None = None,
+                  connect_timeout: float = DEFAULT_CONNECT_TIMEOUT) -> Executor:
+    """The executor for ``--jobs`` / ``--scheduler`` / ``--connect-timeout`` (CaseError for bad values)."""
     if scheduler is not None:
         if jobs is not None:
             raise CaseError("--jobs and --scheduler cannot be combined: the cluster's workers set the parallelism")
-        return DaskExecutor(scheduler)
+        return DaskExecutor(scheduler, timeout=connect_timeout)
     if jobs is not None and jobs < 1:
         raise CaseError(f"--jobs: value {jobs} is not allowed: expected an integer >= 1")
     n = jobs or default_jobs()

@@ -18,7 +18,13 @@ Contract:
   cases.  With ``resume`` a case whose saved JSON carries the same file hash is
   skipped and its saved document reused.
 - One failing case (bad file, non-convergence, any LinecheckError, a crashed worker)
-  is reported in its :class:`CaseOutcome`; the other cases complete.
+  is reported in its :class:`CaseOutcome`; the other cases complete.  When a process-pool
+  worker dies (out-of-memory kill), the pool is restarted (:meth:`Executor.restart`): the
+  tasks the dead worker held fail their case ("worker died (killed by signal 9, ...) while
+  running NAME"), every other unfinished task runs again -- same results, bit for bit.
+- The results folder is checked writable before anything runs (CaseError, exit 2).  A
+  result that cannot be written later (disk full) fails its case and stops the batch
+  (``report.output_error``, exit code 2); the results saved so far stay.
 - Progress goes to ``progress(event)`` (:class:`BatchEvent`, overall and per case);
   setting ``cancel`` (a :class:`threading.Event`) or Ctrl-C stops the batch after
   saving what is finished.
@@ -38,11 +44,16 @@ from typing import Any
 
 from ..core.case import Case, case_hash, load_case
 from ..core.errors import Cancelled, CaseError, LinecheckError
-from .executors import Executor, SequentialExecutor
+from .executors import Executor, SequentialExecutor, describe_exit
 from .merge import merge_runs
-from .tasks import Failure, apply_changes, run_chunk, run_until_case
+from .tasks import Failure, apply_changes, run_chunk
 
 POLL_S = 0.2  # how often the coordinator checks the cancel event while tasks run
+MAX_IDLE_RESTARTS = 3  # pool restarts without any task finishing before the remaining cases fail
+
+
+class _OutputError(Exception):
+    """A result could not be written (disk full, ...): the batch stops, saved results stay."""
 
 
 # --------------------------------------------------------------------------- public data
@@ -53,8 +64,10 @@ class BatchEvent:
     kind: ``"start"`` (batch planned), ``"case_start"``, ``"case_progress"``,
     ``"case_done"``, ``"case_skipped"`` (resume), ``"case_failed"``, ``"finish"``.
     ``case`` is the case index (-1 for batch-level events); ``done``/``total`` count
-    that case's realizations (``done`` may be fractional while a chunk runs in
-    process), ``overall_done``/``overall_total`` all realizations of the batch.
+    that case's realizations (``done`` is fractional while chunks run: tasks report
+    their progress at least once per realization), ``overall_done``/``overall_total``
+    all realizations of the batch (skipped and failed cases count as done),
+    ``cases_done``/``cases_total`` the cases finished (done, skipped or failed) and all.
     """
 
     kind: str
@@ -65,6 +78,8 @@ class BatchEvent:
     overall_done: float
     overall_total: int
     message: str = ""
+    cases_done: int = 0
+    cases_total: int = 0
 
 
 BatchProgress = Callable[[BatchEvent], None]
@@ -112,6 +127,7 @@ class BatchReport:
     elapsed: float = 0.0
     cancelled: bool = False
     interrupted: bool = False  # Ctrl-C (KeyboardInterrupt) rather than the cancel event
+    output_error: str | None = None  # a result could not be written (disk full): the batch stopped
 
     @property
     def failed(self) -> list[CaseOutcome]:
@@ -119,7 +135,9 @@ class BatchReport:
 
     @property
     def exit_code(self) -> int:
-        """0 all cases done, 1 any case failed, 130 cancelled."""
+        """0 all cases done, 1 any case failed, 2 a result could not be written, 130 cancelled."""
+        if self.output_error:
+            return 2
         if self.cancelled:
             return 130
         return 1 if self.failed else 0
@@ -186,6 +204,21 @@ def saved_result(json_path: Path, digest: str, changes: Mapping[str, Any] | None
     return doc
 
 
+def check_writable(folder: Path) -> None:
+    """CaseError (exit 2) unless a file can be created in ``folder`` -- checked before any
+    computing by writing and removing a probe file (``os.access`` is wrong for root and for
+    read-only mounts)."""
+    import os
+    import tempfile
+
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".linecheck-probe.", suffix=".tmp", dir=folder)
+    except OSError as exc:
+        raise CaseError(f"results folder is not writable: {exc.strerror or exc}", file=str(folder)) from None
+    os.close(fd)
+    Path(probe).unlink(missing_ok=True)
+
+
 def result_document(result: Any, path: Path, digest: str | None, changes: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The per-case JSON document: ``run_to_dict`` plus ``case_file``, ``case_hash`` (and ``changes``)."""
     from ..io.jsonout import run_to_dict
@@ -207,7 +240,7 @@ class _CaseState:
     case: Case | None = None
     chunks: list[list[int]] = field(default_factory=list)
     parts: list[Any] = field(default_factory=list)
-    handles: list[Any] = field(default_factory=list)
+    tasks: list[int] = field(default_factory=list)  # indices of its chunks' tasks
     done: float = 0.0
     started: bool = False
     t0: float = 0.0
@@ -260,6 +293,7 @@ def run_batch(
             out_dir.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise CaseError(f"cannot create results folder: {exc.strerror}", file=str(out_dir)) from None
+        check_writable(out_dir)
 
     # ---- plan: one state per distinct job
     jobs: list[RunJob] = []
@@ -304,11 +338,13 @@ def run_batch(
     def emit(kind: str, st: _CaseState | None, message: str = "") -> None:
         if progress is None:
             return
+        n_done = sum(s.outcome.status in ("done", "skipped", "failed") for s in states)
         if st is None:
-            progress(BatchEvent(kind, -1, "", overall_done, overall_total, overall_done, overall_total, message))
+            progress(BatchEvent(kind, -1, "", overall_done, overall_total, overall_done, overall_total, message,
+                                n_done, len(states)))
         else:
             progress(BatchEvent(kind, st.index, st.outcome.name, st.done, st.outcome.realizations,
-                                overall_done, overall_total, message))
+                                overall_done, overall_total, message, n_done, len(states)))
 
     # ---- resume
     for st in states:
@@ -336,53 +372,69 @@ def run_batch(
         size = max(1, int(chunk_size))
 
     handles: list[Any] = []
-    owner: list[tuple[_CaseState, int]] = []  # per handle: its case and chunk number
+    owner: list[tuple[_CaseState, int]] = []  # per task: its case and chunk number
+    partial: dict[int, float] = {}  # per running task: realizations done so far (fractional)
+    holder: dict[int, int] = {}  # per started task of a process pool: the worker's pid
+    suspected: dict[int, int] = {}  # per task: times it was running when a worker died unidentified
 
-    def in_process_progress(st: _CaseState, before: int, n: int) -> Callable[[str, int, int], None]:
+    def update_done(st: _CaseState) -> None:
+        nonlocal overall_done
+        new = (sum(len(c) for c, p in zip(st.chunks, st.parts) if p is not None)
+               + sum(partial.get(i, 0.0) for i, p in zip(st.tasks, st.parts) if p is None))
+        overall_done += new - st.done
+        st.done = new
+
+    def in_process_progress(idx: int, n: int) -> Callable[[str, int, int], None]:
         def cb(stage: str, d: int, total: int) -> None:
-            nonlocal overall_done
             if not stage.startswith("steps 2-3") or total <= 0:
                 return
-            new = before + n * d / total
-            overall_done += new - st.done
-            st.done = new
+            st = owner[idx][0]
+            partial[idx] = n * d / total
+            update_done(st)
             emit("case_progress", st)
         return cb
 
+    def submit(idx: int) -> Any:
+        st, k = owner[idx]
+        chunk = st.chunks[k]
+        kwargs: dict[str, Any] = {}
+        if executor.in_process:
+            kwargs = {"cancel": cancel, "progress": in_process_progress(idx, len(chunk))}
+        elif executor.reporting:
+            kwargs = {"report_key": idx}
+        partial.pop(idx, None)
+        holder.pop(idx, None)
+        if until is not None:  # adaptive count (issue 18): the task runs the whole case
+            kwargs["until"] = (float(until[0]), int(until[1]))
+        return executor.submit(run_chunk, str(st.job.path), chunk, st.outcome.hash,
+                               dict(st.job.changes) if st.job.changes else None, **kwargs)
+
     for st in todo:
-        if until is not None:  # adaptive count: one task per case (issue 18)
-            st.chunks, st.parts = [list(range(st.outcome.realizations))], [None]
-            kwargs = {"cancel": cancel, "progress": in_process_progress(st, 0, st.outcome.realizations)} \
-                if executor.in_process else {}
-            h = executor.submit(run_until_case, str(st.job.path), float(until[0]), int(until[1]), st.outcome.hash,
-                                dict(st.job.changes) if st.job.changes else None, **kwargs)
-            st.handles.append(h)
-            handles.append(h)
-            owner.append((st, 0))
-            continue
-        st.chunks = chunk_ranges(st.outcome.realizations, size)
+        # --until (issue 18): one task per case, its chunks run in sequence inside it
+        st.chunks = [list(range(st.outcome.realizations))] if until is not None else \
+            chunk_ranges(st.outcome.realizations, size)
         st.parts = [None] * len(st.chunks)
-        before = 0
-        for k, chunk in enumerate(st.chunks):
-            kwargs: dict[str, Any] = {}
-            if executor.in_process:
-                kwargs = {"cancel": cancel, "progress": in_process_progress(st, before, len(chunk))}
-            h = executor.submit(run_chunk, str(st.job.path), chunk, st.outcome.hash,
-                                dict(st.job.changes) if st.job.changes else None, **kwargs)
-            st.handles.append(h)
-            handles.append(h)
+        for k in range(len(st.chunks)):
+            idx = len(owner)
             owner.append((st, k))
-            before += len(chunk)
+            st.tasks.append(idx)
+            handles.append(submit(idx))
 
     report = BatchReport([s.outcome for s in states], executor=executor.describe())
+
+    def start_case(st: _CaseState) -> None:
+        if not st.started:
+            st.started, st.t0 = True, time.perf_counter()
+            emit("case_start", st)
 
     def fail_case(st: _CaseState, failure: Failure) -> None:
         nonlocal overall_done
         o = st.outcome
         o.status, o.error, o.error_kind = "failed", failure.message, failure.kind
         o.elapsed = time.perf_counter() - st.t0 if st.t0 else 0.0
-        executor.cancel([h for h, p in zip(st.handles, st.parts) if p is None])
+        executor.cancel([handles[i] for i, p in zip(st.tasks, st.parts) if p is None])
         overall_done += st.outcome.realizations - st.done
+        st.done = st.outcome.realizations
         st.parts = []
         emit("case_failed", st, failure.message)
 
@@ -398,11 +450,67 @@ def run_batch(
         except LinecheckError as err:
             fail_case(st, Failure.of(err))
             return
+        except OSError as exc:  # disk full, folder gone read-only...: stop, keep what is saved
+            msg = f"cannot save the result {o.json_path}: {exc.strerror or exc}"
+            fail_case(st, Failure("OSError", msg, 2))
+            raise _OutputError(msg) from None
         o.status, o.doc = "done", doc
         o.result = merged if keep_results else None
         o.elapsed = time.perf_counter() - st.t0
         st.parts = []
         emit("case_done", st, str(o.json_path) if o.json_path else "")
+
+    def take_reports() -> None:
+        for msg in executor.reports():
+            kind, idx = msg[0], msg[1]
+            if not isinstance(idx, int) or not 0 <= idx < len(owner):
+                continue
+            st = owner[idx][0]
+            if st.outcome.status != "pending":
+                continue
+            if kind == "start":
+                holder[idx] = int(msg[2])
+                start_case(st)
+            elif kind == "progress":
+                partial[idx] = float(msg[2])
+                update_done(st)
+                emit("case_progress", st)
+
+    restarts_idle = 0  # pool restarts since a task last finished
+
+    def recover(pending: list[int]) -> None:
+        """A worker died: fail the tasks it held, re-run the others on a new pool."""
+        nonlocal restarts_idle
+        take_reports()  # every "start" message sent before the death
+        running = {i: holder[i] for i in pending if i in holder}
+        dead = executor.restart()
+        restarts_idle += 1
+        for idx in pending:
+            st = owner[idx][0]
+            if st.outcome.status != "pending":
+                continue
+            h = handles[idx]
+            if h.done() and not isinstance(executor.outcome(h), Failure):
+                continue  # finished before the pool broke: collected below
+            pid = running.get(idx)
+            why = None
+            if pid is not None and pid in dead:
+                why = describe_exit(dead[pid])
+            elif pid is not None and not dead:  # the dead worker is unknown: every running task is suspect
+                suspected[idx] = suspected.get(idx, 0) + 1
+                if suspected[idx] > 1:
+                    why = "ended abruptly, twice"
+            elif restarts_idle > MAX_IDLE_RESTARTS:
+                why = f"ended abruptly {restarts_idle} times in a row"
+            if why is not None:
+                fail_case(st, Failure("WorkerDied", f"worker died ({why}) while running {st.outcome.name}", 1))
+        for idx in pending:
+            st = owner[idx][0]
+            h = handles[idx]
+            if st.outcome.status == "pending" and not (h.done() and not isinstance(executor.outcome(h), Failure)):
+                partial[idx] = 0.0
+                handles[idx] = submit(idx)
+                update_done(st)
 
     # ---- collect
     pending = list(range(len(handles)))
@@ -410,42 +518,45 @@ def run_batch(
         while pending:
             if cancel.is_set():
                 raise Cancelled("batch cancelled")
-            for idx in pending:  # best-effort start notices
-                st, _ = owner[idx]
-                if not st.started and executor.running(handles[idx]):
-                    st.started, st.t0 = True, time.perf_counter()
-                    emit("case_start", st)
+            take_reports()
+            if not executor.reporting:
+                for idx in pending:  # best-effort start notices
+                    if executor.running(handles[idx]):
+                        start_case(owner[idx][0])
             if executor.in_process:  # the next task runs now: announce its case first
-                st, _ = owner[pending[0]]
-                if not st.started:
-                    st.started, st.t0 = True, time.perf_counter()
-                    emit("case_start", st)
+                start_case(owner[pending[0]][0])
             done_local = executor.wait([handles[i] for i in pending], timeout=POLL_S)
+            if executor.broken():
+                recover(pending)
+                pending = [i for i in pending if owner[i][0].outcome.status == "pending"]
+                continue
+            take_reports()
             finished = [pending[i] for i in done_local]
             for idx in finished:
                 st, k = owner[idx]
                 value = executor.outcome(handles[idx])
                 if st.outcome.status != "pending":
                     continue  # its case already failed
-                if not st.started:
-                    st.started, st.t0 = True, time.perf_counter()
-                    emit("case_start", st)
+                start_case(st)
                 if isinstance(value, Failure):
                     fail_case(st, value)
                     continue
+                restarts_idle = 0
                 st.parts[k] = value
-                new = sum(len(c) for c, p in zip(st.chunks, st.parts) if p is not None)
-                overall_done += new - st.done
-                st.done = new
+                partial.pop(idx, None)
+                update_done(st)
                 emit("case_progress", st)
                 if all(p is not None for p in st.parts):
                     finish_case(st)
             fs = set(finished)
             # drop finished tasks and every task of a case that has failed meanwhile
             pending = [i for i in pending if i not in fs and owner[i][0].outcome.status == "pending"]
-    except (Cancelled, KeyboardInterrupt) as exc:
-        report.cancelled = True
-        report.interrupted = isinstance(exc, KeyboardInterrupt)
+    except (Cancelled, KeyboardInterrupt, _OutputError) as exc:
+        if isinstance(exc, _OutputError):
+            report.output_error = str(exc)
+        else:
+            report.cancelled = True
+            report.interrupted = isinstance(exc, KeyboardInterrupt)
         cancel.set()
         executor.abort([handles[i] for i in pending])
         for st in states:

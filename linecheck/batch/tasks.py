@@ -14,8 +14,10 @@ crosses process boundaries intact.  Nothing here prints or imports a UI library.
 
 from __future__ import annotations
 
+import os
 import signal
 import threading
+import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -89,42 +91,35 @@ def run_chunk(
     *,
     progress: Callable[[str, int, int], None] | None = None,
     cancel: threading.Event | None = None,
+    report_key: Any = None,
+    until: tuple[float, int] | None = None,
 ) -> Any:
     """Steps 1-3 of one case for a subset of its realizations.
+
+    ``until=(target, max_realizations)`` (``batch --until``, issue 18): the whole case with an
+    adaptive count instead (:func:`linecheck.service.run_until`; ``realizations`` is then the
+    initial count's range, used for progress only).
 
     Returns the :class:`~linecheck.service.RunResult` of those realizations, or a
     :class:`Failure`.  ``progress``/``cancel`` are only passed when the task runs
     in the coordinating process; :class:`Cancelled` is raised, not returned.
+    ``report_key``: in a process-pool worker, report start and progress under this key
+    (:func:`init_pool_worker`).
     """
     from ..service import run_case
 
+    if report_key is not None and _REPORTS is not None:
+        _report("start", report_key, os.getpid())
+        if os.environ.get(KILL_HOOK_ENV) == Path(case_path).stem:  # test hook (see KILL_HOOK_ENV)
+            os.kill(os.getpid(), getattr(signal, "SIGKILL", signal.SIGTERM))
+        progress = _worker_progress(report_key, len(realizations))
     try:
         case = load_checked(case_path, expected_hash, changes)
+        if until is not None:
+            from ..service import run_until
+
+            return run_until(case, float(until[0]), max_realizations=int(until[1]), progress=progress, cancel=cancel)
         return run_case(case, realizations=list(realizations), progress=progress, cancel=cancel)
-    except Cancelled:
-        raise
-    except LinecheckError as err:
-        return Failure.of(err)
-
-
-def run_until_case(
-    case_path: str,
-    target: float,
-    max_realizations: int,
-    expected_hash: str | None = None,
-    changes: Mapping[str, Any] | None = None,
-    *,
-    progress: Callable[[str, int, int], None] | None = None,
-    cancel: threading.Event | None = None,
-) -> Any:
-    """``batch --until``: one case with an adaptive realization count (:func:`service.run_until`),
-    as one task (its chunks run in sequence: each decides the next).  Returns the RunResult or a
-    :class:`Failure`."""
-    from ..service import run_until
-
-    try:
-        case = load_checked(case_path, expected_hash, changes)
-        return run_until(case, target, max_realizations=max_realizations, progress=progress, cancel=cancel)
     except Cancelled:
         raise
     except LinecheckError as err:
@@ -237,6 +232,87 @@ def scan_chunk(
 def ignore_sigint() -> None:
     """Process-pool initializer: Ctrl-C is handled by the coordinator, not by each worker."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+# --------------------------------------------------------------------------- pool workers
+#: the coordinator's report queue in a pool worker (set by :func:`init_pool_worker`)
+_REPORTS: Any = None
+#: seconds between two progress reports of one task (at least one per realization is sent)
+REPORT_INTERVAL_S = 0.25
+#: seconds between two checks of the parent process by the worker's watchdog thread
+WATCHDOG_S = 1.0
+#: test hook: a pool worker that starts a chunk of the case file with this stem kills itself
+#: with SIGKILL, as the kernel's out-of-memory killer would (tests of the dead-worker recovery)
+KILL_HOOK_ENV = "LINECHECK_TEST_KILL_WORKER_ON"
+PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
+
+
+def _exit_with_parent(parent_pid: int, pdeathsig: bool) -> None:
+    """Make this worker exit when the coordinator dies (SIGKILL, SIGTERM, crash).
+
+    Linux: ``prctl(PR_SET_PDEATHSIG, SIGKILL)`` -- the kernel kills the worker when its
+    parent goes (only set when the pool was created in the coordinator's main thread: the
+    signal follows the thread that started the worker).  Everywhere: a daemon thread
+    polls ``os.getppid()`` every :data:`WATCHDOG_S` and exits once the worker has been
+    re-parented.  Without this, idle workers wait forever on the task queue (they hold
+    its write end themselves), and with them the resource tracker.
+    """
+    if pdeathsig and os.name == "posix" and os.uname().sysname == "Linux":
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+        except (OSError, AttributeError):  # pragma: no cover - no prctl: the watchdog remains
+            pass
+    if os.getppid() != parent_pid:  # the parent died before we got here
+        os._exit(1)
+
+    def watch() -> None:
+        while True:
+            time.sleep(WATCHDOG_S)
+            if os.getppid() != parent_pid:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="linecheck-parent-watchdog", daemon=True).start()
+
+
+def init_pool_worker(reports: Any = None, parent_pid: int | None = None, pdeathsig: bool = False) -> None:
+    """Process-pool initializer: ignore Ctrl-C, exit with the parent, keep the report queue.
+
+    ``reports``: a ``multiprocessing.SimpleQueue`` read by the coordinator; tasks
+    submitted with a ``report_key`` put ``("start", key, pid)`` on it before they run
+    (synchronously: the coordinator knows which worker holds which task even when the
+    worker is killed right after) and ``("progress", key, done, total)`` while they run.
+    """
+    global _REPORTS
+    ignore_sigint()
+    _REPORTS = reports
+    if parent_pid is not None:
+        _exit_with_parent(parent_pid, pdeathsig)
+
+
+def _report(*msg: Any) -> None:
+    if _REPORTS is not None:
+        _REPORTS.put(msg)
+
+
+def _worker_progress(key: Any, n: int) -> Callable[[str, int, int], None]:
+    """A ``progress(stage, done, total)`` callback sending the task's realizations done
+    (fraction of ``n``) at most every :data:`REPORT_INTERVAL_S`, and whenever one more
+    whole realization is done."""
+    last = [time.monotonic(), 0]
+
+    def cb(stage: str, d: int, total: int) -> None:
+        if not stage.startswith("steps 2-3") or total <= 0:
+            return
+        done = n * d / total
+        now = time.monotonic()
+        if int(done) > last[1] or now - last[0] >= REPORT_INTERVAL_S:
+            last[0], last[1] = now, int(done)
+            _report("progress", key, done)
+
+    return cb
 
 
 def noop() -> None:

@@ -15,12 +15,65 @@ from typing import Annotated, Any, TypeVar
 
 import typer
 from rich.markup import escape
+from typer.core import TyperGroup, TyperOption
+
+try:  # the click that Typer runs on: vendored in recent Typer releases, the click package before
+    from typer._click.exceptions import NoArgsIsHelpError, UsageError
+except ImportError:  # pragma: no cover - older Typer
+    from click.exceptions import NoArgsIsHelpError, UsageError
 from rich.console import Console
 
 from ..core.case import Case, load_case
 from ..core.errors import LinecheckError
 
+def usage_line(err: UsageError) -> str:
+    """One line for a command-line usage error: what is wrong, the usage, where the help is."""
+    ctx = err.ctx
+    msg = err.format_message().rstrip(".")
+    if ctx is None:
+        return msg
+    pieces = " ".join(ctx.command.collect_usage_pieces(ctx))
+    return f"{msg}; usage: {ctx.command_path} {pieces} (see {ctx.command_path} --help)"
+
+
+class LinecheckGroup(TyperGroup):
+    """The command group: a usage error of a command (a missing argument, an unknown option, a bad
+    value) is one red line on stderr and exit code 2, like every other bad input (README)."""
+
+    def invoke(self, ctx: Any) -> Any:
+        try:
+            return super().invoke(ctx)
+        except NoArgsIsHelpError:
+            raise
+        except UsageError as err:
+            err_console.print(f"[bold red]error:[/] {escape(usage_line(err))}", highlight=False, soft_wrap=True,
+                              emoji=False)
+            raise typer.Exit(2) from None
+
+
+def _flag_without_type(option_cls: type) -> None:
+    """Show a flag (``--force``) without a ``<bool>`` type beside it in the help: it takes no value.
+
+    Typer's rich help prints the type of every option, flags included; this leaves the type
+    column of flags empty (and keeps it for options that take a value).
+    """
+    show = getattr(option_cls, "display_type_rich", None)
+    if show is None or getattr(show, "_linecheck", False):
+        return
+
+    def display_type_rich(self: Any, ctx: Any) -> str | None:
+        if getattr(self, "is_flag", False) and getattr(self, "metavar", None) is None:
+            return None
+        return show(self, ctx)
+
+    display_type_rich._linecheck = True  # type: ignore[attr-defined]
+    option_cls.display_type_rich = display_type_rich
+
+
+_flag_without_type(TyperOption)
+
 app = typer.Typer(
+    cls=LinecheckGroup,
     name="linecheck",
     help="Dynamic design check of transmission-line conductors under downburst and synoptic winds.",
     no_args_is_help=True,
@@ -33,8 +86,8 @@ app = typer.Typer(
 console = Console(width=None if sys.stdout.isatty() else 160)
 err_console = Console(stderr=True, width=None if sys.stderr.isatty() else 160)
 
-CaseArg = Annotated[Path, typer.Argument(help="Case file (TOML).", show_default=False)]
-CasesArg = Annotated[list[Path], typer.Argument(help="Case files (TOML).", show_default=False)]
+CaseArg = Annotated[Path, typer.Argument(help="Case file (TOML).", show_default=False, metavar="CASE_FILE")]
+CasesArg = Annotated[list[Path], typer.Argument(help="Case files (TOML).", show_default=False, metavar="CASE_FILE")]
 JsonOpt = Annotated[Path | None, typer.Option("--json", help="Write the result as JSON to this file.")]
 
 F = TypeVar("F", bound=Callable[..., Any])

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import glob
 import threading
+import time
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -21,6 +22,7 @@ from rich.table import Table
 from ..core.errors import CaseError
 from .app import CaseArg, app, console, err_console, handle_errors, read_case
 from .limits import MaxMemoryOpt, apply_max_memory
+from .export_cmd import EngineerOpt, LineOpt, ProjectOpt, RevisionOpt, TitleOpt, title_block
 from .stats_view import MaxRealOpt, UntilOpt, parse_until
 
 JobsOpt = Annotated[int | None, typer.Option(
@@ -29,6 +31,9 @@ JobsOpt = Annotated[int | None, typer.Option(
 SchedulerOpt = Annotated[str | None, typer.Option(
     "--scheduler", help="Run on a Dask distributed cluster at this address (tcp://HOST:PORT); "
                         "needs pip install 'linecheck\\[dask]'.", show_default=False)]
+ConnectTimeoutOpt = Annotated[float, typer.Option(
+    "--connect-timeout", help="With --scheduler: seconds allowed for the connection and the scheduler's handshake "
+                              "(each step; an unreachable or silent address exits 2).", min=0.001, max=3600.0)]
 BatchExcelOpt = Annotated[Path | None, typer.Option(
     "--excel", help="Also write the Excel design sheet (.xlsx) of all cases to this file.", show_default=False)]
 BatchTemplateOpt = Annotated[Path | None, typer.Option(
@@ -73,24 +78,71 @@ def _check_excel(excel: Path | None, force: bool, template: Path | None) -> None
     check_excel_target(excel, force=force, template=template)
 
 
-def _write_excel(docs: list[dict[str, Any]], excel: Path, force: bool, template: Path | None) -> None:
+def _write_excel(docs: list[dict[str, Any]], excel: Path, force: bool, template: Path | None,
+                 title: dict[str, str] | None = None) -> None:
     try:
         from ..excel.writer import write_workbook
     except ImportError:
         raise CaseError("Excel output is not available in this installation (linecheck.excel missing)") from None
-    kwargs: dict[str, Any] = {"force": force}
+    kwargs: dict[str, Any] = {"force": force, "title": title or None}
     if template is not None:
         kwargs["template"] = template
     write_workbook(docs, excel, **kwargs)
 
 
-class BatchDisplay:
-    """Rich progress for :class:`linecheck.batch.BatchEvent`: one overall bar, one bar per running case."""
+def _clock(seconds: float) -> str:
+    s = int(round(max(0.0, seconds)))
+    return f"{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}"
+
+
+def _count(done: float, total: int) -> str:
+    return f"{done:.1f}/{total}" if done != int(done) else f"{int(done)}/{total}"
+
+
+class _Rate:
+    """Elapsed time and ETA of a batch from its events (realizations done in this run)."""
 
     def __init__(self) -> None:
+        self.t0 = time.monotonic()
+        self.start_done: float | None = None  # realizations already done (resume) when the batch started
+
+    def elapsed(self) -> float:
+        return time.monotonic() - self.t0
+
+    def eta(self, done: float, total: int) -> str:
+        base = self.start_done or 0.0
+        ran = done - base
+        if ran <= 0 or total <= done:
+            return "--:--:--" if total > done else _clock(0)
+        return _clock(self.elapsed() * (total - done) / ran)
+
+    def summary(self, ev: Any) -> str:
+        pct = 100.0 * ev.overall_done / ev.overall_total if ev.overall_total else 100.0
+        return (f"cases {ev.cases_done}/{ev.cases_total}, realizations {_count(ev.overall_done, ev.overall_total)} "
+                f"({pct:.0f} %), elapsed {_clock(self.elapsed())}, ETA {self.eta(ev.overall_done, ev.overall_total)}")
+
+
+class BatchDisplay:
+    """Progress for :class:`linecheck.batch.BatchEvent`.
+
+    In a terminal (rich): one overall bar (cases and realizations done / total, elapsed,
+    ETA) and one bar per running case, both moving while chunks run (tasks report at
+    least once per realization).  Piped (CI, logs): plain lines -- one per finished,
+    failed or skipped case, and a progress line when a whole realization more is done,
+    at most every ``interval`` seconds (0: every realization).
+    """
+
+    def __init__(self, *, interval: float = 5.0, live: bool | None = None, console: Any = None) -> None:
+        self.console = console if console is not None else err_console
+        self.live = self.console.is_terminal if live is None else live
+        self.interval = interval
+        self.rate = _Rate()
+        self.last_line = float("-inf")
+        self.last_whole = 0
         self.bars = Progress(
             TextColumn("{task.description}"), BarColumn(), TextColumn("{task.fields[count]}"),
-            TimeElapsedColumn(), console=err_console, transient=True,
+            TimeElapsedColumn(), TextColumn("{task.fields[eta]}"), console=self.console, transient=True,
+            disable=not self.live,
         )
         self.overall: TaskID | None = None
         self.cases: dict[int, TaskID] = {}
@@ -103,19 +155,52 @@ class BatchDisplay:
         self.bars.__exit__(*exc)
 
     def _count(self, done: float, total: int) -> str:
-        return f"{int(done)}/{total}"
+        return _count(done, total)
+
+    def _overall_count(self, ev: Any) -> str:
+        return f"{ev.cases_done}/{ev.cases_total} cases, {self._count(ev.overall_done, ev.overall_total)} realizations"
+
+    def _line(self, text: str) -> None:
+        self.console.print(text, highlight=False, soft_wrap=True, markup=False, emoji=False)
+        self.last_line = time.monotonic()
 
     def __call__(self, ev: Any) -> None:
+        if ev.kind == "start":
+            self.rate = _Rate()
+            self.rate.start_done = ev.overall_done
+            self.last_whole = int(ev.overall_done)
+        if self.live:
+            self._live(ev)
+        else:
+            self._plain(ev)
+
+    def _plain(self, ev: Any) -> None:
+        if ev.kind == "start":
+            self._line(f"batch: {ev.cases_total} case(s), {ev.overall_total} realizations on {ev.message}")
+        elif ev.kind in ("case_done", "case_failed", "case_skipped"):
+            word = {"case_done": "done", "case_failed": "failed", "case_skipped": "skipped"}[ev.kind]
+            extra = f": {ev.message}" if ev.kind == "case_failed" else ""
+            self._line(f"{word:<8}{ev.name}{extra}  [{self.rate.summary(ev)}]")
+            self.last_whole = int(ev.overall_done)
+        elif ev.kind == "case_progress":
+            whole = int(ev.overall_done)
+            if whole > self.last_whole and time.monotonic() - self.last_line >= self.interval:
+                self.last_whole = whole
+                self._line(f"progress: {self.rate.summary(ev)}")
+
+    def _live(self, ev: Any) -> None:
         b = self.bars
         if ev.kind == "start":
-            self.overall = b.add_task(f"[bold]batch[/] on {ev.message}", total=max(ev.overall_total, 1),
-                                      count=self._count(ev.overall_done, ev.overall_total))
+            self.overall = b.add_task(f"[bold]batch[/] on {escape(ev.message)}", total=max(ev.overall_total, 1),
+                                      count=self._overall_count(ev), eta="")
             return
         if self.overall is not None:
-            b.update(self.overall, completed=ev.overall_done, count=self._count(ev.overall_done, ev.overall_total))
-        if ev.kind == "case_start" and ev.case not in self.cases:
-            self.cases[ev.case] = b.add_task(f"  {escape(ev.name)}", total=max(ev.total, 1), count=self._count(ev.done, ev.total))
-        elif ev.kind == "case_progress" and ev.case in self.cases:
+            b.update(self.overall, completed=ev.overall_done, count=self._overall_count(ev),
+                     eta=f"ETA {self.rate.eta(ev.overall_done, ev.overall_total)}")
+        if ev.kind in ("case_start", "case_progress") and ev.case not in self.cases:
+            self.cases[ev.case] = b.add_task(f"  {escape(ev.name)}", total=max(ev.total, 1),
+                                             count=self._count(ev.done, ev.total), eta="")
+        if ev.kind == "case_progress" and ev.case in self.cases:
             b.update(self.cases[ev.case], completed=ev.done, count=self._count(ev.done, ev.total))
         elif ev.kind in ("case_done", "case_failed", "case_skipped"):
             if ev.case in self.cases:
@@ -137,26 +222,99 @@ def _kn(doc: dict[str, Any] | None, reaction: str, stat: str, scale: float = 1e-
     return "**" if v is None else fmt.format(v * scale)
 
 
+#: Cont_R above this (a fraction) is flagged "dynamic analysis recommended" (the paper's conclusion;
+#: the same threshold as the Excel summary's default --cont-r-threshold and the TUI)
+CONT_R_FLAG = 0.10
+REACTION_NAMES = ("Rx", "Ry", "Rz")
+QUANTITY_TEXT = {"rms_background": "background r.m.s.", "rms_fluctuating": "fluctuating r.m.s."}
+
+
+def cont_r_flags(doc: dict[str, Any] | None, state: str = "recommended") -> list[str]:
+    """Reactions whose ``"dynamic_analysis"`` flag is ``state`` ("recommended": the 95 % interval
+    of Cont_R lies above :data:`CONT_R_FLAG`; "inconclusive": it straddles it; issue 18)."""
+    out = []
+    for r in REACTION_NAMES:
+        try:
+            if doc["reactions"][r].get("dynamic_analysis") == state:  # type: ignore[index]
+                out.append(r)
+        except (KeyError, TypeError, AttributeError):
+            continue
+    return out
+
+
+def sanity_failures(doc: dict[str, Any] | None) -> list[dict[str, Any]]:
+    """The failed items of the time- vs frequency-domain sanity check of a synoptic result."""
+    try:
+        items = doc["spectral"]["sanity_check"]  # type: ignore[index]
+    except (KeyError, TypeError):
+        return []
+    return [i for i in items or [] if isinstance(i, dict) and i.get("ok") is False]
+
+
+def _sanity_text(item: dict[str, Any]) -> str:
+    def kn(v: Any) -> str:
+        return "?" if v is None else f"{v / 1e3:.3f}"
+
+    return (f"{item.get('reaction')} {QUANTITY_TEXT.get(item.get('quantity'), item.get('quantity'))} "
+            f"{kn(item.get('time_domain'))} vs {kn(item.get('frequency_domain'))} kN "
+            f"(allowed difference {kn(item.get('allowed_difference'))})")
+
+
 def summary_table(report: Any) -> Table:
-    """One row per case: status, peak reactions, gust factors, Cont_R, time, JSON or error."""
+    """One row per case: status, peak reactions, gust factors, Cont_R, flags, time, JSON or error.
+
+    Flags: ``Cont_R>10% <reactions>`` (dynamic analysis recommended) and ``t/f check`` (the
+    time- and frequency-domain r.m.s. of a synoptic case differ); :func:`summary_notes` explains them.
+    """
     t = Table(title="batch summary (tower of interest)", title_justify="left")
-    for col, just in (("case", "left"), ("status", "left"), ("n", "right"), ("peak Rx kN", "right"), ("peak Ry kN", "right"),
-                      ("GF_Dy Rx", "right"), ("GF_Dy Ry", "right"), ("Cont_R Ry %", "right"), ("time s", "right"),
-                      ("result / error", "left")):
+    for col, just in (("case", "left"), ("status", "left"), ("n", "right"), ("peak Rx kN", "right"),
+                      ("peak Ry kN", "right"), ("GF_Dy Rx", "right"), ("GF_Dy Ry", "right"), ("Cont_R Ry %", "right"),
+                      ("flags", "left"), ("time s", "right"), ("result / error", "left")):
         t.add_column(col, justify=just, overflow="fold")
     colours = {"done": "green", "skipped": "cyan", "failed": "red", "cancelled": "yellow", "pending": "yellow"}
     for o in report.outcomes:
         d = o.doc
+        flagged = cont_r_flags(d)
+        cont_ry = _kn(d, "Ry", "Cont_R", 100.0, "{:.1f}")
+        if "Ry" in flagged:
+            cont_ry = f"[bold yellow]{cont_ry}[/]"
+        flags = []
+        if flagged:
+            flags.append(f"[bold yellow]Cont_R>10% {' '.join(flagged)}[/]")
+        unsure = cont_r_flags(d, "inconclusive")
+        if unsure:
+            flags.append(f"[yellow]Cont_R~10% {' '.join(unsure)}[/]")
+        if sanity_failures(d):
+            flags.append("[bold red]t/f check[/]")
         t.add_row(
             escape(o.name), f"[{colours.get(o.status, 'white')}]{o.status}[/]",
             str(d.get("realizations", "")) if d else "",
             _kn(d, "Rx", "peak_dynamic"), _kn(d, "Ry", "peak_dynamic"),
             _kn(d, "Rx", "GF_Dy", 1.0, "{:.3f}"), _kn(d, "Ry", "GF_Dy", 1.0, "{:.3f}"),
-            _kn(d, "Ry", "Cont_R", 100.0, "{:.1f}"),
+            cont_ry, " ".join(flags),
             f"{o.elapsed:.1f}" if o.status == "done" else "",
             escape(o.error if o.error else (str(o.json_path) if o.json_path and o.ok else "")),
         )
     return t
+
+
+def summary_notes(report: Any) -> list[str]:
+    """Footnotes of :func:`summary_table` for the flags that appear in it (rich markup)."""
+    notes = []
+    if any(cont_r_flags(o.doc) for o in report.outcomes):
+        notes.append(f"[bold yellow]Cont_R>10%[/]: the resonant share of the peak (Cont_R, Eq. 16) of these reactions "
+                     f"exceeds {CONT_R_FLAG:.0%} (its 95 % interval lies above): dynamic analysis recommended (a "
+                     "quasi-static analysis misses it).")
+    if any(cont_r_flags(o.doc, "inconclusive") for o in report.outcomes):
+        notes.append(f"[yellow]Cont_R~10%[/]: the 95 % interval of Cont_R straddles {CONT_R_FLAG:.0%}: inconclusive, "
+                     "run more realizations (--until 1%).")
+    bad = [(o.name, sanity_failures(o.doc)) for o in report.outcomes if sanity_failures(o.doc)]
+    if bad:
+        notes.append("[bold red]t/f check[/]: time- and frequency-domain r.m.s. differ by more than the sampling "
+                     "error of the realizations explains (see the case's sanity check, `linecheck spectral`): "
+                     + "; ".join(f"{escape(name)}: " + ", ".join(_sanity_text(i) for i in items)
+                                 for name, items in bad) + ".")
+    return notes
 
 
 @app.command()
@@ -174,6 +332,16 @@ def batch(
     template: BatchTemplateOpt = None,
     chunk: ChunkOpt = None,
     max_memory: MaxMemoryOpt = None,
+    project: ProjectOpt = None,
+    line: LineOpt = None,
+    engineer: EngineerOpt = None,
+    revision: RevisionOpt = None,
+    title: TitleOpt = None,
+    connect_timeout: ConnectTimeoutOpt = 10.0,
+    progress_interval: Annotated[float, typer.Option(
+        "--progress-interval", help="Output not a terminal (CI, logs): print a progress line at most every this "
+                                    "many seconds, when one more realization is done (0: every realization).",
+        min=0.0)] = 5.0,
     until: UntilOpt = None,
     max_realizations: MaxRealOpt = 1000,
 ) -> None:
@@ -182,26 +350,34 @@ def batch(
 
     apply_max_memory(max_memory)  # each task checks its memory estimate (workers inherit the limit)
 
+    fields = title_block(project, line, engineer, revision, title, excel=excel)
     paths = expand_cases(cases)
     target = parse_until(until)
     _check_excel(excel, force, template)
     out_dir = json_dir if json_dir is not None else ((excel.parent if excel is not None else Path.cwd()) / "results")
     cancel = threading.Event()
-    with make_executor(jobs, scheduler) as executor, BatchDisplay() as display:
+    with (make_executor(jobs, scheduler, connect_timeout) as executor,
+          BatchDisplay(interval=progress_interval) as display):
         report = run_batch(paths, executor=executor, json_dir=out_dir, resume=resume, chunk_size=chunk,
                            progress=display, cancel=cancel,
                            until=None if target is None else (target, max_realizations))
     console.print(summary_table(report))
+    for note in summary_notes(report):
+        console.print(note, highlight=False, soft_wrap=True)
     n_done = sum(o.status == "done" for o in report.outcomes)
     n_skip = sum(o.status == "skipped" for o in report.outcomes)
     console.print(f"{n_done} run, {n_skip} skipped, {len(report.failed)} failed "
                   f"in {report.elapsed:.1f} s on {report.executor}; results in {out_dir}", highlight=False)
+    if report.output_error:
+        n_saved = sum(o.status == "done" for o in report.outcomes)
+        raise CaseError(f"{report.output_error}; the batch stopped, {n_saved} result(s) saved in {out_dir}: "
+                        "free space (or fix the folder) and run again with --resume")
     if report.cancelled:
         err_console.print(f"[bold red]interrupted[/]: finished cases are saved in {out_dir}; "
                           "run again with --resume to do the rest", highlight=False)
         raise typer.Exit(130)
     if excel is not None:
-        _write_excel(report.docs(), excel, force, template)
+        _write_excel(report.docs(), excel, force, template, fields)
         console.print(f"wrote {excel}")
     if report.failed:
         err_console.print(f"[bold red]error:[/] {len(report.failed)} case(s) failed: "
@@ -263,6 +439,7 @@ def scan(
     jobs: JobsOpt = None,
     scheduler: SchedulerOpt = None,
     max_memory: MaxMemoryOpt = None,
+    connect_timeout: ConnectTimeoutOpt = 10.0,
 ) -> None:
     """Find the critical downburst configurations: step 1 over a grid of positions and sizes."""
     apply_max_memory(max_memory)  # each step-1 task checks its memory estimate
@@ -275,7 +452,7 @@ def scan(
     if csv_out is not None:
         check_target(csv_out, what="CSV")
     cancel = threading.Event()
-    with make_executor(jobs, scheduler) as executor:
+    with make_executor(jobs, scheduler, connect_timeout) as executor:
         try:
             with progress_bar() as cb:
                 result = run_scan(case_file, grid, executor=executor, hold=hold, progress=cb, cancel=cancel)

@@ -20,7 +20,7 @@ from .progress import progress_bar
 @app.command()
 @handle_errors
 def check(cases: CasesArg) -> None:
-    """Validate case files without running them (exit 2 on the first bad file)."""
+    """Validate case files without running them; every bad file is reported, one line each (exit 2 if any)."""
     failed = 0
     for path in cases:
         try:
@@ -61,6 +61,9 @@ def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
             *(f"{rw[k, j, c] / 1e3:.3f}" for c in range(3)),
         )
     console.print(table)
+    console.print(f"[dim]* tower of interest (line.tower_of_interest = {toi + 1}); Rx, Ry, Rz total reactions "
+                  "(conductor weight included), \"wind\" their wind-induced part (still air subtracted).[/]",
+                  highlight=False)
     series = case.wind.type == "downburst"
     tens = ", ".join(f"{h / 1e3:.2f}" for h in (m.tension.max(axis=0) if series else m.tension[0]))
     console.print(f"span tensions H (kN{', largest over the event' if series else ''}): {tens}   "
@@ -78,3 +81,4 @@ from . import tui_cmd  # noqa: E402,F401
 from . import export_cmd  # noqa: E402,F401
 from . import batch_cmd  # noqa: E402,F401
 from . import validate_cmd  # noqa: E402,F401
+from . import codes_cmd  # noqa: E402,F401

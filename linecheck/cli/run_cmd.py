@@ -5,16 +5,27 @@ from __future__ import annotations
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 from rich.table import Table
 
 from .. import service
 from ..core.case import Case
 from ..core.results import REACTIONS
 from ..io.atomic import check_target
-from ..io.display import SUMMARY_STATS, stat_text
+from ..io.display import SUMMARY_STATS
 from ..io.jsonout import _num, run_to_dict, write_json
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
-from .export_cmd import ExcelOpt, ForceOpt, TemplateOpt
+from .export_cmd import (
+    EngineerOpt,
+    ExcelOpt,
+    ForceOpt,
+    LineOpt,
+    ProjectOpt,
+    RevisionOpt,
+    TemplateOpt,
+    TitleOpt,
+    title_block,
+)
 from .limits import MaxMemoryOpt, apply_max_memory
 from .limits import warn as limits_warn
 from .progress import progress_bar
@@ -33,34 +44,105 @@ def override(case: Case, realizations: int | None, seed: int | None) -> Case:
                                "--seed": ("analysis.seed", seed)})
 
 
+#: Column headers of the console table: at most 7 characters a line, so that the table with its
+#: ``± std`` lines fits a 120-column terminal; :data:`TABLE_LEGEND` explains them.
+SHORT_HEADERS = {
+    "mean_max": "M\nkN", "rms_background": "rms B\nkN", "rms_resonant": "rms R\nkN",
+    "peak_quasi_static": "peak QS\nkN", "peak_dynamic": "peak Dy\nkN", "GF_Dy": "GF_Dy", "GF_QS": "GF_QS",
+    "Cont_M": "Cont_M\n%", "Cont_BG": "Cont_BG\n%", "Cont_R": "Cont_R\n%", "peak_normalised": "peak /\ngypL",
+}
+#: Cont_R (fraction) above which the table marks a reaction: "dynamic analysis recommended" (as the
+#: Excel design sheet's default --cont-r-threshold; paper Sect. 5).
+CONT_R_FLAG = 0.10
+#: Reactions whose Cont_R is flagged (the paper's Table 5 reactions, as in the Excel Summary; Rz's
+#: wind-induced part is small beside the conductor weight, its Cont_R is not a design signal).
+FLAGGED_REACTIONS = ("Rx", "Ry")
+TABLE_LEGEND = (
+    "M: largest wind-induced mean; rms B, rms R: background and resonant r.m.s.; peak QS = M+B (quasi-static), "
+    "peak Dy = M+B+R (dynamic); GF ** : mean zero by symmetry (or < 1 % of the largest mean); Cont_R: share of "
+    "the peak that a quasi-static analysis misses; peak / gypL: peak Dy / (g*yp L_x) (Eq. 17).")
+
+
+def _cell(entry: dict, stat, n: int) -> str:
+    """``mean`` over ``± std`` (two lines, when there are several realizations); ``**`` when undefined."""
+    m, sd = entry.get("mean"), entry.get("std")
+    if m is None:
+        return "**"
+    text = stat.fmt.format(m * stat.scale)
+    if n > 1 and sd is not None:
+        text += "\n±" + stat.fmt.format(sd * stat.scale)
+    return text
+
+
 def results_table(doc: dict) -> Table:
-    """Rich table of the statistics at the tower of interest (kN, %)."""
+    """Rich table of the statistics at the tower of interest (kN, %); a Cont_R above 10 % in bold red."""
     n = doc["realizations"]
     t = Table(title=f"{doc['case']}: reactions at tower {doc['tower_of_interest']} "
                     f"({doc['wind']}, V_ref = {doc['v_ref']:g} m/s, {n} realization{'s' if n > 1 else ''})",
               title_justify="left")
-    t.add_column("reaction", justify="right")
+    t.add_column("", justify="right", no_wrap=True)
     for st in SUMMARY_STATS:
-        t.add_column(f"{st.label} {st.unit}" if st.unit != "-" else st.label, justify="right")
+        t.add_column(SHORT_HEADERS.get(st.key, st.label), justify="right", no_wrap=True)
     for r in REACTIONS:
-        t.add_row(r, *(stat_text(doc["reactions"][r][st.key], st, n) for st in SUMMARY_STATS))
+        cells = []
+        for st in SUMMARY_STATS:
+            entry = doc["reactions"][r][st.key]
+            text = escape(_cell(entry, st, n))
+            if st.key == "Cont_R" and cont_r_flagged(doc, r):
+                text = f"[bold red]{text}[/]"
+            cells.append(text)
+        t.add_row(r, *cells)
     return t
 
 
+def cont_r_flagged(doc: dict, reaction: str) -> bool:
+    """Whether ``reaction`` (Rx, Ry only) has the flag "recommended": the 95 % interval of its
+    Cont_R lies above :data:`CONT_R_FLAG` (issue 18, docs/method.md)."""
+    return reaction in FLAGGED_REACTIONS and doc["reactions"][reaction].get("dynamic_analysis") == "recommended"
+
+
+def print_legend(doc: dict) -> None:
+    """The legend of :func:`results_table`, and the Cont_R flag when a reaction has it."""
+    console.print(f"[dim]{TABLE_LEGEND}[/]", highlight=False)
+    flagged = [r for r in FLAGGED_REACTIONS if cont_r_flagged(doc, r)]
+    if flagged:
+        console.print(f"[bold red]Cont_R above {100 * CONT_R_FLAG:.0f} %[/] ({', '.join(flagged)}, in red; its 95 % interval "
+                      "lies above): dynamic analysis recommended, the resonant part is a significant share of the "
+                      "peak (paper Sect. 5).",
+                      highlight=False)
+
+
+def burn_in_note(doc: dict) -> str | None:
+    """One line on a synoptic record that is not stationary: what it means and what to do (issue 10, 14).
+
+    ``None`` when the burn-in is sufficient (or the run is not synoptic).
+    """
+    b = doc.get("burn_in")
+    if not b or doc.get("wind") != "synoptic" or b["sufficient"]:
+        return None
+    need = "never (undamped)" if b["required"] is None else f"{b['required']:,.0f} s"
+    mode = f"the {b['mode_hz']:.3f} Hz mode (zeta {b['zeta']:.2g}) would need a burn-in of {need}"
+    if doc.get("damping") == "paper" and b["seconds"] == 0:
+        return (f"[yellow]note:[/] damping = \"paper\" leaves the {b['mode_hz']:.3f} Hz mode almost undamped "
+                f"(zeta {b['zeta']:.2g}; stationary only after a burn-in of {need}): as in the paper, its resonant "
+                "part comes from a record starting at rest, below the stationary level the frequency-domain check "
+                "assumes; for a design value use damping = \"quasi-steady\" (docs/method.md, Damping).")
+    return (f"[yellow]note:[/] record not stationary: {mode}, {b['seconds']:,.0f} s used ({b['source']}); its "
+            "resonant part is below its stationary level: raise analysis.duration (the derived burn-in is capped "
+            "at 10 x duration) or analysis.burn_in, or set analysis.structural_damping (docs/method.md, Damping).")
+
+
 def print_burn_in(doc: dict) -> None:
-    """Say how much of a synoptic record was discarded, and when it is not enough (issue 10)."""
+    """Say how much of a synoptic record was discarded, and when it is not enough (issue 10): one line."""
     b = doc.get("burn_in")
     if not b or doc.get("wind") != "synoptic":
         return
-    if b["sufficient"]:
+    note = burn_in_note(doc)
+    if note is not None:
+        console.print(note, highlight=False, soft_wrap=True)
+    else:
         console.print(f"[dim]burn-in {b['seconds']:.0f} s discarded ({b['source']}); statistics from a stationary "
                       f"response (slowest significant mode {b['mode_hz']:.3f} Hz, zeta {b['zeta']:.3g}).[/]",
-                      highlight=False)
-    else:
-        need = "never (undamped)" if b["required"] is None else f"{b['required']:.0f} s"
-        console.print(f"[yellow]record too short for a stationary response:[/] mode {b['mode_hz']:.3f} Hz with "
-                      f"zeta {b['zeta']:.2g} needs a burn-in of {need}, {b['seconds']:.0f} s used ({b['source']}). "
-                      "Its resonant part is not at its stationary level; see docs/method.md (damping).",
                       highlight=False)
 
 
@@ -77,10 +159,16 @@ def run(
     force: ForceOpt = False,
     no_check: Annotated[bool, typer.Option("--no-check", help="Skip the frequency-domain sanity check of a synoptic case (long lines: its cost grows faster than the number of spans).")] = False,
     max_memory: MaxMemoryOpt = None,
+    project: ProjectOpt = None,
+    line: LineOpt = None,
+    engineer: EngineerOpt = None,
+    revision: RevisionOpt = None,
+    title: TitleOpt = None,
     until: UntilOpt = None,
     max_realizations: MaxRealOpt = 1000,
 ) -> None:
     """Steps 1-3: mean, background and resonant reactions, gust factors and contributions."""
+    fields = title_block(project, line, engineer, revision, title, excel=excel)
     apply_max_memory(max_memory)
     case = override(read_case(case_file), realizations, seed)
     target = parse_until(until)
@@ -99,14 +187,13 @@ def run(
     doc = run_to_dict(res, full_histories=full_histories)
     console.print(results_table(doc))
     console.print(design_table(doc))
-    for line in stats_notes(doc):
-        console.print(f"[dim]{line}[/]", highlight=False)
-    console.print("[dim]GF ** : mean reaction zero by symmetry (or < 1 % of the largest mean); "
-                  "Cont_R = share of the peak that a quasi-static analysis misses.[/]")
+    for note in stats_notes(doc):
+        console.print(f"[dim]{note}[/]", highlight=False)
+    print_legend(doc)
     from .spectral_cmd import print_sanity
 
     print_burn_in(doc)
-    print_sanity(doc)
+    print_sanity(doc, explained=burn_in_note(doc) is not None)
     if no_check and case.wind.type == "synoptic":
         console.print("[dim]frequency-domain check skipped (--no-check): no \"spectral\" block, no sanity check.[/]")
     if json_out is not None:
@@ -115,7 +202,7 @@ def run(
     if excel is not None:
         from ..excel.writer import write_workbook
 
-        write_workbook([doc], excel, template=template, force=force)
+        write_workbook([doc], excel, template=template, force=force, title=fields or None)
         console.print(f"wrote {excel}")
 
 

@@ -53,8 +53,12 @@ def spectral(case_file: CaseArg, json_out: JsonOpt = None) -> None:
         console.print(f"wrote {json_out}")
 
 
-def print_sanity(doc: dict) -> None:
-    """The run's "sanity check" line(s): time vs frequency domain."""
+def print_sanity(doc: dict, *, explained: bool = False) -> None:
+    """The run's "sanity check" line(s): time vs frequency domain.
+
+    ``explained``: the burn-in note (a record that is not stationary) was printed, which is
+    the usual reason of a flag; the hint is then not repeated.
+    """
     sp = doc.get("spectral")
     if not sp:
         return
@@ -68,6 +72,6 @@ def print_sanity(doc: dict) -> None:
     head = "[green]sanity check ok[/]" if not bad else (
         f"[bold red]sanity check: {len(bad)} difference(s) larger than sampling error explains[/]")
     console.print(head + ": " + "; ".join(parts), highlight=False)
-    if bad:
+    if bad and not explained:
         console.print("[dim]A flagged resonant component usually means a lightly damped mode that the record "
                       "does not reach stationarity for (see docs/validation.md, damping).[/]")

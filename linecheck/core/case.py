@@ -29,6 +29,7 @@ SUPPORT_TYPES = ("strain", "suspension")
 WIND_TYPES = ("synoptic", "downburst")
 DOWNBURST_PRESETS = ("Db_x", "Db_y")
 DAMPING_MODELS = ("quasi-steady", "paper")
+CODE_TERRAINS = ("sea", "open", "suburban", "urban")  # [codes] terrain (docs/codes.md)
 # Conductor self-damping assumed with the quasi-steady model (ratio at the lowest mean-state
 # mode, stiffness-proportional): it damps the axial modes that no aerodynamic model damps.
 DEFAULT_STRUCTURAL_DAMPING = 0.002
@@ -140,6 +141,12 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         _f("peak_window", "s", "peaks taken per window of the analysed record; statistics over windows x realizations (default: the whole record; a downburst's whole event)", low=0.0, high=1e5, low_open=True),
         _f("design_fractile", "-", "non-exceedance probability of the Gumbel design peak (0.5 = median peak)", default=0.5, low=0.0, high=0.999, low_open=True),
     ),
+    "codes": (  # design-code comparison (issue 19, docs/codes.md)
+        FieldSpec("terrain", "choice", "-", 'terrain for the design codes: "sea", "open", "suburban" or "urban" (maps to each code\'s category)', default="open", choices=CODE_TERRAINS),
+        FieldSpec("asce74_exposure", "choice", "-", "ASCE 74 exposure category (default: from terrain)", choices=("B", "C", "D")),
+        FieldSpec("iec60826_terrain", "choice", "-", "IEC 60826 terrain category (default: from terrain)", choices=("A", "B", "C", "D")),
+        FieldSpec("en50341_terrain", "choice", "-", "EN 50341-1 / EN 1991-1-4 terrain category (default: from terrain)", choices=("0", "I", "II", "III", "IV")),
+    ),
 }
 
 
@@ -239,6 +246,16 @@ class Analysis:
 
 
 @dataclass(frozen=True)
+class Codes:
+    """Terrain of the design-code comparison (docs/codes.md); None = from ``terrain``."""
+
+    terrain: str = "open"
+    asce74_exposure: str | None = None
+    iec60826_terrain: str | None = None
+    en50341_terrain: str | None = None
+
+
+@dataclass(frozen=True)
 class Case:
     """One analysis case: a line section, a wind and the analysis settings."""
 
@@ -248,6 +265,7 @@ class Case:
     analysis: Analysis = field(default_factory=Analysis)
     description: str = ""
     source: Path | None = None
+    codes: Codes = field(default_factory=Codes)
 
     @property
     def g_yp(self) -> float:
@@ -262,7 +280,7 @@ class Case:
 
 GRAVITY = 9.81  # [m/s2], paper Eq. 8
 
-_SUBTABLES = {"": ("line", "wind", "analysis"), "wind": ("downburst",)}
+_SUBTABLES = {"": ("line", "wind", "analysis", "codes"), "wind": ("downburst",)}
 
 
 # --------------------------------------------------------------------------- loading
@@ -492,9 +510,10 @@ def case_from_dict(
         raise ctx.error("analysis", "time_step", f"value {analysis.time_step!r} is too large for duration {analysis.duration!r}: expected at most duration/4")
     if analysis.peak_window is not None and analysis.peak_window < 4 * analysis.time_step:
         raise ctx.error("analysis", "peak_window", f"value {analysis.peak_window!r} is too short for time_step {analysis.time_step!r}: expected at least 4 time steps")
+    codes = Codes(**_read_section(data.get("codes", {}), "codes", ctx))
     name = top["name"] or default_name
     return Case(name=name, description=top["description"] or "", line=line, wind=wind, analysis=analysis,
-                source=Path(file) if file else None)
+                source=Path(file) if file else None, codes=codes)
 
 
 def _build_downburst(d: dict[str, Any], line: Line, ctx: _Ctx, base_dir: Path | None) -> Downburst:
@@ -635,6 +654,8 @@ def case_to_dict(case: Case) -> dict[str, Any]:
                 db.pop(k, None)
         doc["wind"]["downburst"] = db
     doc["analysis"] = pick(case.analysis, "analysis")
+    if case.codes != Codes():
+        doc["codes"] = pick(case.codes, "codes")
     return doc
 
 
@@ -662,7 +683,7 @@ def case_to_toml(case: Case) -> str:
                 lines.append(f"{spec.name} = {_toml_value(table[spec.name])}{unit}")
 
     emit("", doc)
-    for section in ("line", "wind", "wind.downburst", "analysis"):
+    for section in ("line", "wind", "wind.downburst", "analysis", "codes"):
         table = doc.get(section) if "." not in section else doc["wind"].get("downburst")
         if table is None:
             continue

@@ -619,7 +619,8 @@ class DavenportEstimate:
     Attributes:
         background: B [-]; resonant: R [-]; peak_factor: g [-]; f1 [Hz]; zeta_a [-];
         GF_Dy = 1 + 2 g I sqrt(B + R); GF_QS = 1 + 2 g I sqrt(B); Cont_R [-];
-        GF_ASCE: ASCE Manual 74 (2010) wire gust response factor G_w = 1 + 2.7 E_w sqrt(B_w).
+        GF_ASCE: ASCE Manual 74 (2010) wire gust factor on the mean pressure, 1 + 2.7 E_w sqrt(B_w)
+        (:func:`linecheck.core.codes.asce74_wire_gust`, exposure C).
     """
 
     background: float
@@ -663,13 +664,11 @@ def davenport_gust_factor(
     gB = float(peak_factor(np.sqrt(nuB2), duration))
     gf_dy = 1 + 2 * g * intensity * np.sqrt(B + R)
     gf_qs = 1 + 2 * gB * intensity * np.sqrt(B)
-    # ASCE 74 (2010) section 2.1.5, exposure C: E_w = 4.9 sqrt(kappa) (33/z)^(1/alpha),
-    # B_w = 1 / (1 + 0.8 L / L_s), L_s = 220 (z/33)^(1/eps) [ft]; kappa = 0.005, alpha = 9.5, eps = 5.
-    z_ft = height / 0.3048
-    Ew = 4.9 * np.sqrt(0.005) * (33.0 / z_ft) ** (1 / 9.5)
-    Ls = 220.0 * (z_ft / 33.0) ** (1 / 5.0) * 0.3048
-    Bw = 1.0 / (1.0 + 0.8 * span / Ls)
-    gf_asce = 1 + 2.7 * Ew * np.sqrt(Bw)
+    # ASCE 74 (2010) section 2.1.5, exposure C: the wire gust factor on the 10-min mean pressure,
+    # 1 + 2.7 E_w sqrt(B_w) (implemented once, in linecheck.core.codes)
+    from .codes import asce74_wire_gust
+
+    gf_asce = asce74_wire_gust(height, span, "C").mean_gust_factor
     return DavenportEstimate(B, R, g, f1, float(zeta), float(gf_dy), float(gf_qs),
                              float((gf_dy - gf_qs) / gf_dy), float(gf_asce))
 

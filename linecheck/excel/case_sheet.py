@@ -12,6 +12,7 @@ from openpyxl.worksheet.worksheet import Worksheet
 
 from ..core.case import SCHEMA
 from . import template as tpl
+from ..io.display import flag_state, flag_text
 from .cells import (
     FLAG_NOTE,
     KN,
@@ -25,6 +26,7 @@ from .cells import (
     Cursor,
     align,
     cell_value,
+    header_text,
     is_num,
     kn,
     link,
@@ -87,8 +89,8 @@ def write_case(ws: Worksheet, doc: dict, threshold: float, chart_points: int, su
     right = get_column_letter(CHART_COL + int(CHART_W / 1.75) + 1)
     ws.print_area = f"A1:{right}{max(last_table_row, bottom)}"
     page_setup(ws, summary)
-    ws.oddHeader.left.text = project
-    ws.oddHeader.right.text = str(doc["case"])
+    ws.oddHeader.left.text = header_text(project)
+    ws.oddHeader.right.text = header_text(doc["case"])
 
 
 def _inputs_table(cur: Cursor, doc: dict, params: dict) -> None:
@@ -261,9 +263,9 @@ def _contributions_table(cur: Cursor, doc: dict, threshold: float,
         for k, stat in enumerate(("Cont_M", "Cont_BG", "Cont_R")):
             v = doc["reactions"][r][stat].get("mean")
             cur.put(cur.row, 3 + k, cell_value(v, "pct"), fmt=PCT)
-        v = doc["reactions"][r]["Cont_R"].get("mean")
-        flag = r in flagged and is_num(v) and v > threshold
-        c = cur.put(cur.row, 6, FLAG_NOTE if flag else "", "lc_text")
+        state = flag_state(doc, r, threshold) if r in flagged else None  # issue 18: on the 95 % interval
+        flag = state is not None
+        c = cur.put(cur.row, 6, FLAG_NOTE if state == "recommended" else flag_text(state), "lc_text")
         align(c, indent=1)
         if flag:
             c.font = Font(name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT)
@@ -408,7 +410,9 @@ def _spectral(cur: Cursor, doc: dict) -> None:
                 c.font = Font(name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT)
                 c.fill = PatternFill("solid", fgColor=tpl.FLAG_FILL)
             cur.row += 1
-        cur.note("FLAG: time and frequency domain differ by more than the sampling error of the realizations explains.")
+        if any(isinstance(it, dict) and not it.get("ok") for it in checks):
+            cur.note("FLAG: time and frequency domain differ by more than the sampling error of the realizations "
+                     "explains.")
     rest = {k: v for k, v in sp.items() if k not in done}
     if rest:
         cur.row += 1

@@ -7,6 +7,7 @@ import re
 from collections.abc import Sequence
 from typing import Any
 
+from openpyxl.cell.cell import ILLEGAL_CHARACTERS_RE
 from openpyxl.styles import Alignment, Font
 from openpyxl.worksheet.hyperlink import Hyperlink
 from openpyxl.worksheet.worksheet import Worksheet
@@ -67,6 +68,37 @@ GF_UNDEFINED = "**"
 _RESERVED = {"summary", "peaks"}
 
 
+#: First characters that make a spreadsheet read a typed text as a formula (OWASP "CSV injection":
+#: ``=``, ``+``, ``-``, ``@``, tab, carriage return).
+FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
+
+
+def set_value(cell, value: Any) -> Any:
+    """Put ``value`` into ``cell``; a text is always stored as a text, never as a formula.
+
+    openpyxl turns a ``str`` beginning with ``=`` into a formula and ``"#N/A"`` into an
+    error value; every text the writer puts into a cell (case names, descriptions, title
+    block, failed files, error messages) goes through here, so a case named
+    ``=cmd|' /C calc'!A0`` is an inline string.  A text that starts like a formula also
+    gets Excel's quote prefix, so that editing the cell keeps it a text.  Characters that
+    XML 1.0 cannot hold (control characters) are replaced by U+FFFD.
+    """
+    if isinstance(value, str):
+        value = ILLEGAL_CHARACTERS_RE.sub("\ufffd", value)
+        cell.value = value
+        cell.data_type = "s"
+        if value.startswith(FORMULA_START):
+            cell.quotePrefix = True
+    else:
+        cell.value = value
+    return cell
+
+
+def header_text(text: Any) -> str:
+    """``text`` for a page header/footer: ``&`` starts a field code there, ``&&`` is a literal ampersand."""
+    return ILLEGAL_CHARACTERS_RE.sub("\ufffd", str(text)).replace("&", "&&")
+
+
 def is_num(v: Any) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
@@ -115,7 +147,8 @@ def align(cell, **changes: Any) -> None:
 
 
 def link(cell, sheet: str) -> None:
-    cell.hyperlink = Hyperlink(ref=cell.coordinate, location=f"'{sheet}'!A1", display=str(cell.value))
+    quoted = sheet.replace("'", "''")  # a quote inside a quoted sheet name is doubled
+    cell.hyperlink = Hyperlink(ref=cell.coordinate, location=f"'{quoted}'!A1", display=str(cell.value))
     cell.font = Font(name="Calibri", size=10, color="0563C1", underline="single")
 
 
@@ -141,8 +174,9 @@ class Cursor:
         self.row = row
 
     def put(self, row: int, col: int, value: Any, style: str = "lc_number", fmt: str | None = None):
-        c = self.ws.cell(row=row, column=col, value=value)
+        c = self.ws.cell(row=row, column=col)
         c.style = style
+        set_value(c, value)
         if fmt is not None and is_num(value):
             c.number_format = fmt
         return c
@@ -151,7 +185,7 @@ class Cursor:
         self.row += 1
         for col in range(1, width + 1):
             self.ws.cell(row=self.row, column=col).style = "lc_section"
-        self.ws.cell(row=self.row, column=1, value=text)
+        set_value(self.ws.cell(row=self.row, column=1), text)
         self.row += 1
 
     def header(self, labels: Sequence[str], col0: int = 1) -> None:

@@ -12,7 +12,7 @@ from openpyxl.chart.title import Title
 from openpyxl.drawing.text import CharacterProperties, Paragraph, ParagraphProperties, RegularTextRun
 from openpyxl.worksheet.worksheet import Worksheet
 
-from .cells import is_num
+from .cells import is_num, set_value
 
 #: Layout of a case sheet: charts to the right of the tables (columns A-H), data outside the print area.
 CHART_COL = 10  # J
@@ -45,7 +45,7 @@ def as_array(values: Any) -> np.ndarray:
 
 
 def _write_column(ws: Worksheet, col: int, row0: int, header: str, values: np.ndarray) -> None:
-    ws.cell(row=row0, column=col, value=header)
+    set_value(ws.cell(row=row0, column=col), header)
     for i, v in enumerate(values.tolist()):
         ws.cell(row=row0 + 1 + i, column=col, value=v if math.isfinite(v) else None)
 

@@ -26,7 +26,10 @@ from .cells import (
     page_setup,
     wind_label,
 )
+from ..io.display import flag_state
 from .charts import chart_title
+
+INCONCLUSIVE_NOTE = "inconclusive: run more realizations"
 
 
 # --------------------------------------------------------------------------- Summary
@@ -41,6 +44,7 @@ def write_summary(ws: Worksheet, docs: list[dict], names: list[str | None], thre
         cols.append((spec[1], (spec, "mean"), 9))
         if with_std and spec[4]:
             cols.append(("±", (spec, "std"), 7))
+    cols.append((SANITY_HEADER, None, 14))
     cols.append(("Note", None, 44))
     cur = Cursor(ws, top)
     for k, (label, _, width) in enumerate(cols):
@@ -72,7 +76,7 @@ def write_summary(ws: Worksheet, docs: list[dict], names: list[str | None], thre
                     link(cell, names[n_doc])
                 c += 1
             note = ""
-            for label, spec, _ in cols[len(SUMMARY_IDS):-1]:
+            for label, spec, _ in cols[len(SUMMARY_IDS):-2]:
                 (stat, _h, fmt, kind, _s), which = spec
                 if failed:
                     cur.put(row, left + c, None)
@@ -85,10 +89,19 @@ def write_summary(ws: Worksheet, docs: list[dict], names: list[str | None], thre
                     cur.put(row, left + c, value, "lc_number", fmt)
                     if stat == "Cont_R" and which == "mean":
                         cont_r_col = left + c
-                        v = entry.get("mean")
-                        if is_num(v) and v > threshold:
+                        state = flag_state(doc, r, threshold)  # issue 18: on the 95 % interval
+                        if state == "recommended":
                             note = FLAG_NOTE
+                        elif state == "inconclusive":
+                            note = INCONCLUSIVE_NOTE
                 c += 1
+            check, check_bad = ("", False) if failed else sanity_text(doc)
+            ccell = cur.put(row, left + c, check, "lc_text")
+            align(ccell, horizontal="center", wrap_text=True)
+            if check_bad:
+                ccell.font = Font(name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT)
+                ccell.fill = PatternFill("solid", fgColor=tpl.FLAG_FILL)
+            c += 1
             if failed:
                 note = f"FAILED: {doc['error']}"
             ncell = cur.put(row, left + c, note, "lc_text")
@@ -100,7 +113,8 @@ def write_summary(ws: Worksheet, docs: list[dict], names: list[str | None], thre
                 ncell.font = Font(name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT)
             if n_doc % 2 == 1:
                 for k in range(len(cols)):
-                    ws.cell(row=row, column=left + k).fill = band
+                    if not (k == len(cols) - 2 and check_bad):
+                        ws.cell(row=row, column=left + k).fill = band
             row += 1
     last = row - 1
     right = left + len(cols) - 1
@@ -112,10 +126,17 @@ def write_summary(ws: Worksheet, docs: list[dict], names: list[str | None], thre
                        fill=PatternFill("solid", fgColor=tpl.FLAG_FILL, bgColor=tpl.FLAG_FILL),
                        font=Font(bold=True, color=tpl.FLAG_FONT)))
     cur.row = last + 2
-    cur.note(f"Cont_R above {threshold:.0%} is flagged: {FLAG_NOTE} (the resonant share of the peak "
+    cur.note(f"Note: '{FLAG_NOTE}' where the 95 % interval of Cont_R lies above {threshold:.0%}, "
+             f"'{INCONCLUSIVE_NOTE}' where it straddles {threshold:.0%} (none where GF is ** or the reaction is below "
+             "5 % of the still-air load); the colour marks a mean Cont_R above it.")
+    cur.note(f"Cont_R above {threshold:.0%}: {FLAG_NOTE} (the resonant share of the peak "
              "that a quasi-static analysis misses; paper Sect. 5).")
     cur.note(f"{GF_UNDEFINED} : GF undefined, the mean reaction is zero by symmetry or below 1 % of the "
              "largest mean reaction of the case; peaks and contributions are still given.")
+    cur.note(f"{SANITY_HEADER.replace(chr(10), ' ')}: the time-domain statistics beside the frequency-domain "
+             "estimate of a synoptic case (sanity check, case sheet \"Spectral check\"); FLAG: they differ by more "
+             "than the sampling error explains, usually a lightly damped mode the record does not reach stationarity "
+             "for; — : downburst (no check); not run: run without the check (--no-check).")
     cur.note("Values are those of the JSON results: forces N/1000; Cont_* are the JSON fractions shown in %; "
              "± is the standard deviation over the realizations (n).")
     cur.note("Reactions at the tower of interest, wind-induced (still air excluded): Rx along the line, "
@@ -134,6 +155,29 @@ def write_summary(ws: Worksheet, docs: list[dict], names: list[str | None], thre
     ws.page_setup.fitToHeight = 0
     if not ws.page_setup.orientation:
         ws.page_setup.orientation = "landscape"
+
+
+#: Summary column of the time-vs-frequency sanity check of a synoptic case.
+SANITY_HEADER = "Time vs\nfreq."
+
+
+def sanity_text(doc: dict) -> tuple[str, bool]:
+    """Summary text of a case's time-vs-frequency sanity check and whether it failed.
+
+    ``"ok"``, ``"FLAG: Rz rms_resonant, ..."`` (the quantities that differ), ``"—"`` for a
+    downburst (no check), ``"not run"`` for a synoptic result without a spectral block.
+    """
+    if doc.get("wind") != "synoptic":
+        return "—", False
+    sp = doc.get("spectral")
+    checks = sp.get("sanity_check") if isinstance(sp, dict) else None
+    if not isinstance(checks, list) or not checks:
+        return "not run", False
+    bad = [f"{it.get('reaction', '')} {it.get('quantity', '')}".strip() for it in checks
+           if isinstance(it, dict) and not it.get("ok")]
+    if bad:
+        return "FLAG: " + ", ".join(bad), True
+    return "ok", False
 
 
 # --------------------------------------------------------------------------- Peaks

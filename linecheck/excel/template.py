@@ -29,6 +29,7 @@ from openpyxl.workbook.defined_name import DefinedName
 from openpyxl.worksheet.worksheet import Worksheet
 
 from ..core.errors import CaseError
+from .cells import set_value
 
 #: Defined names of the title block (filled from ``title=``; ``date`` defaults to today).
 TITLE_NAMES = ("project", "line", "section", "engineer", "checked_by", "date", "revision", "units_note")
@@ -224,6 +225,6 @@ def fill_title(wb: Workbook, values: dict[str, Any]) -> None:
             continue
         ws, cell = dest
         value = values.get(name, "")
-        ws[cell] = value
+        set_value(ws[cell], value)  # user text: stored as a text, never a formula
         if isinstance(value, (_dt.date, _dt.datetime)):
             ws[cell].number_format = "yyyy-mm-dd"

@@ -25,6 +25,7 @@ block's extremes, unless the result was saved with ``--full-histories``.
 
 from __future__ import annotations
 
+import io
 import json
 import os
 from collections.abc import Iterable, Sequence
@@ -121,9 +122,15 @@ def write_workbook(
     values = tpl.title_values(title)
     wb = tpl.load_template(template)
     build_workbook(wb, docs, values, float(cont_r_threshold), max(int(chart_points), 16), reactions)
+    # The zip is built in memory and written with one plain write: a full disk then fails on
+    # that write (a clean OSError, mapped to one line below), never inside zipfile, whose
+    # half-closed archive would print a ZipFile.__del__ traceback at exit.
+    buffer = io.BytesIO()
+    wb.save(buffer)
     try:
         with atomic_path(p, force=force, what="Excel") as tmp:
-            wb.save(tmp)
+            with open(tmp, "wb") as fh:
+                fh.write(buffer.getbuffer())
             _set_mode(tmp, p)
     except OSError as exc:
         raise CaseError(f"cannot write Excel file: {exc.strerror or exc}", file=str(p)) from None
@@ -228,6 +235,11 @@ def build_workbook(wb: Workbook, docs: list[dict], title: dict[str, Any], thresh
     for d, name in ok:
         ws = wb.create_sheet(name)
         write_case(ws, d, threshold, chart_points, summary, header_text, reactions)
+    if any(d.get("codes") for d, _ in ok):  # design codes (issue 19)
+        from .codes_sheet import write_codes
+
+        at = wb.sheetnames.index(peaks_name) + 1 if peaks_name in wb.sheetnames else None
+        write_codes(wb.create_sheet(sheet_name("Codes", taken), at), [d for d, _ in ok], summary)
     wb.active = wb.sheetnames.index(summary.title)
 
 

@@ -8,6 +8,7 @@ true.
 from __future__ import annotations
 
 import contextlib
+import errno
 import glob
 import os
 import stat
@@ -61,10 +62,18 @@ def check_target(path: str | Path, *, force: bool = True, what: str = "output") 
 
 @contextlib.contextmanager
 def atomic_path(path: str | Path, *, force: bool = True, what: str = "output") -> Iterator[Path]:
-    """Yield a temporary path next to ``path``; rename it over ``path`` on success."""
+    """Yield a temporary path next to ``path``; rename it over ``path`` on success.
+
+    An ``OSError`` while writing or renaming (a full disk, ENOSPC; a quota; an I/O error)
+    becomes a one-line :class:`CaseError` (exit 2) naming the file; the temporary file is
+    removed and an existing ``path`` is left as it was.
+    """
     p = check_target(path, force=force, what=what)
     clean_stale_temporaries(p)
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent if str(p.parent) else ".")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent if str(p.parent) else ".")
+    except OSError as exc:
+        raise CaseError(_os_message(what, exc), file=str(p)) from None
     os.close(fd)
     tmp_path = Path(tmp)
     try:
@@ -79,9 +88,21 @@ def atomic_path(path: str | Path, *, force: bool = True, what: str = "output") -
             os.replace(tmp_path, p)
         except PermissionError:
             raise CaseError(f"cannot replace {what} file (is it open in another program?)", file=str(p)) from None
+    except OSError as exc:
+        raise CaseError(_os_message(what, exc), file=str(p)) from None
     finally:
-        with contextlib.suppress(FileNotFoundError):
+        with contextlib.suppress(OSError):
             tmp_path.unlink()
+
+
+def _os_message(what: str, exc: OSError) -> str:
+    """One line for an operating-system error while writing an output file."""
+    reason = exc.strerror or str(exc) or type(exc).__name__
+    if exc.errno == errno.ENOSPC:
+        reason = "no space left on device; free some space and run again (nothing was written)"
+    elif exc.errno == errno.EDQUOT:
+        reason = "disk quota exceeded; free some space and run again (nothing was written)"
+    return f"cannot write {what} file: {reason}"
 
 
 def write_atomic(path: str | Path, writer: Callable[[Path], None], *, force: bool = True, what: str = "output") -> Path:

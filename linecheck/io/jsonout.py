@@ -180,6 +180,7 @@ def run_document(res: Any, *, full_histories: bool = False, max_points: int = 20
              "allowed_difference": _num(it.allowed), "ok": it.ok}
             for it in sanity_check(res)
         ]
+    doc["codes"] = codes_block(res)
     M = res.mean[:, j, :]
     B = res.background[0]
     R = res.resonant[0]
@@ -194,6 +195,34 @@ def run_document(res: Any, *, full_histories: bool = False, max_points: int = 20
     if extra:
         doc.update(extra)
     return document_of(res, doc)
+
+
+def codes_to_dict(cr: Any) -> dict[str, Any]:
+    """JSON of a :class:`~linecheck.service.CodesResult` (issue 19 contract):
+    ``{"ASCE74": {"edition", "verified", "provision", "inputs", "note", "load_per_length",
+    "towers": [{"index", "Ry": {"code_load", "linecheck_peak", "ratio", "verdict"}}]}, ...}``, N."""
+    out: dict[str, Any] = {}
+    for c in cr.checks:
+        out[c.code] = {
+            "edition": c.edition,
+            "verified": bool(c.verified),
+            "provision": c.provision,
+            "inputs": {k: _num(v) for k, v in c.inputs.items()},
+            "note": c.note,
+            "load_per_length": _num(c.load_per_length),
+            "towers": [{"index": t.index, **{r: {"code_load": _num(v.code_load), "linecheck_peak": _num(v.linecheck_peak),
+                                                 "ratio": _num(v.ratio), "verdict": v.verdict}
+                                             for r, v in t.reactions.items()}} for t in c.towers],
+        }
+    return out
+
+
+def codes_block(res: Any) -> dict[str, Any]:
+    """The ``"codes"`` block of a run document: the design codes beside the run's peaks; a code
+    outside its validity is reported, not raised (``linecheck codes`` raises instead)."""
+    from ..service import codes_analysis
+
+    return codes_to_dict(codes_analysis(res.case, res, strict=False))
 
 
 def spectral_to_dict(sp: Any) -> dict[str, Any]:

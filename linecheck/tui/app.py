@@ -33,12 +33,14 @@ from .screens.error import ErrorScreen
 from .screens.help import HelpScreen
 from .screens.prompt import PathPrompt
 from .widgets.browser import CaseBrowser
+from .widgets.codes import CodesView
 from .widgets.compare import CompareView
 from .widgets.params import ParameterEditor
 from .widgets.results import ResultsView
 from .widgets.runpanel import RunPanel
 
-MAIN_TABS = {"cases": "#case-tree", "params": "#params-table", "results": "#summary-table", "compare": "#compare-table"}
+MAIN_TABS = {"cases": "#case-tree", "params": "#params-table", "results": "#summary-table", "compare": "#compare-table",
+             "codes": "#codes-table"}
 STATE_ACTIONS = {"run", "cancel", "save_as", "revert", "pin", "export_excel", "export_json"}
 
 
@@ -53,6 +55,7 @@ class LinecheckApp(App[None]):
         Binding("2", "show_tab('params')", "Parameters", show=False),
         Binding("3", "show_tab('results')", "Results", show=False),
         Binding("4", "show_tab('compare')", "Compare", show=False),
+        Binding("5", "show_tab('codes')", "Codes", show=False),
         Binding("r", "run", "Run"),
         Binding("c", "cancel", "Cancel run"),
         Binding("s", "save_as", "Save as"),
@@ -93,6 +96,8 @@ class LinecheckApp(App[None]):
                 yield ResultsView()
             with TabPane("4 Compare", id="compare"):
                 yield CompareView()
+            with TabPane("5 Codes", id="codes"):
+                yield CodesView()
         yield RunPanel(id="run-panel")
         yield Footer()
 
@@ -340,6 +345,7 @@ class LinecheckApp(App[None]):
         try:
             self.query_one(ResultsView).show(out, self.pinned, stale=self._stale_note(out))
             self.query_one(CompareView).show(self.pinned, out)
+            self.query_one(CodesView).show(out.doc)
         except Exception as err:  # a display problem must not end the session
             self.show_error("Cannot show the result", f"{type(err).__name__}: {err}")
         tab = "compare" if self.pinned is not None and self.pinned is not out else "results"

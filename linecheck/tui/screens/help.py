@@ -16,7 +16,7 @@ Design check of conductor reactions under downburst and synoptic winds
 
 ## Keys
 
-- `1` `2` `3` `4`: tabs Cases, Parameters, Results, Compare
+- `1` `2` `3` `4` `5`: tabs Cases, Parameters, Results, Compare, Codes (design codes beside the peaks)
 - arrows, `enter`: move; open a case (Cases) or edit a parameter (Parameters)
 - `e`: edit the highlighted parameter; `enter` applies, `esc` cancels
 - `s`: save the edited case as a new TOML file in the working folder (an existing file is never

@@ -1,0 +1,59 @@
+"""The "Codes" sheet: design-code conductor wind loads beside linecheck's peaks (issue 19).
+
+Reads the ``"codes"`` block of each run document (:func:`linecheck.io.jsonout.codes_block`);
+it computes nothing itself.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from openpyxl.worksheet.worksheet import Worksheet
+
+from .cells import KN3, RATIO, Cursor, kn, page_setup
+
+COLUMNS = (("Case", 18), ("Code", 11), ("Edition", 30), ("Verified", 9), ("Tower", 6), ("Reaction", 9),
+           ("Code load\n(kN)", 11), ("linecheck peak\n(kN)", 13), ("Ratio", 8), ("Verdict", 26), ("Note", 60))
+
+
+def write_codes(ws: Worksheet, docs: list[dict[str, Any]], like: Worksheet | None = None) -> int:
+    """Fill ``ws`` with one row per case, code, tower and reaction; returns the rows written."""
+    from openpyxl.utils import get_column_letter
+
+    cur = Cursor(ws, 1)
+    cur.put(1, 1, "Design codes: conductor wind load on the transverse reaction vs linecheck's peak", "lc_section")
+    cur.row = 3
+    cur.header([c for c, _ in COLUMNS])
+    for k, (_, width) in enumerate(COLUMNS):
+        ws.column_dimensions[get_column_letter(k + 1)].width = width
+    ws.row_dimensions[3].height = 30
+    n = 0
+    for doc in docs:
+        block = doc.get("codes") if "error" not in doc else None
+        if not block:
+            continue
+        for code, c in block.items():
+            for t in c.get("towers", []):
+                for r, v in t.items():
+                    if r == "index":
+                        continue
+                    row = cur.row
+                    cur.put(row, 1, doc.get("case"), "lc_text")
+                    cur.put(row, 2, code, "lc_text")
+                    cur.put(row, 3, c.get("edition"), "lc_text")
+                    cur.put(row, 4, "yes" if c.get("verified") else "no", "lc_text")
+                    cur.put(row, 5, t["index"])
+                    cur.put(row, 6, r, "lc_text")
+                    cur.put(row, 7, kn(v.get("code_load")), fmt=KN3)
+                    cur.put(row, 8, kn(v.get("linecheck_peak")), fmt=KN3)
+                    cur.put(row, 9, v.get("ratio"), fmt=RATIO)
+                    cur.put(row, 10, v.get("verdict"), "lc_text")
+                    cur.put(row, 11, c.get("note"), "lc_note")
+                    cur.row += 1
+                    n += 1
+    cur.row += 1
+    cur.note("linecheck peak: mean over realizations of the wind-induced dynamic peak (peak_dynamic); "
+             "ratio = linecheck peak / code load. Unverified codes are shown, not judged (docs/codes.md).")
+    ws.freeze_panes = "A4"
+    page_setup(ws, like)
+    return n

@@ -70,3 +70,9 @@ def _validate_written_results(request):
             continue
         if isinstance(d, dict) and "schema_version" in d and "reactions" in d:
             _check_result(d, str(p))
+
+
+def pytest_terminal_summary(terminalreporter):
+    n = _SCHEMA_STATS["validated"]
+    if n:
+        terminalreporter.write_line(f"result documents validated against docs/results.schema.json: {n}")

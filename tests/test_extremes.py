@@ -171,3 +171,15 @@ def test_flag_state_at_another_threshold():
     assert flag_state(doc, "Rx", 0.05) == "recommended"
     assert flag_state(doc, "Ry", 0.05) == "inconclusive"
     assert flag_state(doc, "Ry", 0.08) is None
+
+
+def test_how_to_read_notes_only_when_they_apply():
+    from linecheck.io.display import HOW_TO_READ_GF_BELOW_1, HOW_TO_READ_NEGATIVE_CONT_BG, how_to_read
+
+    def doc(gf, bg):
+        return {"reactions": {"Rx": {"GF_Dy": {"mean": 1.2}, "GF_QS": {"mean": gf}, "Cont_BG": {"mean": bg}},
+                              "Ry": {"GF_Dy": {"mean": None}, "GF_QS": {"mean": None}, "Cont_BG": {"mean": 0.1}}}}
+
+    assert how_to_read(doc(1.1, 0.05)) == []
+    assert how_to_read(doc(0.94, -0.04)) == [HOW_TO_READ_GF_BELOW_1, HOW_TO_READ_NEGATIVE_CONT_BG]
+    assert how_to_read(doc(0.99, 0.01)) == [HOW_TO_READ_GF_BELOW_1]

@@ -512,6 +512,7 @@ def join_runs(parts: list[RunResult]) -> RunResult:
 
 
 UNTIL_OVERSHOOT = 1.1  # next count: 10 % above the n (se ~ 1/sqrt(n)) predicts, to stop in few chunks
+UNTIL_MAX_CHUNK = 50  # realizations added per chunk at most: bounds a chunk's memory (resource guard)
 
 
 def run_until(
@@ -529,7 +530,8 @@ def run_until(
     ``max_realizations`` have run (issue 18).
 
     Starts with ``analysis.realizations`` (at most the cap); each next count is the one the
-    1/sqrt(n) law predicts, times :data:`UNTIL_OVERSHOOT`.  Realization r always gets the same
+    1/sqrt(n) law predicts, times :data:`UNTIL_OVERSHOOT`, adding at most
+    :data:`UNTIL_MAX_CHUNK` realizations per chunk.  Realization r always gets the same
     turbulence, so the result is bit-identical to ``run_case`` with the same count.
     """
     if not target > 0:
@@ -545,7 +547,7 @@ def run_until(
             return dataclasses.replace(res, until=UntilInfo(float(target), achieved, bool(achieved <= target),
                                                             int(max_realizations)))
         want = done * (achieved / target) ** 2 * UNTIL_OVERSHOOT if np.isfinite(achieved) else 2 * done
-        nxt = int(min(max_realizations, max(done + 1, int(np.ceil(want)))))
+        nxt = int(min(max_realizations, done + UNTIL_MAX_CHUNK, max(done + 1, int(np.ceil(want)))))
         parts.append(run_case(case, realizations=np.arange(done, nxt), interpolate_states=interpolate_states,
                               spectral_check=False, progress=progress, cancel=cancel, warn=warn))
 

@@ -22,6 +22,7 @@ CORE_MODULES = [
     "linecheck.core.wind.mean",
     "linecheck.core.wind.turbulence",
     "linecheck.core.wind.point",
+    "linecheck.core.wind.ring",
     "linecheck.service",
     "linecheck.io.jsonout",
     "linecheck.io.display",

@@ -590,3 +590,24 @@ def test_export_description_marks_edits_unless_the_user_rewrote_it() -> None:
     rewritten = with_value(edited, "description", "my variant at 30 m/s")
     own = {**doc, "description": rewritten.description}
     assert doc_for_export(own, rewritten, original) is own  # the user's own words stay
+
+
+async def test_model_spread_action(tmp_path: Path) -> None:
+    """m runs a downburst case under every built-in model: the document gets the "models" block
+    (same as the service's) and the summary notes list each model and the envelope."""
+    folder = tmp_path / "cases"
+    folder.mkdir()
+    write_case(folder, "case07-single.toml", "db", **{"analysis.duration": 30.0, "analysis.realizations": 1})
+    messages = Recorder()
+    app = LinecheckApp([folder])
+    async with app.run_test(size=SIZE, message_hook=messages) as pilot:
+        await pilot.pause()
+        await pilot.press("enter")
+        await wait_for(pilot, lambda: of_type(messages, msg.CaseOpened), "CaseOpened", messages)
+        await pilot.press("m")
+        await wait_for(pilot, lambda: of_type(messages, msg.RunFinished), "RunFinished", messages)
+        doc = of_type(messages, msg.RunFinished)[-1].output.doc
+        assert list(doc["models"]) == ["holmes-oliver", "ring-jet"]
+        assert doc["models"]["holmes-oliver"] == doc["reactions"]
+        notes = str(app.query_one("#summary-notes", Static).render())
+        assert "ring-jet" in notes and "envelope" in notes

@@ -31,7 +31,9 @@ required for `type = "downburst"` and rejected for `"synoptic"`; `span_speeds` (
 has one entry per span; a `preset` and explicit `jet_diameter`/`distance`/`angle` must agree;
 `time_step` ≤ `duration`/4; `sag` < `height` (the lowest point of a parabola of average
 elevation `height` is `height` − `sag`/3; insulator swing lifts the conductor, so no swing
-allowance is added); with suspension towers, `insulator_length` < `height`.
+allowance is added); with suspension towers, `insulator_length` < `height`; downburst `model`
+(default `"table"` with a `field`, else `"holmes-oliver"`): `"table"` needs `field`, `field`
+needs `"table"`, `jet_velocity` is for `"ring-jet"` only and `t1`/`t_f` are not (docs/wind.md).
 
 Hostile input: every key and string value is refused if it holds a control character (C0
 except tab, DEL, C1: they would inject terminal escape sequences and are illegal in Excel),

@@ -209,6 +209,7 @@ class ScanResult:
     v_max: float | None = None
     elapsed: float = 0.0
     executor: str = ""
+    model: str | None = None  # downburst model scanned (issue 15); None: the case's own
 
     @property
     def n_failed(self) -> int:
@@ -276,8 +277,11 @@ def run_scan(
     chunk_size: int | None = None,
     progress: Callable[[str, int, int], None] | None = None,
     cancel: threading.Event | None = None,
+    model: str | None = None,
 ) -> ScanResult:
     """Step 1 at every grid point of ``grid`` for the case in ``case_path``.
+
+    ``model``: scan under this downburst running-mean model (issue 15; ``None``: the case's own).
 
     Args:
         hold: ``"jet"`` (default): one storm, V_max held at its value for the case's own
@@ -299,6 +303,10 @@ def run_scan(
         raise CaseError('wind.type: a scan needs a downburst case (type = "downburst")', file=str(path))
     if hold not in HOLDS:
         raise CaseError(f"--hold: value {hold!r} is not allowed: expected one of {', '.join(HOLDS)}")
+    if model is not None:
+        from ..service import case_with_model
+
+        case = case_with_model(case, model)
     v_max = None
     if hold == "jet":
         from ..core.wind.mean import downburst_field
@@ -312,6 +320,8 @@ def run_scan(
     for a in range(0, n, size):
         chunk = [tuple(map(float, p)) for p in pts[a:a + size]]
         kwargs = {"cancel": cancel} if executor.in_process and cancel is not None else {}
+        if model is not None:
+            kwargs["model"] = model
         handles.append(executor.submit(scan_chunk, str(path), chunk, a, digest, v_max, **kwargs))
     peak = np.full((n, 3), np.nan)
     tt = np.full((n, 3), np.nan)
@@ -347,7 +357,7 @@ def run_scan(
         executor.abort([handles[i] for i in pending])
         raise
     return ScanResult(case, path, pts, peak, tt, vref, tuple(errors), hold, v_max,
-                      time.perf_counter() - t0, executor.describe())
+                      time.perf_counter() - t0, executor.describe(), model)
 
 
 def critical_jobs(result: ScanResult, reactions: Sequence[str] = ("Rx", "Ry")) -> list[RunJob]:
@@ -360,8 +370,15 @@ def critical_jobs(result: ScanResult, reactions: Sequence[str] = ("Rx", "Ry")) -
     for (r, th, dj), names in groups.items():
         tag = "-".join(names)
         changes = {"name": f"{result.case.name} critical {', '.join(names)}", **scan_changes(r, th, dj)}
+        suffix = ""
+        if result.model is not None:
+            from ..service import model_changes
+
+            changes.update(model_changes(result.case, result.model))
+            changes["name"] += f" [{result.model}]"
+            suffix = f".{result.model}"
         jobs.append(RunJob(result.case_path, label=changes["name"], changes=changes,
-                           json_name=f"{stem}-critical-{tag}.json"))
+                           json_name=f"{stem}-critical-{tag}{suffix}.json"))
     return jobs
 
 

@@ -198,8 +198,11 @@ def scan_chunk(
     v_max: float | None = None,
     *,
     cancel: threading.Event | None = None,
+    model: str | None = None,
 ) -> Any:
     """Step 1 at each (distance R [m], angle Theta [deg], jet diameter D_j [m]) of ``points``.
+
+    ``model``: the downburst running-mean model to scan under (issue 15; ``None``: the case's own).
 
     ``v_max`` [m/s]: the storm's fixed V_max (see :func:`scan_point`), or ``None``.
 
@@ -210,6 +213,10 @@ def scan_chunk(
         case = load_checked(case_path, expected_hash)
         if case.wind.type != "downburst" or case.wind.downburst is None:
             raise CaseError('wind.type: a scan needs a downburst case (type = "downburst")', file=str(case_path))
+        if model is not None:
+            from ..service import model_changes
+
+            case = apply_changes(case, model_changes(case, model))
     except LinecheckError as err:
         return Failure.of(err)
     n = len(points)

@@ -342,6 +342,10 @@ def batch(
         "--progress-interval", help="Output not a terminal (CI, logs): print a progress line at most every this "
                                     "many seconds, when one more realization is done (0: every realization).",
         min=0.0)] = 5.0,
+    models: Annotated[str | None, typer.Option(
+        "--models", help='Downburst model spread: run every case under "all" built-in running-mean models (or a '
+                         'comma list) with the same seeds; <stem>.<model>.json per run, <stem>.json with the '
+                         '"models" block and envelope.', show_default=False)] = None,
     until: UntilOpt = None,
     max_realizations: MaxRealOpt = 1000,
 ) -> None:
@@ -353,6 +357,11 @@ def batch(
     fields = title_block(project, line, engineer, revision, title, excel=excel)
     paths = expand_cases(cases)
     target = parse_until(until)
+    plan = None
+    if models is not None:
+        from ..batch.models import model_jobs
+
+        paths, plan = model_jobs(paths, models)
     _check_excel(excel, force, template)
     out_dir = json_dir if json_dir is not None else ((excel.parent if excel is not None else Path.cwd()) / "results")
     cancel = threading.Event()
@@ -376,8 +385,20 @@ def batch(
         err_console.print(f"[bold red]interrupted[/]: finished cases are saved in {out_dir}; "
                           "run again with --resume to do the rest", highlight=False)
         raise typer.Exit(130)
+    docs = report.docs()
+    if plan is not None:
+        from ..batch.models import combined_documents
+        from ..io.jsonout import write_json
+
+        docs = combined_documents(report, plan)
+        for path, doc in zip(plan, docs):
+            if "models" in doc:
+                write_json(out_dir / f"{path.stem}.json", doc)
+        console.print(f"model spread: {sum('models' in d for d in docs)} case document(s) with a \"models\" block "
+                      f"in {out_dir}",
+                      highlight=False)
     if excel is not None:
-        _write_excel(report.docs(), excel, force, template, fields)
+        _write_excel(docs, excel, force, template, fields)
         console.print(f"wrote {excel}")
     if report.failed:
         err_console.print(f"[bold red]error:[/] {len(report.failed)} case(s) failed: "
@@ -389,8 +410,21 @@ def batch(
 PAPER_CRITICAL = {"Rx": ("Db_x", 1.6, 30.0), "Ry": ("Db_y", 1.2, 0.0)}  # paper Table 2 (El Damatty et al. 2013)
 
 
+def models_scan_table(results: list[Any]) -> Table:
+    """Critical configuration per downburst model (issue 15)."""
+    t = Table(title="critical configuration per downburst model", title_justify="left")
+    for col in ("model", "reaction", "R m", "R/D_j", "Θ deg", "D_j m", "max |mean| kN", "at t s"):
+        t.add_column(col, justify="right" if col not in ("model", "reaction") else "left")
+    for res in results:
+        for c in res.criticals(("Rx", "Ry")):
+            t.add_row(res.model or "", c.reaction, f"{c.distance:.0f}", f"{c.distance_over_dj:.2f}", f"{c.angle:g}",
+                      f"{c.jet_diameter:.0f}", f"{c.value / 1e3:.3f}", f"{c.time:.1f}")
+    return t
+
+
 def scan_table(result: Any) -> Table:
-    t = Table(title=f"{result.case.name}: critical downburst configurations "
+    model = escape(f" [{result.model}]") if getattr(result, "model", None) else ""
+    t = Table(title=f"{result.case.name}{model}: critical downburst configurations "
                     f"(tower {result.case.line.tower_of_interest}, step 1)", title_justify="left")
     for col in ("reaction", "R m", "R/D_j", "Θ deg", "D_j m", "max |mean| kN", "at t s", "V_ref at p m/s", "paper"):
         t.add_column(col, justify="right")
@@ -412,6 +446,55 @@ def dynamic_table(report: Any) -> Table:
                   _kn(d, "Rx", "GF_Dy", 1.0, "{:.3f}"), _kn(d, "Ry", "GF_Dy", 1.0, "{:.3f}"),
                   _kn(d, "Rx", "Cont_R", 100.0, "{:.1f}"), _kn(d, "Ry", "Cont_R", 100.0, "{:.1f}"))
     return t
+
+
+def _scan_each_model(case_file: Path, case: Any, grid: Any, names: tuple[str, ...], *, hold: str,
+                     csv_out: Path | None, dynamic: bool, json_dir: Path | None, jobs: int | None,
+                     scheduler: str | None) -> None:
+    """``scan --models``: the scan under each downburst model, then the critical position per model."""
+    from ..batch import make_executor, run_critical, run_scan, write_scan_csv
+    from .progress import progress_bar
+
+    cancel = threading.Event()
+    with make_executor(jobs, scheduler) as executor:
+        summary = []
+        for model in names:
+            try:
+                with progress_bar() as cb:
+                    result = run_scan(case_file, grid, executor=executor, hold=hold, progress=cb, cancel=cancel,
+                                      model=model)
+            except KeyboardInterrupt:
+                cancel.set()
+                raise
+            console.print(scan_table(result))
+            strength = (f"one storm, V_max = {result.v_max:.1f} m/s (the case's own configuration)"
+                        if result.hold == "jet" else f"V_ref = {case.wind.v_ref:g} m/s at point p everywhere")
+            console.print(f"[dim]{grid.size} configurations in {result.elapsed:.1f} s on {escape(result.executor)}; "
+                          f"{strength}; value = wind-induced mean reaction with the largest magnitude over the "
+                          "event.[/]", highlight=False)
+            if result.n_failed:
+                first = next(e for e in result.errors if e)
+                err_console.print(f"[yellow]warning:[/] {result.n_failed} configuration(s) failed and were left out, "
+                                  f"e.g.: {escape(first)}", highlight=False, soft_wrap=True)
+            if csv_out is not None:
+                target = csv_out if model is None else csv_out.with_name(f"{csv_out.stem}.{model}{csv_out.suffix}")
+                write_scan_csv(result, target)
+                console.print(f"wrote {target}")
+            if not result.criticals():
+                raise CaseError("no scan configuration could be analysed", file=str(case_file))
+            summary.append(result)
+            if dynamic:
+                console.print(f"[dim]full analysis at the critical configurations with the case's V_ref = "
+                              f"{case.wind.v_ref:g} m/s at point p[/]", highlight=False)
+                with BatchDisplay() as display:
+                    report = run_critical(result, executor=executor, json_dir=json_dir, progress=display, cancel=cancel)
+                console.print(dynamic_table(report))
+                if report.cancelled:
+                    raise typer.Exit(130)
+                if report.failed:
+                    raise typer.Exit(1)
+        if len(summary) > 1:
+            console.print(models_scan_table(summary))
 
 
 @app.command()
@@ -440,6 +523,9 @@ def scan(
     scheduler: SchedulerOpt = None,
     max_memory: MaxMemoryOpt = None,
     connect_timeout: ConnectTimeoutOpt = 10.0,
+    models: Annotated[str | None, typer.Option(
+        "--models", help='Scan under "all" built-in downburst running-mean models (or a comma list) and report '
+                         "the critical position per model.", show_default=False)] = None,
 ) -> None:
     """Find the critical downburst configurations: step 1 over a grid of positions and sizes."""
     apply_max_memory(max_memory)  # each step-1 task checks its memory estimate
@@ -452,6 +538,12 @@ def scan(
     if csv_out is not None:
         check_target(csv_out, what="CSV")
     cancel = threading.Event()
+    if models is not None:
+        from .. import service
+
+        _scan_each_model(case_file, case, grid, service.parse_models(case, models), hold=hold, csv_out=csv_out,
+                         dynamic=dynamic, json_dir=json_dir, jobs=jobs, scheduler=scheduler)
+        return
     with make_executor(jobs, scheduler, connect_timeout) as executor:
         try:
             with progress_bar() as cb:

@@ -12,7 +12,7 @@ from .. import service
 from ..core.case import Case
 from ..core.results import REACTIONS
 from ..io.atomic import check_target
-from ..io.display import SUMMARY_STATS
+from ..io.display import SUMMARY_STATS, stat_text
 from ..io.jsonout import _num, run_to_dict, write_json
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .export_cmd import (
@@ -32,6 +32,10 @@ from .progress import progress_bar
 from .stats_view import MaxRealOpt, UntilOpt, design_table, parse_until
 from .stats_view import notes as stats_notes
 
+ModelsOpt = Annotated[str | None, typer.Option(
+    "--models", help='Downburst model spread: run the case under "all" built-in running-mean models '
+                     '(or a comma list, e.g. holmes-oliver,ring-jet) with the same turbulence seeds; '
+                     'adds a "models" block and the envelope.', show_default=False)]
 RealOpt = Annotated[int | None, typer.Option("--realizations", "-n", help="Number of realizations (overrides the case).", min=1)]
 SeedOpt = Annotated[int | None, typer.Option("--seed", help="Random seed (overrides the case).", min=0)]
 
@@ -132,6 +136,31 @@ def burn_in_note(doc: dict) -> str | None:
             "at 10 x duration) or analysis.burn_in, or set analysis.structural_damping (docs/method.md, Damping).")
 
 
+def models_table(doc: dict) -> Table:
+    """Rich table of the model spread (issue 15): one row per model and the envelope."""
+    by_key = {st.key: st for st in SUMMARY_STATS}
+    stat_by_key = by_key.__getitem__
+    n = doc["realizations"]
+    keys = ("mean_max", "peak_dynamic", "GF_Dy", "GF_QS", "peak_normalised")
+    t = Table(title=f"{doc['case']}: downburst model spread at tower {doc['tower_of_interest']}", title_justify="left")
+    t.add_column("model", justify="left", no_wrap=True)
+    for r in ("Rx", "Ry"):
+        for k in keys:
+            st = stat_by_key(k)
+            t.add_column(f"{r} {st.label}" + (f" {st.unit}" if st.unit != "-" else ""), justify="right")
+    for name, blk in doc["models"].items():
+        t.add_row(name, *(stat_text(blk[r][k], stat_by_key(k), n) for r in ("Rx", "Ry") for k in keys))
+    env = doc["models_envelope"]
+    cells = []
+    for r in ("Rx", "Ry"):
+        for k in keys:
+            e = env[r][k]
+            st = stat_by_key(k)
+            cells.append("" if e["value"] is None else f"{st.fmt.format(e['value'] * st.scale)} ({e['model']})")
+    t.add_row("[bold]envelope[/]", *cells)
+    return t
+
+
 def print_burn_in(doc: dict) -> None:
     """Say how much of a synoptic record was discarded, and when it is not enough (issue 10): one line."""
     b = doc.get("burn_in")
@@ -164,6 +193,7 @@ def run(
     engineer: EngineerOpt = None,
     revision: RevisionOpt = None,
     title: TitleOpt = None,
+    models: ModelsOpt = None,
     until: UntilOpt = None,
     max_realizations: MaxRealOpt = 1000,
 ) -> None:
@@ -178,18 +208,30 @@ def run(
         from ..excel.writer import check_excel_target
 
         check_excel_target(excel, force=force, template=template)
+    names = service.parse_models(case, models) if models is not None else ()
     with progress_bar() as cb:
-        if target is None:
-            res = service.run_case(case, progress=cb, spectral_check=not no_check, warn=limits_warn)
-        else:
+        if names:
+            spread = service.run_models(case, names, progress=cb, spectral_check=not no_check, warn=limits_warn)
+            own = case.wind.downburst.model_name
+            res = spread[own] if own in spread else next(iter(spread.values()))
+        elif target is not None:
             res = service.run_until(case, target, max_realizations=max_realizations, progress=cb,
                                     spectral_check=not no_check, warn=limits_warn)
+        else:
+            res = service.run_case(case, progress=cb, spectral_check=not no_check, warn=limits_warn)
     doc = run_to_dict(res, full_histories=full_histories)
+    if names:
+        from ..io.jsonout import models_block
+
+        doc["model"] = res.case.wind.downburst.model_name
+        doc.update(models_block(spread))
     console.print(results_table(doc))
     console.print(design_table(doc))
     for note in stats_notes(doc):
         console.print(f"[dim]{note}[/]", highlight=False)
     print_legend(doc)
+    if names:
+        console.print(models_table(doc))
     from .spectral_cmd import print_sanity
 
     print_burn_in(doc)

@@ -88,6 +88,8 @@ def series_summary(case: Case, s: PointSeries) -> dict[str, Any]:
             "r_max": _f(fld.r_max), "radial_decay": _f(fld.radial_decay), "z_max": _f(fld.z_max),
             "delta": _f(fld.delta), "t1": _f(fld.t1), "t_f": _f(fld.t_f),
             "translation_speed": _f(db.translation_speed), "translation_direction": _f(db.translation_direction),
+            "model": db.model_name,
+            "jet_velocity": _f(fld.ring.jet_velocity) if fld.ring is not None else None,
         }
     return doc
 

@@ -28,6 +28,11 @@ from .errors import CaseError
 SUPPORT_TYPES = ("strain", "suspension")
 WIND_TYPES = ("synoptic", "downburst")
 DOWNBURST_PRESETS = ("Db_x", "Db_y")
+# Downburst running-mean models (issue 15; docs/wind.md).  "holmes-oliver": separable
+# Holmes-Oliver x Wood x Chay; "table": the user field file; "ring-jet": travelling ring vortex +
+# wall jet (linecheck/core/wind/ring.py).  A file without ``model`` keeps its meaning: "table" when
+# it names a ``field``, else "holmes-oliver" (see docs/wind.md for the choice of default).
+DOWNBURST_MODELS = ("holmes-oliver", "table", "ring-jet")
 DAMPING_MODELS = ("quasi-steady", "paper")
 CODE_TERRAINS = ("sea", "open", "suburban", "urban")  # [codes] terrain (docs/codes.md)
 # Conductor self-damping assumed with the quasi-steady model (ratio at the lowest mean-state
@@ -116,6 +121,7 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         FieldSpec("span_speeds", "float_list", "m/s", "synoptic only: mean speed per span (default v_ref on every span)", low=0.0, high=150.0),
     ),
     "wind.downburst": (
+        FieldSpec("model", "choice", "-", 'running-mean model (default: "table" with a field file, else "holmes-oliver")', choices=DOWNBURST_MODELS),
         FieldSpec("preset", "choice", "-", "critical configuration: Db_x (D_j=2L, R=1.6D_j, 30 deg) or Db_y (D_j=2L, R=1.2D_j, 0 deg)", choices=DOWNBURST_PRESETS),
         _f("jet_diameter", "m", "downburst jet diameter D_j", low=10.0, high=1e5),
         _f("distance", "m", "distance R from the tower of interest to the downburst centre", low=0.0, high=1e6),
@@ -128,6 +134,7 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         _f("translation_speed", "m/s", "storm translation speed (Holmes & Oliver vector sum)", default=0.0, low=0.0, high=100.0),
         _f("translation_direction", "deg", "direction of storm travel, from +x toward +y", default=90.0, low=-360.0, high=360.0),
         FieldSpec("field", "str", "", "user running-mean field file (CSV or NPZ), relative to the case file"),
+        _f("jet_velocity", "m/s", 'model "ring-jet": downdraft speed V_j setting the time scale D_j/V_j (default: from v_ref at p)', low=0.0, high=200.0, low_open=True),
     ),
     "analysis": (
         _f("duration", "s", "analysed record length (downburst default: 0 to T_f)", low=0.0, high=1e5, low_open=True),
@@ -209,6 +216,15 @@ class Downburst:
     translation_direction: float = 90.0  # [deg]
     field: str | None = None  # path as written in the file
     field_path: Path | None = None  # resolved path
+    model: str | None = None  # None: derived, see model_name
+    jet_velocity: float | None = None  # [m/s] V_j ("ring-jet")
+
+    @property
+    def model_name(self) -> str:
+        """The running-mean model in force: ``model``, else "table" with a field, else "holmes-oliver"."""
+        if self.model is not None:
+            return self.model
+        return "table" if self.field is not None else "holmes-oliver"
 
 
 @dataclass(frozen=True)
@@ -531,6 +547,17 @@ def _build_downburst(d: dict[str, Any], line: Line, ctx: _Ctx, base_dir: Path | 
             raise ctx.error(sec, key, f"missing: give {key} or a preset (\"Db_x\" or \"Db_y\")")
     if d["t1"] is not None and d["t_f"] is not None and d["t_f"] <= d["t1"]:
         raise ctx.error(sec, "t_f", f"value {d['t_f']!r} is not allowed: expected t_f > t1 = {d['t1']!r}")
+    model = d["model"] if d["model"] is not None else ("table" if d["field"] is not None else "holmes-oliver")
+    if model == "table" and d["field"] is None:
+        raise ctx.error(sec, "model", 'value "table" needs a field file: give field = "file.csv" (or .npz), see docs/wind.md')
+    if model != "table" and d["field"] is not None:
+        raise ctx.error(sec, "field", f'is read by model "table" only, but model = "{model}": remove field or set model = "table"')
+    if model != "ring-jet" and d["jet_velocity"] is not None:
+        raise ctx.error(sec, "jet_velocity", f'is a parameter of model "ring-jet" only, but model = "{model}": remove it')
+    if model == "ring-jet":
+        for key in ("t1", "t_f"):
+            if d[key] is not None:
+                raise ctx.error(sec, key, f'shapes the "holmes-oliver" time history only; model "ring-jet" takes its time scale from D_j/V_j (jet_velocity): remove {key}')
     path = None
     if d["field"] is not None:
         path = Path(d["field"])

@@ -67,6 +67,8 @@ def write_case(ws: Worksheet, doc: dict, threshold: float, chart_points: int, su
         _inputs_table(cur, doc, params)
     _still_air_and_step1(cur, doc)
     _stats_table(cur, doc)
+    if isinstance(doc.get("models"), dict):
+        _models_table(cur, doc)
     contrib_rows = _contributions_table(cur, doc, threshold, flagged)
     _towers_table(cur, doc)
     if isinstance(doc.get("spectral"), dict):
@@ -250,6 +252,30 @@ def _stats_table(cur: Cursor, doc: dict) -> None:
         cur.row += 1
     for stat in ("peak_dynamic", "GF_Dy", "Cont_R", "peak_normalised"):
         cur.note(f"{stat}: {STAT_INFO[stat][3]}")
+
+
+def _models_table(cur: Cursor, doc: dict) -> None:
+    """Downburst model spread (issue 15): each model's realization means and the envelope."""
+    stats = ("mean_max", "peak_dynamic", "GF_Dy", "peak_normalised")
+    cur.section(f"Downburst model spread at tower {doc['tower_of_interest']} (realization means; "
+                f"this sheet's other tables: model {doc.get('model', '?')})")
+    cur.header(["Model", "Reaction", *stats, "", ""])
+    rows = list(doc["models"].items()) + [("envelope", None)]
+    for name, blk in rows:
+        for r in ("Rx", "Ry"):
+            cur.put(cur.row, 1, name if r == "Rx" else "", "lc_text")
+            cur.put(cur.row, 2, r, "lc_text")
+            for k, stat in enumerate(stats):
+                unit, fmt, kind, _meaning = STAT_INFO[stat]
+                if blk is None:
+                    e = doc["models_envelope"][r][stat]
+                    cur.put(cur.row, 3 + k, cell_value(e.get("value"), kind), fmt=fmt)
+                else:
+                    cur.put(cur.row, 3 + k, cell_value(((blk.get(r) or {}).get(stat) or {}).get("mean"), kind), fmt=fmt)
+            cur.row += 1
+    env = doc["models_envelope"]
+    cur.note("Envelope governed by: " + "; ".join(
+        f"{r} {stat} {env[r][stat]['model']}" for r in ("Rx", "Ry") for stat in stats))
 
 
 def _contributions_table(cur: Cursor, doc: dict, threshold: float,

@@ -225,6 +225,39 @@ def codes_block(res: Any) -> dict[str, Any]:
     return codes_to_dict(codes_analysis(res.case, res, strict=False))
 
 
+def reactions_block(res: Any, tower: int | None = None) -> dict[str, Any]:
+    """``{"Rx": {stat: {...}, "dynamic_analysis"}, "Ry": .., "Rz": ..}`` of one tower (0-based; default
+    the tower of interest) of a RunResult: the same typed block as the document's ``"reactions"``
+    (issue 18: mean, std, se, fractiles, Gumbel fits, intervals, the Cont_R flag)."""
+    from .document import _reactions_json, reactions_of
+
+    return _reactions_json(reactions_of(res.summary(), res.tower_index if tower is None else tower))
+
+
+def models_block(results: dict[str, Any]) -> dict[str, Any]:
+    """Model spread of issue 15: ``{"models": {name: <same as "reactions">}, "models_envelope":
+    {R: {stat: {"value", "model"}}}}`` at the tower of interest.  The envelope takes, per
+    reaction and statistic, the realization mean of largest magnitude and names its model."""
+    return models_from_reactions({name: reactions_block(res) for name, res in results.items()})
+
+
+def models_from_reactions(models: dict[str, Any]) -> dict[str, Any]:
+    """:func:`models_block` from each model's ``"reactions"`` block (e.g. of saved documents)."""
+    from ..core.results import REACTIONS, STATISTICS
+
+    env: dict[str, Any] = {}
+    for r in REACTIONS:
+        env[r] = {}
+        for s in STATISTICS:
+            best, who = None, None
+            for name, blk in models.items():
+                v = blk[r][s]["mean"]
+                if v is not None and (best is None or abs(v) > abs(best)):
+                    best, who = v, name
+            env[r][s] = {"value": best, "model": who}
+    return {"models": models, "models_envelope": env}
+
+
 def spectral_to_dict(sp: Any) -> dict[str, Any]:
     """JSON block of a :class:`~linecheck.service.SpectralResult` (reactions at the tower of interest)."""
     from ..core.results import REACTIONS

@@ -41,7 +41,7 @@ from .widgets.runpanel import RunPanel
 
 MAIN_TABS = {"cases": "#case-tree", "params": "#params-table", "results": "#summary-table", "compare": "#compare-table",
              "codes": "#codes-table"}
-STATE_ACTIONS = {"run", "cancel", "save_as", "revert", "pin", "export_excel", "export_json"}
+STATE_ACTIONS = {"run", "run_models", "cancel", "save_as", "revert", "pin", "export_excel", "export_json"}
 
 
 class LinecheckApp(App[None]):
@@ -57,6 +57,7 @@ class LinecheckApp(App[None]):
         Binding("4", "show_tab('compare')", "Compare", show=False),
         Binding("5", "show_tab('codes')", "Codes", show=False),
         Binding("r", "run", "Run"),
+        Binding("m", "run_models", "Model spread"),
         Binding("c", "cancel", "Cancel run"),
         Binding("s", "save_as", "Save as"),
         Binding("p", "pin", "Pin"),
@@ -134,7 +135,7 @@ class LinecheckApp(App[None]):
             return True
         if isinstance(self.screen, ModalScreen):
             return False
-        if action == "run":
+        if action in ("run", "run_models"):
             return not self.running
         if action == "cancel":
             return self.running
@@ -267,7 +268,14 @@ class LinecheckApp(App[None]):
                                     caution=files.in_shipped_folder), done)
 
     # ------------------------------------------------------------------ run
-    def action_run(self) -> None:
+    def action_run_models(self) -> None:
+        """Run the case under every built-in downburst model (issue 15), same seeds."""
+        if self.case is not None and self.case.wind.type != "downburst":
+            self.notify("The model spread is for downburst cases.", severity="warning")
+            return
+        self.action_run(models="all")
+
+    def action_run(self, models: str | None = None) -> None:
         if self.running:
             self.notify("A run is in progress: c cancels it.", severity="warning")
             return
@@ -283,15 +291,15 @@ class LinecheckApp(App[None]):
         self._run_original = self.original
         self.query_one(RunPanel).start(self.case)
         self.post_message(RunStarted(self.case))
-        self.run_job(self.case, self._cancel)
+        self.run_job(self.case, self._cancel, models)
         self.refresh_bindings()
 
     @work(thread=True, exclusive=True, exit_on_error=False, group="run")
-    def run_job(self, case: Case, cancel: threading.Event) -> runner.RunOutput:
+    def run_job(self, case: Case, cancel: threading.Event, models: str | None = None) -> runner.RunOutput:
         def progress(stage: str, done: int, total: int) -> None:
             self.post_message(RunProgress(stage, done, total))
 
-        return runner.execute(case, progress=progress, cancel=cancel, extras=self.extras)
+        return runner.execute(case, progress=progress, cancel=cancel, extras=self.extras, models=models)
 
     def action_cancel(self) -> None:
         if self.running and self._cancel is not None:

@@ -49,8 +49,12 @@ def execute(
     progress: service.Progress | None = None,
     cancel: threading.Event | None = None,
     extras: bool = True,
+    models: str | None = None,
 ) -> RunOutput:
-    """Run ``case`` and collect the result tabs' data (raises ``Cancelled`` when ``cancel`` is set)."""
+    """Run ``case`` and collect the result tabs' data (raises ``Cancelled`` when ``cancel`` is set).
+
+    ``models``: e.g. ``"all"``: the downburst model spread (issue 15; :func:`service.run_models`);
+    the result tabs show the case's own model, the document gets the ``"models"`` block."""
     t0 = time.perf_counter()
 
     def check() -> None:
@@ -61,8 +65,18 @@ def execute(
         if progress is not None:
             progress(stage, done, total)
 
-    result = service.run_case(case, progress=progress, cancel=cancel)
-    doc = run_to_dict(result)
+    if models is not None:
+        from ..io.jsonout import models_block
+
+        spread = service.run_models(case, service.parse_models(case, models), progress=progress, cancel=cancel)
+        own = case.wind.downburst.model_name
+        result = spread[own] if own in spread else next(iter(spread.values()))
+        doc = run_to_dict(result)
+        doc["model"] = result.case.wind.downburst.model_name
+        doc.update(models_block(spread))
+    else:
+        result = service.run_case(case, progress=progress, cancel=cancel)
+        doc = run_to_dict(result)
     modes = wind = None
     if extras:
         check()

@@ -50,6 +50,7 @@ from scipy.special import erf
 from ..case import Case, Downburst, read_regular_file
 from ..errors import CaseError
 from ..system import LineSystem
+from . import ring as ring_model
 
 # ------------------------------------------------------------------------- constants
 R_MAX_OVER_DJ = 1.2  # r_max = 1.2 D_j: radius of peak outflow of Kim & Hangan (2007), = paper's Db_y R
@@ -411,6 +412,7 @@ class DownburstField:
     t1: float = math.nan
     t_f: float = math.nan
     table: FieldTable | None = None
+    ring: ring_model.RingJet | None = None  # model "ring-jet" (issue 15)
 
     # -- model pieces
     def centre_at(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -422,6 +424,9 @@ class DownburstField:
     def shape(self, r: np.ndarray, t: np.ndarray) -> np.ndarray:
         """Radial speed per unit V_max [-] at radius r [m] and time t [s] (broadcast shapes)."""
         r, t = np.broadcast_arrays(np.asarray(r, dtype=float), np.asarray(t, dtype=float))
+        if self.ring is not None:
+            # issue 15: non-separable ring vortex + image + wall jet, per unit V_j
+            return self.ring.shape(r, self.height, t)
         if self.table is None:
             # issue 3: V = V_max f_r(r) f_z(z) Pi(t)
             return (radial_profile(r, self.r_max, self.radial_decay)
@@ -512,7 +517,7 @@ def _downburst(case: Case) -> Downburst:
 
 def _table_of(case: Case) -> FieldTable | None:
     db = _downburst(case)
-    if db.field is None:
+    if db.model_name != "table" or db.field is None:
         return None
     path = db.field_path if db.field_path is not None else Path(db.field)
     if db.t1 is not None or db.t_f is not None:
@@ -532,6 +537,8 @@ def event_window(case: Case) -> tuple[float, float]:
     dur = case.analysis.duration
     if case.wind.type == "synoptic":
         return 0.0, float(dur if dur is not None else SYNOPTIC_DURATION_DEFAULT)
+    if _downburst(case).model_name == "ring-jet":
+        return 0.0, float(dur if dur is not None else ring_model.TAU_END * _ring_scale(case).time_scale)
     table = _table_of(case)
     if table is None:
         t_f = _downburst(case).t_f if _downburst(case).t_f is not None else T_F_DEFAULT
@@ -544,6 +551,31 @@ def event_window(case: Case) -> tuple[float, float]:
                         f"{t_last:g} s (expected duration <= {t_last - t0:g})",
                         file=str(case.source) if case.source else None, key="analysis.duration")
     return t0, t0 + float(dur)
+
+
+@lru_cache(maxsize=64)
+def _ring_scale(case: Case) -> ring_model.RingJet:
+    """D_j and V_j of a "ring-jet" case: ``jet_velocity``, else V_ref / (peak over the event of the
+    stationary dimensionless outflow at p, at the conductor height), i.e. V_j = V_max."""
+    db = _downburst(case)
+    dj = db.jet_diameter
+    if db.jet_velocity is not None:
+        return ring_model.RingJet(dj, float(db.jet_velocity))
+    rho_p = abs(db.distance * math.cos(math.radians(db.angle))) / dj
+    if abs(math.cos(math.radians(db.angle))) < 1e-12:
+        rho_p = 0.0
+    tau = np.linspace(0.0, ring_model.TAU_END, 6001)
+    s = np.abs(ring_model.radial_speed(rho_p, case.line.height / dj, tau))
+    k = int(np.argmax(s))
+    peak = float(s[k])
+    lo, hi = tau[max(k - 1, 0)], tau[min(k + 1, tau.size - 1)]
+    res = minimize_scalar(lambda tt: -abs(float(ring_model.radial_speed(rho_p, case.line.height / dj, tt))),
+                          bounds=(lo, hi), method="bounded", options={"xatol": 1e-10})
+    peak = max(peak, float(-res.fun))
+    if not peak > 0.0:
+        raise CaseError("the outflow at point p is zero (the centre lies on the line): change distance/angle",
+                        file=str(case.source) if case.source else None, key="wind.downburst")
+    return ring_model.RingJet(dj, case.wind.v_ref / peak)
 
 
 def _max_speed_at_p(field: DownburstField, v_max: float, times: np.ndarray) -> tuple[float, float]:
@@ -610,7 +642,18 @@ def _downburst_field_cached(case: Case, stamp: tuple[int, int] | None) -> Downbu
         translation = (translation[0], 0.0)
     window = event_window(case)
     table = _table_of(case)
-    if table is None:
+    if db.model_name == "ring-jet":
+        rj = _ring_scale(case)
+        if db.t1 is not None or db.t_f is not None:  # guarded by the loader too
+            raise CaseError("t1/t_f shape the holmes-oliver model only", file=src, key="wind.downburst.t1")
+        field = DownburstField(dj, h, centre, 0.0, translation, 1.0, point_p, window, ring=rj)
+        # reference instant of the centre position: when the stationary outflow at p peaks
+        times = np.linspace(window[0], window[1], 6001)
+        r_p0 = abs(centre[1])
+        t_ref = float(times[int(np.argmax(np.abs(field.shape(np.full(times.size, r_p0), times))))])
+        field = DownburstField(**{**field.__dict__, "t_ref": t_ref})
+        special = times
+    elif table is None:
         r_max = db.r_max if db.r_max is not None else R_MAX_OVER_DJ * dj
         r_dec = db.radial_decay if db.radial_decay is not None else RADIAL_DECAY_OVER_DJ * dj
         z_max = db.z_max if db.z_max is not None else Z_MAX_OVER_DJ * dj
@@ -633,7 +676,14 @@ def _downburst_field_cached(case: Case, stamp: tuple[int, int] | None) -> Downbu
     special = special[(special >= window[0]) & (special <= window[1])]
     r_p = abs(centre[1])
     v_ref = case.wind.v_ref
-    if translation == (0.0, 0.0):
+    if translation == (0.0, 0.0) and db.model_name == "ring-jet":
+        # stationary ring-jet: |V(p,t)| = V_max |s(r_p, t)|, maximum found by grid + refinement
+        peak = _max_speed_at_p(field, 1.0, special)[0]
+        if not peak > 0.0:
+            raise CaseError(f"the outflow at point p (x = {point_p:g} m) is zero over the window, so V_ref cannot "
+                            "be matched; change distance/angle", file=src, key="wind.downburst")
+        v_max = v_ref / peak  # paper section 2.1: peak running mean at p (conductor height) = V_ref
+    elif translation == (0.0, 0.0):
         # stationary centre: |V(p,t)| = V_max |shape(r_p, t)|; its maximum is at T1 or a table instant
         # (linear interpolation in t) or a window end, so the scaling is exact (issue 3).
         peak = float(np.max(np.abs(field.shape(np.full(special.size, r_p), special))))

@@ -142,6 +142,8 @@ class ResultsView(Vertical):
                          "realizations (linecheck run --until 1%).", style="yellow")
         for line in how_to_read(doc):
             notes.append("\n" + line, style="dim")
+        if isinstance(doc.get("models"), dict):
+            notes.append("\n" + models_text(doc))
         sa = doc.get("still_air", {}).get("reactions", {})
         if sa:
             notes.append("\nstill air: " + ", ".join(f"{r} {v / 1e3:.3f} kN" for r, v in sa.items() if v is not None),
@@ -225,3 +227,20 @@ class ResultsView(Vertical):
         if output.case.wind.type == "downburst":
             text += f" at t = {m.mean_time:.1f} s (largest mean reaction at the tower of interest)"
         notes.update(Text(text + "; dir: direction holding most of the mode's kinetic energy.", style="dim"))
+
+
+def models_text(doc: dict) -> str:
+    """Downburst model spread (issue 15): peak dynamic Rx/Ry and GF_Dy per model, and the envelope."""
+    def fmt(v, scale, f):
+        return "**" if v is None else f.format(v * scale)
+
+    lines = [f"model spread (shown above: {doc.get('model', '?')}):"]
+    for name, blk in doc["models"].items():
+        lines.append(f"  {name:<14} peak Rx {fmt(blk['Rx']['peak_dynamic']['mean'], 1e-3, '{:.3f}')} kN, "
+                     f"Ry {fmt(blk['Ry']['peak_dynamic']['mean'], 1e-3, '{:.3f}')} kN; GF_Dy Rx "
+                     f"{fmt(blk['Rx']['GF_Dy']['mean'], 1, '{:.3f}')}, Ry {fmt(blk['Ry']['GF_Dy']['mean'], 1, '{:.3f}')}")
+    env = doc["models_envelope"]
+    lines.append("  envelope       " + ", ".join(
+        f"peak {r} {fmt(env[r]['peak_dynamic']['value'], 1e-3, '{:.3f}')} kN ({env[r]['peak_dynamic']['model']})"
+        for r in ("Rx", "Ry")))
+    return "\n".join(lines)

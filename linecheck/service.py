@@ -153,6 +153,12 @@ def record_time(case: Case) -> np.ndarray:
     return record_times(case)
 
 
+def peak_window_steps(case: Case) -> int | None:
+    """Samples per peak window (``analysis.peak_window`` / time step), None for the whole record."""
+    w = case.analysis.peak_window
+    return None if w is None else max(1, int(round(w / case.analysis.time_step)))
+
+
 @dataclass(frozen=True)
 class RunResult:
     """Steps 1-3 of a case and the statistics of Eqs 15-17.
@@ -166,6 +172,7 @@ class RunResult:
         stats: statistics per realization at every tower (:class:`Statistics`).
         spectral: frequency-domain check (synoptic cases; None for downbursts).
         burn_in: the discarded start of the record and whether it suffices (issue 10).
+        until: the adaptive stop of :func:`run_until` (None for a fixed count).
     """
 
     case: Case
@@ -179,6 +186,7 @@ class RunResult:
     stats: Statistics
     spectral: "SpectralResult | None" = None
     burn_in: "BurnIn | None" = None
+    until: "UntilInfo | None" = None
 
     @property
     def tower_index(self) -> int:
@@ -189,6 +197,18 @@ class RunResult:
     def still_air(self) -> np.ndarray:
         """[N] still-air reactions at every tower, shape (n_towers, 3)."""
         return self.static.mean.still_air.reactions
+
+    @property
+    def windows(self) -> int:
+        """Peak windows per realization (1 without ``analysis.peak_window``)."""
+        return self.stats.n_samples // max(int(self.realizations.size), 1)
+
+    def summary(self) -> "ResultSummary":
+        """Statistics summarised over realizations x windows (issue 18): moments, fractiles,
+        Gumbel fits of the peaks, 95 % intervals, the Cont_R flag."""
+        from .core.results import summarise_statistics
+
+        return summarise_statistics(self.stats, self.still_air, self.case.analysis.design_fractile)
 
 
 def reference_state_index(case: Case, mean: MeanStates) -> int:
@@ -504,7 +524,7 @@ def run_case(
         M = np.stack([np.interp(t, mean.time, flat[:, i]) for i in range(flat.shape[1])], axis=1).reshape(
             (t.size,) + rw.shape[1:])
     Bk, Rk = resp.background[:, keep], resp.resonant[:, keep]
-    stats = compute_statistics(M[keep], Bk, Rk, mean.still_air.reactions, case.g_yp_L)
+    stats = compute_statistics(M[keep], Bk, Rk, mean.still_air.reactions, case.g_yp_L, window=peak_window_steps(case))
     j = case.line.tower_of_interest - 1
     spectral = spectral_analysis(case, static=st, synoptic=sm) if sm is not None and spectral_check else None
     return RunResult(
@@ -512,6 +532,95 @@ def run_case(
         background=Bk[:, :, j, :].copy(), resonant=Rk[:, :, j, :].copy(), stats=stats,
         spectral=spectral, burn_in=burn,
     )
+
+
+@dataclass(frozen=True)
+class UntilInfo:
+    """Adaptive realization count (issue 18, ``--until``).
+
+    target, achieved: [-] relative standard errors (0.01 = 1 %); achieved is the largest
+    se/|mean| of GF_Dy and of peak_dynamic over the reactions at the tower of interest whose
+    GF_Dy is defined; reached: achieved <= target; max_realizations: the cap.
+    """
+
+    target: float
+    achieved: float
+    reached: bool
+    max_realizations: int
+
+
+def relative_standard_error(res: RunResult) -> float:
+    """Largest se/|mean| of GF_Dy and peak_dynamic at the tower of interest over the reactions whose
+    GF_Dy is defined (a reaction with a vanishing mean has no gust factor to converge) [-]."""
+    from .core.extremes import summarise
+
+    j = res.tower_index
+    gf = summarise(res.stats.GF_Dy[:, j])
+    pk = summarise(res.stats.peak_dynamic[:, j])
+    if gf.n < 2:
+        return float("inf")
+    ok = np.isfinite(gf.mean)
+    if not ok.any():
+        ok = pk.mean > 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rel = np.concatenate([(gf.se / np.abs(gf.mean))[ok & np.isfinite(gf.mean)], (pk.se / np.abs(pk.mean))[ok]])
+    return float(rel.max()) if rel.size else 0.0
+
+
+def join_runs(parts: list[RunResult]) -> RunResult:
+    """One result from runs of consecutive disjoint realization sets of one case, in order
+    (realization r always has the same turbulence, so this is bit-identical to one run)."""
+    if len(parts) == 1:
+        return parts[0]
+    first = parts[0]
+    return dataclasses.replace(
+        first,
+        realizations=np.concatenate([p.realizations for p in parts]),
+        background=np.concatenate([p.background for p in parts], axis=0),
+        resonant=np.concatenate([p.resonant for p in parts], axis=0),
+        stats=Statistics.concatenate([p.stats for p in parts]),
+    )
+
+
+UNTIL_OVERSHOOT = 1.1  # next count: 10 % above the n (se ~ 1/sqrt(n)) predicts, to stop in few chunks
+UNTIL_MAX_CHUNK = 50  # realizations added per chunk at most: bounds a chunk's memory (resource guard)
+
+
+def run_until(
+    case: Case,
+    target: float,
+    *,
+    max_realizations: int = 1000,
+    interpolate_states: bool = False,
+    spectral_check: bool = True,
+    progress: Progress | None = None,
+    cancel: threading.Event | None = None,
+    warn: Warn | None = None,
+) -> RunResult:
+    """Add realizations in chunks until :func:`relative_standard_error` <= ``target`` [-] or
+    ``max_realizations`` have run (issue 18).
+
+    Starts with ``analysis.realizations`` (at most the cap); each next count is the one the
+    1/sqrt(n) law predicts, times :data:`UNTIL_OVERSHOOT`, adding at most
+    :data:`UNTIL_MAX_CHUNK` realizations per chunk.  Realization r always gets the same
+    turbulence, so the result is bit-identical to ``run_case`` with the same count.
+    """
+    if not target > 0:
+        raise ValueError(f"target {target!r} must be > 0")
+    n = max(2, min(case.analysis.realizations, max_realizations))
+    parts = [run_case(case, realizations=np.arange(n), interpolate_states=interpolate_states,
+                      spectral_check=spectral_check, progress=progress, cancel=cancel, warn=warn)]
+    while True:
+        res = join_runs(parts)
+        achieved = relative_standard_error(res)
+        done = res.realizations.size
+        if achieved <= target or done >= max_realizations:
+            return dataclasses.replace(res, until=UntilInfo(float(target), achieved, bool(achieved <= target),
+                                                            int(max_realizations)))
+        want = done * (achieved / target) ** 2 * UNTIL_OVERSHOOT if np.isfinite(achieved) else 2 * done
+        nxt = int(min(max_realizations, done + UNTIL_MAX_CHUNK, max(done + 1, int(np.ceil(want)))))
+        parts.append(run_case(case, realizations=np.arange(done, nxt), interpolate_states=interpolate_states,
+                              spectral_check=False, progress=progress, cancel=cancel, warn=warn))
 
 
 @dataclass(frozen=True)
@@ -770,7 +879,7 @@ def sanity_check(res: RunResult) -> list[SanityItem]:
     from .core.results import REACTIONS
 
     j = res.tower_index
-    n = res.realizations.size
+    n = res.stats.n_samples
     ex = res.spectral.exact
     items = []
     scale = float(np.max(ex.rms_fluctuating))

@@ -553,11 +553,14 @@ def test_summary_flags_cont_r_and_failed_sanity_check(short_cases):
     flagged = copy.deepcopy(clean)
     flagged.name = "flagged"
     flagged.doc["reactions"]["Ry"]["Cont_R"]["mean"] = 0.25
+    flagged.doc["reactions"]["Ry"]["dynamic_analysis"] = "recommended"  # interval above 10 % (issue 18)
     flagged.doc["spectral"]["sanity_check"][0].update(reaction="Rz", quantity="rms_fluctuating", time_domain=176.0,
                                                       frequency_domain=212.0, allowed_difference=20.0, ok=False)
     for item in clean.doc["spectral"]["sanity_check"]:
         item["ok"] = True
     clean.doc["reactions"]["Ry"]["Cont_R"]["mean"] = 0.05
+    for r in ("Rx", "Ry", "Rz"):
+        clean.doc["reactions"][r]["dynamic_analysis"] = None
     report = BatchReport([clean, flagged])
 
     def render(obj) -> str:

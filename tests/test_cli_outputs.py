@@ -382,6 +382,8 @@ def test_run_table_fits_120_columns_and_flags_cont_r(doc):
     d["reactions"]["Rx"]["Cont_R"]["mean"] = CONT_R_FLAG + 0.05
     d["reactions"]["Ry"]["Cont_R"]["mean"] = CONT_R_FLAG - 0.05
     d["reactions"]["Rz"]["Cont_R"]["mean"] = 0.999  # Rz is not flagged (as in the Excel Summary)
+    for r, state in (("Rx", "recommended"), ("Ry", None), ("Rz", "recommended")):  # issue 18 flag states
+        d["reactions"][r]["dynamic_analysis"] = state
     con = Console(width=120, record=True, color_system="truecolor", force_terminal=True)
     con.print(results_table(d))
     text = con.export_text(clear=False)

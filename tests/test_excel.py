@@ -145,7 +145,7 @@ def test_summary_values_equal_json(docs, book):
                 want = _conv(std, scale, "std") if doc["realizations"] > 1 else None
                 assert cells[k + 1] == want, (row["Case"], row["Reaction"], stat, "std")
             checked += 1
-        flagged = block["Cont_R"]["mean"] is not None and block["Cont_R"]["mean"] > 0.10
+        flagged = block["dynamic_analysis"] == "recommended"  # issue 18: the 95 % interval above 10 %
         assert (row["Note"] == FLAG_NOTE) == flagged
     assert checked == len(docs) * len(SUMMARY_REACTIONS) * len(STAT_COLS)
     assert headers.count("±") == 8  # every statistic but mean_max (realizations > 1 present)
@@ -189,7 +189,10 @@ def test_threshold_changes_flags(light, tmp_path):
     path = tmp_path / "t.xlsx"
     write_workbook(light, path, cont_r_threshold=0.001)
     _, _, rows = _summary_table(load_workbook(path))
-    want = sum(1 for d in light for r in SUMMARY_REACTIONS if (d["reactions"][r]["Cont_R"]["mean"] or 0) > 0.001)
+    from linecheck.io.display import flag_state
+
+    want = sum(1 for d in light for r in SUMMARY_REACTIONS if flag_state(d, r, 0.001) == "recommended")
+    assert want > 0  # the rule is recomputed at the threshold from the intervals
     assert sum(1 for r in rows if r["Note"] == FLAG_NOTE) == want
     ws = load_workbook(path)["Summary"]
     assert any(rule.formula == ["0.001"] for rng in ws.conditional_formatting for rule in rng.rules)

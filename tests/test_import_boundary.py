@@ -14,6 +14,7 @@ CORE_MODULES = [
     "linecheck.core.dynamics",
     "linecheck.core.damping",
     "linecheck.core.results",
+    "linecheck.core.extremes",
     "linecheck.core.modes",
     "linecheck.core.budget",
     "linecheck.core.spectral",
@@ -26,6 +27,7 @@ CORE_MODULES = [
     "linecheck.service",
     "linecheck.io.jsonout",
     "linecheck.io.display",
+    "linecheck.io.document",
 ]
 
 

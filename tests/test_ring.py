@@ -202,7 +202,7 @@ def test_run_models_cli_json_block(tmp_path):
     doc = json.loads(out.read_text())
     assert list(doc["models"]) == ["holmes-oliver", "ring-jet"] and doc["model"] == "holmes-oliver"
     assert doc["models"]["holmes-oliver"] == doc["reactions"]
-    assert set(doc["models"]["ring-jet"]["Ry"]) == set(STATISTICS)
+    assert set(doc["models"]["ring-jet"]["Ry"]) == set(STATISTICS) | {"dynamic_analysis"}  # typed block (issue 18)
     for rn in ("Rx", "Ry"):
         vals = {m: doc["models"][m][rn]["peak_dynamic"]["mean"] for m in doc["models"]}
         e = doc["models_envelope"][rn]["peak_dynamic"]

@@ -195,6 +195,10 @@ def saved_result(json_path: Path, digest: str, changes: Mapping[str, Any] | None
         return None
     if not isinstance(doc, dict) or doc.get("case_hash") != digest or "reactions" not in doc:
         return None
+    from ..io.document import SCHEMA_VERSION
+
+    if doc.get("schema_version") != SCHEMA_VERSION:  # saved by an older linecheck: run it again
+        return None
     if doc.get("changes") != (json.loads(json.dumps(dict(changes))) if changes else None):
         return None
     return doc
@@ -252,6 +256,7 @@ def run_batch(
     keep_results: bool = False,
     progress: BatchProgress | None = None,
     cancel: threading.Event | None = None,
+    until: tuple[float, int] | None = None,
 ) -> BatchReport:
     """Run every case (all realizations) and save each result as it completes.
 
@@ -265,6 +270,9 @@ def run_batch(
         keep_results: keep the merged RunResult of each case in its outcome.
         progress: ``progress(BatchEvent)``; called in the calling thread.
         cancel: a threading.Event; when set the batch stops, finished cases stay saved.
+        until: ``(target, max_realizations)``: each case adds realizations until the relative
+            standard error is below ``target`` (:func:`linecheck.service.run_until`), as one task
+            per case (cases still run in parallel); bit-identical to a fixed run of the same count.
 
     Returns:
         A :class:`BatchReport`; it never raises for a failing case.
@@ -396,11 +404,15 @@ def run_batch(
             kwargs = {"report_key": idx}
         partial.pop(idx, None)
         holder.pop(idx, None)
+        if until is not None:  # adaptive count (issue 18): the task runs the whole case
+            kwargs["until"] = (float(until[0]), int(until[1]))
         return executor.submit(run_chunk, str(st.job.path), chunk, st.outcome.hash,
                                dict(st.job.changes) if st.job.changes else None, **kwargs)
 
     for st in todo:
-        st.chunks = chunk_ranges(st.outcome.realizations, size)
+        # --until (issue 18): one task per case, its chunks run in sequence inside it
+        st.chunks = [list(range(st.outcome.realizations))] if until is not None else \
+            chunk_ranges(st.outcome.realizations, size)
         st.parts = [None] * len(st.chunks)
         for k in range(len(st.chunks)):
             idx = len(owner)

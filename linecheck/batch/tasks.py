@@ -92,8 +92,13 @@ def run_chunk(
     progress: Callable[[str, int, int], None] | None = None,
     cancel: threading.Event | None = None,
     report_key: Any = None,
+    until: tuple[float, int] | None = None,
 ) -> Any:
     """Steps 1-3 of one case for a subset of its realizations.
+
+    ``until=(target, max_realizations)`` (``batch --until``, issue 18): the whole case with an
+    adaptive count instead (:func:`linecheck.service.run_until`; ``realizations`` is then the
+    initial count's range, used for progress only).
 
     Returns the :class:`~linecheck.service.RunResult` of those realizations, or a
     :class:`Failure`.  ``progress``/``cancel`` are only passed when the task runs
@@ -110,6 +115,10 @@ def run_chunk(
         progress = _worker_progress(report_key, len(realizations))
     try:
         case = load_checked(case_path, expected_hash, changes)
+        if until is not None:
+            from ..service import run_until
+
+            return run_until(case, float(until[0]), max_realizations=int(until[1]), progress=progress, cancel=cancel)
         return run_case(case, realizations=list(realizations), progress=progress, cancel=cancel)
     except Cancelled:
         raise

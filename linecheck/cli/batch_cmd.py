@@ -23,6 +23,7 @@ from ..core.errors import CaseError
 from .app import CaseArg, app, console, err_console, handle_errors, read_case
 from .limits import MaxMemoryOpt, apply_max_memory
 from .export_cmd import EngineerOpt, LineOpt, ProjectOpt, RevisionOpt, TitleOpt, title_block
+from .stats_view import MaxRealOpt, UntilOpt, parse_until
 
 JobsOpt = Annotated[int | None, typer.Option(
     "--jobs", "-j", help="Local worker processes (default: the number of cores; 1 runs in this process).",
@@ -228,18 +229,16 @@ REACTION_NAMES = ("Rx", "Ry", "Rz")
 QUANTITY_TEXT = {"rms_background": "background r.m.s.", "rms_fluctuating": "fluctuating r.m.s."}
 
 
-def cont_r_flags(doc: dict[str, Any] | None) -> list[str]:
-    """Reactions whose mean Cont_R exceeds :data:`CONT_R_FLAG` (where GF_Dy is defined: a
-    share of a vanishing peak means nothing)."""
+def cont_r_flags(doc: dict[str, Any] | None, state: str = "recommended") -> list[str]:
+    """Reactions whose ``"dynamic_analysis"`` flag is ``state`` ("recommended": the 95 % interval
+    of Cont_R lies above :data:`CONT_R_FLAG`; "inconclusive": it straddles it; issue 18)."""
     out = []
     for r in REACTION_NAMES:
         try:
-            v = doc["reactions"][r]["Cont_R"]["mean"]  # type: ignore[index]
-            gf = doc["reactions"][r]["GF_Dy"]["mean"]  # type: ignore[index]
-        except (KeyError, TypeError):
+            if doc["reactions"][r].get("dynamic_analysis") == state:  # type: ignore[index]
+                out.append(r)
+        except (KeyError, TypeError, AttributeError):
             continue
-        if v is not None and gf is not None and v > CONT_R_FLAG:
-            out.append(r)
     return out
 
 
@@ -268,9 +267,9 @@ def summary_table(report: Any) -> Table:
     time- and frequency-domain r.m.s. of a synoptic case differ); :func:`summary_notes` explains them.
     """
     t = Table(title="batch summary (tower of interest)", title_justify="left")
-    for col, just in (("case", "left"), ("status", "left"), ("peak Rx kN", "right"), ("peak Ry kN", "right"),
-                      ("GF_Dy Rx", "right"), ("GF_Dy Ry", "right"), ("Cont_R Ry %", "right"), ("flags", "left"),
-                      ("time s", "right"), ("result / error", "left")):
+    for col, just in (("case", "left"), ("status", "left"), ("n", "right"), ("peak Rx kN", "right"),
+                      ("peak Ry kN", "right"), ("GF_Dy Rx", "right"), ("GF_Dy Ry", "right"), ("Cont_R Ry %", "right"),
+                      ("flags", "left"), ("time s", "right"), ("result / error", "left")):
         t.add_column(col, justify=just, overflow="fold")
     colours = {"done": "green", "skipped": "cyan", "failed": "red", "cancelled": "yellow", "pending": "yellow"}
     for o in report.outcomes:
@@ -282,10 +281,14 @@ def summary_table(report: Any) -> Table:
         flags = []
         if flagged:
             flags.append(f"[bold yellow]Cont_R>10% {' '.join(flagged)}[/]")
+        unsure = cont_r_flags(d, "inconclusive")
+        if unsure:
+            flags.append(f"[yellow]Cont_R~10% {' '.join(unsure)}[/]")
         if sanity_failures(d):
             flags.append("[bold red]t/f check[/]")
         t.add_row(
             escape(o.name), f"[{colours.get(o.status, 'white')}]{o.status}[/]",
+            str(d.get("realizations", "")) if d else "",
             _kn(d, "Rx", "peak_dynamic"), _kn(d, "Ry", "peak_dynamic"),
             _kn(d, "Rx", "GF_Dy", 1.0, "{:.3f}"), _kn(d, "Ry", "GF_Dy", 1.0, "{:.3f}"),
             cont_ry, " ".join(flags),
@@ -300,7 +303,11 @@ def summary_notes(report: Any) -> list[str]:
     notes = []
     if any(cont_r_flags(o.doc) for o in report.outcomes):
         notes.append(f"[bold yellow]Cont_R>10%[/]: the resonant share of the peak (Cont_R, Eq. 16) of these reactions "
-                     f"exceeds {CONT_R_FLAG:.0%}: dynamic analysis recommended (a quasi-static analysis misses it).")
+                     f"exceeds {CONT_R_FLAG:.0%} (its 95 % interval lies above): dynamic analysis recommended (a "
+                     "quasi-static analysis misses it).")
+    if any(cont_r_flags(o.doc, "inconclusive") for o in report.outcomes):
+        notes.append(f"[yellow]Cont_R~10%[/]: the 95 % interval of Cont_R straddles {CONT_R_FLAG:.0%}: inconclusive, "
+                     "run more realizations (--until 1%).")
     bad = [(o.name, sanity_failures(o.doc)) for o in report.outcomes if sanity_failures(o.doc)]
     if bad:
         notes.append("[bold red]t/f check[/]: time- and frequency-domain r.m.s. differ by more than the sampling "
@@ -339,6 +346,8 @@ def batch(
         "--models", help='Downburst model spread: run every case under "all" built-in running-mean models (or a '
                          'comma list) with the same seeds; <stem>.<model>.json per run, <stem>.json with the '
                          '"models" block and envelope.', show_default=False)] = None,
+    until: UntilOpt = None,
+    max_realizations: MaxRealOpt = 1000,
 ) -> None:
     """Run many cases (all realizations) in parallel, saving each result as it completes."""
     from ..batch import make_executor, run_batch
@@ -347,6 +356,7 @@ def batch(
 
     fields = title_block(project, line, engineer, revision, title, excel=excel)
     paths = expand_cases(cases)
+    target = parse_until(until)
     plan = None
     if models is not None:
         from ..batch.models import model_jobs
@@ -358,7 +368,8 @@ def batch(
     with (make_executor(jobs, scheduler, connect_timeout) as executor,
           BatchDisplay(interval=progress_interval) as display):
         report = run_batch(paths, executor=executor, json_dir=out_dir, resume=resume, chunk_size=chunk,
-                           progress=display, cancel=cancel)
+                           progress=display, cancel=cancel,
+                           until=None if target is None else (target, max_realizations))
     console.print(summary_table(report))
     for note in summary_notes(report):
         console.print(note, highlight=False, soft_wrap=True)

@@ -29,6 +29,8 @@ from .export_cmd import (
 from .limits import MaxMemoryOpt, apply_max_memory
 from .limits import warn as limits_warn
 from .progress import progress_bar
+from .stats_view import MaxRealOpt, UntilOpt, design_table, parse_until
+from .stats_view import notes as stats_notes
 
 ModelsOpt = Annotated[str | None, typer.Option(
     "--models", help='Downburst model spread: run the case under "all" built-in running-mean models '
@@ -98,9 +100,9 @@ def results_table(doc: dict) -> Table:
 
 
 def cont_r_flagged(doc: dict, reaction: str) -> bool:
-    """Whether ``reaction``'s mean Cont_R is above :data:`CONT_R_FLAG` (Rx, Ry only)."""
-    v = doc["reactions"][reaction]["Cont_R"].get("mean")
-    return reaction in FLAGGED_REACTIONS and v is not None and v > CONT_R_FLAG
+    """Whether ``reaction`` (Rx, Ry only) has the flag "recommended": the 95 % interval of its
+    Cont_R lies above :data:`CONT_R_FLAG` (issue 18, docs/method.md)."""
+    return reaction in FLAGGED_REACTIONS and doc["reactions"][reaction].get("dynamic_analysis") == "recommended"
 
 
 def print_legend(doc: dict) -> None:
@@ -108,8 +110,9 @@ def print_legend(doc: dict) -> None:
     console.print(f"[dim]{TABLE_LEGEND}[/]", highlight=False)
     flagged = [r for r in FLAGGED_REACTIONS if cont_r_flagged(doc, r)]
     if flagged:
-        console.print(f"[bold red]Cont_R above {100 * CONT_R_FLAG:.0f} %[/] ({', '.join(flagged)}, in red): dynamic analysis "
-                      "recommended, the resonant part is a significant share of the peak (paper Sect. 5).",
+        console.print(f"[bold red]Cont_R above {100 * CONT_R_FLAG:.0f} %[/] ({', '.join(flagged)}, in red; its 95 % interval "
+                      "lies above): dynamic analysis recommended, the resonant part is a significant share of the "
+                      "peak (paper Sect. 5).",
                       highlight=False)
 
 
@@ -191,11 +194,14 @@ def run(
     revision: RevisionOpt = None,
     title: TitleOpt = None,
     models: ModelsOpt = None,
+    until: UntilOpt = None,
+    max_realizations: MaxRealOpt = 1000,
 ) -> None:
     """Steps 1-3: mean, background and resonant reactions, gust factors and contributions."""
     fields = title_block(project, line, engineer, revision, title, excel=excel)
     apply_max_memory(max_memory)
     case = override(read_case(case_file), realizations, seed)
+    target = parse_until(until)
     if json_out is not None:
         check_target(json_out, what="JSON")
     if excel is not None:
@@ -208,6 +214,9 @@ def run(
             spread = service.run_models(case, names, progress=cb, spectral_check=not no_check, warn=limits_warn)
             own = case.wind.downburst.model_name
             res = spread[own] if own in spread else next(iter(spread.values()))
+        elif target is not None:
+            res = service.run_until(case, target, max_realizations=max_realizations, progress=cb,
+                                    spectral_check=not no_check, warn=limits_warn)
         else:
             res = service.run_case(case, progress=cb, spectral_check=not no_check, warn=limits_warn)
     doc = run_to_dict(res, full_histories=full_histories)
@@ -217,6 +226,9 @@ def run(
         doc["model"] = res.case.wind.downburst.model_name
         doc.update(models_block(spread))
     console.print(results_table(doc))
+    console.print(design_table(doc))
+    for note in stats_notes(doc):
+        console.print(f"[dim]{note}[/]", highlight=False)
     print_legend(doc)
     if names:
         console.print(models_table(doc))

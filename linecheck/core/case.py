@@ -149,6 +149,8 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         _f("burn_in", "s", "synoptic: discarded start of the record (default: from the least-damped significant mode)", low=0.0, high=1e5),
         FieldSpec("drag", "choice", "-", 'fluctuating drag: "linear" (paper Eq. 5) or "quadratic" (the v^2 term kept, its mean I^2 in step 1)', default="quadratic", choices=DRAG_MODELS),
         FieldSpec("tension", "choice", "-", 'reactions: "linear" (paper) or "second-order" (+ the tension increment quadratic in the linear motion)', default="second-order", choices=TENSION_MODELS),
+        _f("peak_window", "s", "peaks taken per window of the analysed record; statistics over windows x realizations (default: the whole record; a downburst's whole event)", low=0.0, high=1e5, low_open=True),
+        _f("design_fractile", "-", "non-exceedance probability of the Gumbel design peak (0.5 = median peak)", default=0.5, low=0.0, high=0.999, low_open=True),
     ),
     "codes": (  # design-code comparison (issue 19, docs/codes.md)
         FieldSpec("terrain", "choice", "-", 'terrain for the design codes: "sea", "open", "suburban" or "urban" (maps to each code\'s category)', default="open", choices=CODE_TERRAINS),
@@ -253,6 +255,8 @@ class Analysis:
     burn_in: float | None = None  # [s]; None = derived (synoptic)
     drag: str = "quadratic"  # DRAG_MODELS (docs/method.md "Quadratic drag")
     tension: str = "second-order"  # TENSION_MODELS (docs/method.md "Second-order tension")
+    peak_window: float | None = None  # [s]; None = the whole analysed record (issue 18)
+    design_fractile: float = 0.5  # [-] non-exceedance probability of the design peak (issue 18)
 
     @property
     def structural_ratio(self) -> float:
@@ -526,6 +530,8 @@ def case_from_dict(
     analysis = Analysis(**an_d)
     if analysis.duration is not None and analysis.time_step * 4 > analysis.duration:
         raise ctx.error("analysis", "time_step", f"value {analysis.time_step!r} is too large for duration {analysis.duration!r}: expected at most duration/4")
+    if analysis.peak_window is not None and analysis.peak_window < 4 * analysis.time_step:
+        raise ctx.error("analysis", "peak_window", f"value {analysis.peak_window!r} is too short for time_step {analysis.time_step!r}: expected at least 4 time steps")
     codes = Codes(**_read_section(data.get("codes", {}), "codes", ctx))
     name = top["name"] or default_name
     return Case(name=name, description=top["description"] or "", line=line, wind=wind, analysis=analysis,

@@ -30,6 +30,8 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from .extremes import GumbelFit, Summary, confidence_interval, dynamic_analysis_flag, gumbel_fit, summarise
+
 REACTIONS = ("Rx", "Ry", "Rz")
 STATISTICS = (
     "mean_max",
@@ -49,11 +51,23 @@ STATISTICS = (
     "peak_normalised_total",
 )
 ZERO_MEAN_RTOL = 0.01
+#: Peak statistics: summarised with a Gumbel fit and a design value (issue 18).
+PEAK_STATISTICS = (
+    "peak_quasi_static",
+    "peak_dynamic",
+    "peak_quasi_static_total",
+    "peak_dynamic_total",
+    "peak_normalised",
+    "peak_normalised_total",
+)
+#: Statistics reported with a 95 % confidence interval of their mean (issue 18).
+CI_STATISTICS = ("GF_Dy", "GF_QS", "Cont_R")
 
 
 @dataclass(frozen=True)
 class Statistics:
-    """Per-realization statistics; every field has shape (n_real, n_towers, 3).
+    """Per-realization statistics; every field has shape (n_samples, n_towers, 3), n_samples =
+    n_real x n_windows (realization-major) when peaks are taken per window (issue 18).
 
     Forces in [N]; GF and Cont are ratios (Cont as fractions, 0.042 = 4.2 %).
     """
@@ -91,6 +105,11 @@ class Statistics:
             return np.zeros(v.shape[1:])
         return v.std(axis=0, ddof=1)
 
+    @property
+    def n_samples(self) -> int:
+        """Number of samples (realizations x windows) the statistics are over."""
+        return int(self.mean_max.shape[0])
+
     @staticmethod
     def concatenate(parts: list[Statistics]) -> Statistics:
         """Join statistics of disjoint realization sets (batch/distributed runs)."""
@@ -103,8 +122,15 @@ def compute_statistics(
     resonant: np.ndarray,
     still_air: np.ndarray,
     g_yp_L: float,
+    window: int | None = None,
 ) -> Statistics:
     """Statistics of Eqs 15-17 from response histories.
+
+    With ``window`` (samples, issue 18 ``analysis.peak_window``) the record is cut into
+    n_w = (n_t - 1) // window consecutive windows of ``window`` samples (a remainder shorter
+    than a window at the end is dropped) and every statistic is taken per window: the result
+    has n_real x n_w samples, realization-major.  ``window`` None or >= n_t - 1 steps: the
+    whole record.
 
     Args:
         mean: [N] wind-induced mean reaction M(t), shape (n_t, n_towers, 3).
@@ -112,11 +138,23 @@ def compute_statistics(
         resonant: [N] R(t) = F - B, same shape.
         still_air: [N] still-air reactions, shape (n_towers, 3).
         g_yp_L: [N] normalising force g*_yp L_x (Eq. 17).
+        window: samples per peak window (None: the whole record).
     """
-    M = mean[None]
+    scale = max(float(np.abs(mean).max()), 1e-300)
+    n_real, n_t = background.shape[:2]
+    if window is not None and 0 < window < n_t - 1:
+        n_w = (n_t - 1) // window  # n_t samples span n_t - 1 steps
+        cut = n_w * window
+        tail = background.shape[2:]
+        background = background[:, :cut].reshape((n_real * n_w, window) + tail)
+        resonant = resonant[:, :cut].reshape((n_real * n_w, window) + tail)
+        M = np.tile(mean[:cut].reshape((n_w, window) + tail), (n_real,) + (1,) * (1 + len(tail)))
+        mean_max = np.abs(M).max(axis=1)
+    else:
+        M = mean[None]
+        mean_max = np.broadcast_to(np.abs(mean).max(axis=0), background.shape[:1] + mean.shape[1:]).copy()
     qs = M + background
     dyn = qs + resonant
-    mean_max = np.broadcast_to(np.abs(mean).max(axis=0), background.shape[:1] + mean.shape[1:]).copy()
     rms_b = np.sqrt(np.mean(background**2, axis=1))
     rms_r = np.sqrt(np.mean(resonant**2, axis=1))
     rms_f = np.sqrt(np.mean((background + resonant) ** 2, axis=1))
@@ -125,7 +163,6 @@ def compute_statistics(
     sa = still_air[None, None]
     pk_qs_t = np.abs(qs + sa).max(axis=1)
     pk_dy_t = np.abs(dyn + sa).max(axis=1)
-    scale = max(float(np.abs(mean).max()), 1e-300)
     defined = mean_max > ZERO_MEAN_RTOL * scale
     with np.errstate(divide="ignore", invalid="ignore"):
         gf_dy = np.where(defined, pk_dy / mean_max, np.nan)
@@ -152,3 +189,56 @@ def compute_statistics(
         peak_normalised=norm,
         peak_normalised_total=norm_t,
     )
+
+
+@dataclass(frozen=True)
+class StatisticSummary:
+    """Summary of one statistic over samples at every tower; arrays of shape (n_towers, 3).
+
+    ``gumbel`` for :data:`PEAK_STATISTICS`, ``ci`` (low, high) for :data:`CI_STATISTICS`
+    (None otherwise); units those of the statistic.
+    """
+
+    summary: Summary
+    gumbel: GumbelFit | None = None
+    ci: tuple[np.ndarray, np.ndarray] | None = None
+
+
+@dataclass(frozen=True)
+class ResultSummary:
+    """Every statistic summarised (issue 18) and the three-state Cont_R flag.
+
+    Attributes:
+        statistics: name -> :class:`StatisticSummary` for every name of :data:`STATISTICS`.
+        dynamic_analysis: object array (n_towers, 3) of "recommended", "inconclusive" or None.
+        n_samples: realizations x windows summarised over.
+        design_fractile: non-exceedance probability of the Gumbel design values [-].
+    """
+
+    statistics: dict[str, StatisticSummary]
+    dynamic_analysis: np.ndarray
+    n_samples: int
+    design_fractile: float
+
+
+def summarise_statistics(stats: Statistics, still_air: np.ndarray, design_fractile: float = 0.5) -> ResultSummary:
+    """Summaries, Gumbel fits of the peaks, 95 % intervals and the Cont_R flag (issue 18).
+
+    Args:
+        stats: per-sample statistics, fields (n_samples, n_towers, 3).
+        still_air: [N] still-air reactions, shape (n_towers, 3).
+        design_fractile: non-exceedance probability of the design peak (``analysis.design_fractile``).
+    """
+    out: dict[str, StatisticSummary] = {}
+    for name in STATISTICS:
+        v = stats.values(name)
+        sm = summarise(v)
+        gb = gumbel_fit(v, design_fractile) if name in PEAK_STATISTICS else None
+        ci = confidence_interval(sm) if name in CI_STATISTICS else None
+        out[name] = StatisticSummary(sm, gb, ci)
+    low, high = out["Cont_R"].ci
+    if stats.n_samples < 2:  # no interval from one sample: the flag can only say "inconclusive"
+        low, high = np.full_like(low, -np.inf), np.full_like(high, np.inf)
+    gf_defined = np.isfinite(out["GF_Dy"].summary.mean)
+    flag = dynamic_analysis_flag(low, high, gf_defined, out["peak_dynamic"].summary.mean, still_air)
+    return ResultSummary(out, flag, stats.n_samples, float(design_fractile))

@@ -12,6 +12,7 @@ from openpyxl.worksheet.worksheet import Worksheet
 
 from ..core.case import SCHEMA
 from . import template as tpl
+from ..io.display import flag_state, flag_text
 from .cells import (
     FLAG_NOTE,
     KN,
@@ -288,9 +289,9 @@ def _contributions_table(cur: Cursor, doc: dict, threshold: float,
         for k, stat in enumerate(("Cont_M", "Cont_BG", "Cont_R")):
             v = doc["reactions"][r][stat].get("mean")
             cur.put(cur.row, 3 + k, cell_value(v, "pct"), fmt=PCT)
-        v = doc["reactions"][r]["Cont_R"].get("mean")
-        flag = r in flagged and is_num(v) and v > threshold
-        c = cur.put(cur.row, 6, FLAG_NOTE if flag else "", "lc_text")
+        state = flag_state(doc, r, threshold) if r in flagged else None  # issue 18: on the 95 % interval
+        flag = state is not None
+        c = cur.put(cur.row, 6, FLAG_NOTE if state == "recommended" else flag_text(state), "lc_text")
         align(c, indent=1)
         if flag:
             c.font = Font(name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT)

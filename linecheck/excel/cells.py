@@ -40,24 +40,26 @@ SUMMARY_STATS: tuple[tuple[str, str, str, str, bool], ...] = (
 SUMMARY_IDS = (("Case", 16), ("Wind", 14), ("Spans", 6), ("L_x\n(m)", 7), ("V_ref\n(m/s)", 7),
                ("Tower", 6), ("n", 5), ("Reaction", 8))
 
+def _stat_info() -> dict[str, tuple[str, str, str, str]]:
+    """Statistics of the case sheets from the one statistics table (:data:`linecheck.io.document.STAT_TABLE`):
+    key -> (shown unit, Excel format, cell kind, meaning)."""
+    from ..io.document import STAT_TABLE
+
+    out = {}
+    for s in STAT_TABLE:
+        if s.kind == "force":
+            out[s.name] = ("kN", KN3, "kN", s.meaning)
+        elif s.kind == "fraction":
+            out[s.name] = ("%", PCT, "pct", s.meaning)
+        elif s.name.startswith("GF_"):
+            out[s.name] = ("-", RATIO, "gf", s.meaning)
+        else:
+            out[s.name] = ("-", NORM, "ratio", s.meaning)
+    return out
+
+
 #: Statistics of the case sheets: key -> (unit, format, kind, meaning).
-STAT_INFO = {
-    "mean_max": ("kN", KN3, "kN", "max over time of |M|, wind-induced mean"),
-    "rms_background": ("kN", KN3, "kN", "r.m.s. of the background B"),
-    "rms_resonant": ("kN", KN3, "kN", "r.m.s. of the resonant R = F - B"),
-    "rms_fluctuating": ("kN", KN3, "kN", "r.m.s. of B + R"),
-    "peak_quasi_static": ("kN", KN3, "kN", "max |M + B| (quasi-static peak)"),
-    "peak_dynamic": ("kN", KN3, "kN", "max |M + B + R| (dynamic peak)"),
-    "peak_quasi_static_total": ("kN", KN3, "kN", "quasi-static peak incl. still air"),
-    "peak_dynamic_total": ("kN", KN3, "kN", "dynamic peak incl. still air"),
-    "GF_Dy": ("-", RATIO, "gf", "peak_dynamic / mean_max (Eq. 15)"),
-    "GF_QS": ("-", RATIO, "gf", "peak_quasi_static / mean_max (Eq. 15)"),
-    "Cont_M": ("%", PCT, "pct", "mean_max / peak (Eq. 16)"),
-    "Cont_BG": ("%", PCT, "pct", "(peak_QS - mean_max) / peak (Eq. 16)"),
-    "Cont_R": ("%", PCT, "pct", "(peak - peak_QS) / peak (Eq. 16)"),
-    "peak_normalised": ("-", NORM, "ratio", "peak_dynamic / (g*yp Lx) (Eq. 17)"),
-    "peak_normalised_total": ("-", NORM, "ratio", "peak_dynamic_total / (g*yp Lx)"),
-}
+STAT_INFO = _stat_info()
 
 #: Default thinning of the time histories for the charts (points per case).
 CHART_POINTS = 1000

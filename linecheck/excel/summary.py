@@ -26,7 +26,10 @@ from .cells import (
     page_setup,
     wind_label,
 )
+from ..io.display import flag_state
 from .charts import chart_title
+
+INCONCLUSIVE_NOTE = "inconclusive: run more realizations"
 
 
 # --------------------------------------------------------------------------- Summary
@@ -86,9 +89,11 @@ def write_summary(ws: Worksheet, docs: list[dict], names: list[str | None], thre
                     cur.put(row, left + c, value, "lc_number", fmt)
                     if stat == "Cont_R" and which == "mean":
                         cont_r_col = left + c
-                        v = entry.get("mean")
-                        if is_num(v) and v > threshold:
+                        state = flag_state(doc, r, threshold)  # issue 18: on the 95 % interval
+                        if state == "recommended":
                             note = FLAG_NOTE
+                        elif state == "inconclusive":
+                            note = INCONCLUSIVE_NOTE
                 c += 1
             check, check_bad = ("", False) if failed else sanity_text(doc)
             ccell = cur.put(row, left + c, check, "lc_text")
@@ -121,7 +126,10 @@ def write_summary(ws: Worksheet, docs: list[dict], names: list[str | None], thre
                        fill=PatternFill("solid", fgColor=tpl.FLAG_FILL, bgColor=tpl.FLAG_FILL),
                        font=Font(bold=True, color=tpl.FLAG_FONT)))
     cur.row = last + 2
-    cur.note(f"Cont_R above {threshold:.0%} is flagged: {FLAG_NOTE} (the resonant share of the peak "
+    cur.note(f"Note: '{FLAG_NOTE}' where the 95 % interval of Cont_R lies above {threshold:.0%}, "
+             f"'{INCONCLUSIVE_NOTE}' where it straddles {threshold:.0%} (none where GF is ** or the reaction is below "
+             "5 % of the still-air load); the colour marks a mean Cont_R above it.")
+    cur.note(f"Cont_R above {threshold:.0%}: {FLAG_NOTE} (the resonant share of the peak "
              "that a quasi-static analysis misses; paper Sect. 5).")
     cur.note(f"{GF_UNDEFINED} : GF undefined, the mean reaction is zero by symmetry or below 1 % of the "
              "largest mean reaction of the case; peaks and contributions are still given.")
@@ -135,6 +143,9 @@ def write_summary(ws: Worksheet, docs: list[dict], names: list[str | None], thre
              "Ry transverse (wind), Rz vertical" + ("" if "Rz" in summary_reactions else
                                                     " (Rz on the case sheets: its wind-induced part is small beside "
                                                     "the conductor weight)") + ".")
+    from .design import write_design_block  # issue 18: design values, intervals, flag states, how to read
+
+    cur.row = write_design_block(ws, docs, cur.row + 1, left)
     ws.auto_filter.ref = f"{get_column_letter(left)}{top}:{get_column_letter(right)}{last}"
     ws.freeze_panes = ws.cell(row=top + 1, column=left + 1)
     ws.print_title_rows = f"{top}:{top}"

@@ -198,7 +198,12 @@ def load_result_docs(paths: Iterable[str | Path]) -> list[dict[str, Any]]:
             raise CaseError(f"invalid JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}", file=str(p)) from None
         items = data if isinstance(data, list) else [data]
         for k, doc in enumerate(items):
-            validate_doc(doc, str(p) if len(items) == 1 else f"{p}[{k}]")
+            where = str(p) if len(items) == 1 else f"{p}[{k}]"
+            if isinstance(doc, dict) and "reactions" in doc and "error" not in doc:
+                from ..io.document import RunDocument  # saved files: schema version and layout (issue 18)
+
+                RunDocument.from_json(doc, source=where)
+            validate_doc(doc, where)
             docs.append(doc)
     if not docs:
         raise CaseError("no results to export (empty list)")

@@ -121,40 +121,35 @@ def case_parameters(case: Any) -> dict[str, Any]:
     return case_to_dict(case)
 
 
-def run_to_dict(res: Any, *, full_histories: bool = False, max_points: int = 2000) -> dict[str, Any]:
-    """JSON document of a run (issue 4 contract).
+def run_to_dict(res: Any, *, full_histories: bool = False, max_points: int = 2000,
+                extra: dict[str, Any] | None = None) -> dict[str, Any]:
+    """JSON document of a run: ``run_document(res, ...).to_json()`` (issue 18 contract,
+    :class:`~linecheck.io.document.RunDocument`; layout in docs/results.schema.json)."""
+    return run_document(res, full_histories=full_histories, max_points=max_points, extra=extra).to_json()
 
-    ``{"case", "wind", "units": "SI", "tower_of_interest", "g_yp_L",
-    "reactions": {"Rx": {stat: {"mean", "std"}}, "Ry": .., "Rz": ..},
-    "towers": [...all towers...], "still_air": {...}, "static": {...},
-    "time_histories": {...}}``.  Forces in N, Cont_* as fractions, GF null where the
-    mean vanishes.  Time histories are those of realization 1 at the tower of
-    interest, thinned to about ``max_points`` samples keeping every block's extremes
-    unless ``full_histories``.
+
+def run_document(res: Any, *, full_histories: bool = False, max_points: int = 2000,
+                 extra: dict[str, Any] | None = None) -> Any:
+    """The typed :class:`~linecheck.io.document.RunDocument` of a run.
+
+    Typed: the header (``"schema_version"``, ``"case"``, ..., ``"realizations"``, ``"windows"``),
+    ``"reactions"`` at the tower of interest and ``"towers"`` (every statistic
+    ``{"mean", "std", "se", "p05", "p50", "p95"}``, peaks with ``"gumbel"``, GF_Dy/GF_QS/Cont_R
+    with ``"ci"``, each reaction with ``"dynamic_analysis"``), ``"until"``.  Untyped blocks:
+    ``"still_air"``, ``"static"``, ``"parameters"``, ``"burn_in"``, ``"damping"``,
+    ``"spectral"``, ``"time_histories"`` and any ``extra`` blocks (e.g. ``"codes"``).
+    Forces in N, Cont_* as fractions, GF null where the mean vanishes.  Time histories are
+    those of realization 1 at the tower of interest, thinned to about ``max_points`` samples
+    keeping every block's extremes unless ``full_histories``.
     """
-    from ..core.results import REACTIONS, STATISTICS
+    from ..core.results import REACTIONS
+    from .document import document_of
 
-    case, stats = res.case, res.stats
+    case = res.case
     j = res.tower_index
-
-    def reaction_block(tower: int) -> dict[str, Any]:
-        return reactions_block(stats, tower)
-
     still = res.static.mean.still_air
     m = res.static.mean
     doc: dict[str, Any] = {
-        **_header(case),
-        "g_yp_L": _num(case.g_yp_L),
-        "v_ref": case.wind.v_ref,
-        "span_length": case.line.span_length,
-        "spans": case.line.spans,
-        "realizations": int(res.realizations.size),
-        "seed": case.analysis.seed,
-        "duration": _num(res.time[-1] - res.time[0]),
-        "time_step": case.analysis.time_step,
-        "reactions": reaction_block(j),
-        "towers": [{"index": k + 1, "support": case.line.supports[k], "reactions": reaction_block(k)}
-                   for k in range(res.system.n_towers)],
         "still_air": {
             "reactions": {r: _num(still.reactions[j, c]) for c, r in enumerate(REACTIONS)},
             "tension": _num(still.tension),
@@ -197,7 +192,9 @@ def run_to_dict(res: Any, *, full_histories: bool = False, max_points: int = 200
         "time": _num(res.time[idx]),
         **{r: {"M": _num(M[idx, c]), "B": _num(B[idx, c]), "R": _num(R[idx, c])} for c, r in enumerate(REACTIONS)},
     }
-    return doc
+    if extra:
+        doc.update(extra)
+    return document_of(res, doc)
 
 
 def codes_to_dict(cr: Any) -> dict[str, Any]:
@@ -228,19 +225,20 @@ def codes_block(res: Any) -> dict[str, Any]:
     return codes_to_dict(codes_analysis(res.case, res, strict=False))
 
 
-def reactions_block(stats: Any, tower: int) -> dict[str, Any]:
-    """``{"Rx": {stat: {"mean", "std"}}, "Ry": .., "Rz": ..}`` of one tower (0-based)."""
-    from ..core.results import REACTIONS, STATISTICS
+def reactions_block(res: Any, tower: int | None = None) -> dict[str, Any]:
+    """``{"Rx": {stat: {...}, "dynamic_analysis"}, "Ry": .., "Rz": ..}`` of one tower (0-based; default
+    the tower of interest) of a RunResult: the same typed block as the document's ``"reactions"``
+    (issue 18: mean, std, se, fractiles, Gumbel fits, intervals, the Cont_R flag)."""
+    from .document import _reactions_json, reactions_of
 
-    return {rname: {s: {"mean": _num(stats.mean(s)[tower, c]), "std": _num(stats.std(s)[tower, c])}
-                    for s in STATISTICS} for c, rname in enumerate(REACTIONS)}
+    return _reactions_json(reactions_of(res.summary(), res.tower_index if tower is None else tower))
 
 
 def models_block(results: dict[str, Any]) -> dict[str, Any]:
     """Model spread of issue 15: ``{"models": {name: <same as "reactions">}, "models_envelope":
     {R: {stat: {"value", "model"}}}}`` at the tower of interest.  The envelope takes, per
     reaction and statistic, the realization mean of largest magnitude and names its model."""
-    return models_from_reactions({name: reactions_block(res.stats, res.tower_index) for name, res in results.items()})
+    return models_from_reactions({name: reactions_block(res) for name, res in results.items()})
 
 
 def models_from_reactions(models: dict[str, Any]) -> dict[str, Any]:

@@ -14,7 +14,16 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..core.case import SCHEMA, Case, FieldSpec
-from ..io.display import SUMMARY_STATS, Stat, stat_text  # noqa: F401  (shared with the CLI)
+from ..io.display import (  # noqa: F401  (shared with the CLI)
+    STAT_ROWS,
+    SUMMARY_STATS,
+    Stat,
+    ci_text,
+    design_text,
+    flag_text,
+    how_to_read,
+    stat_text,
+)
 
 REACTIONS = ("Rx", "Ry", "Rz")
 CONT_R_FLAG = 0.10  # Cont_R above this: "dynamic analysis recommended" (paper's conclusion)
@@ -26,6 +35,25 @@ def summary_rows(doc: dict[str, Any]) -> list[tuple[str, str, str, str, str]]:
     rows = []
     for st in SUMMARY_STATS:
         rows.append((st.label, st.unit, *(stat_text(doc["reactions"][r][st.key], st, n) for r in REACTIONS)))
+    return rows + design_rows(doc)
+
+
+def design_rows(doc: dict[str, Any]) -> list[tuple[str, str, str, str, str]]:
+    """Issue 18 rows: Gumbel design peaks (wind-induced and total), 95 % intervals of GF_Dy, GF_QS
+    and Cont_R, and the Cont_R flag state, at the tower of interest (empty for an old document)."""
+    reactions = doc["reactions"]
+    if "dynamic_analysis" not in reactions.get("Ry", {}):
+        return []
+    p = doc.get("design_fractile", 0.5)
+    rows = []
+    for key, label in (("peak_dynamic", f"design peak (p = {p:g})"),
+                       ("peak_dynamic_total", f"design total (p = {p:g})")):
+        st = STAT_ROWS[key]
+        rows.append((label, st.unit, *(design_text(reactions[r][key], st) for r in REACTIONS)))
+    for key in ("GF_Dy", "GF_QS", "Cont_R"):
+        st = STAT_ROWS[key]
+        rows.append((f"{st.label} 95 % CI", st.unit, *(ci_text(reactions[r][key], st) for r in REACTIONS)))
+    rows.append(("dynamic analysis", "", *(flag_text(reactions[r].get("dynamic_analysis")) for r in REACTIONS)))
     return rows
 
 
@@ -35,15 +63,10 @@ def summary_title(doc: dict[str, Any]) -> str:
             f"V_ref = {doc['v_ref']:g} m/s, {n} realization{'s' if n > 1 else ''}, seed {doc.get('seed')})")
 
 
-def cont_r_flags(doc: dict[str, Any]) -> list[str]:
-    """Reactions whose mean Cont_R exceeds :data:`CONT_R_FLAG` (only where the mean reaction
-    is not negligible, i.e. GF_Dy is defined: a share of a vanishing peak means nothing)."""
-    out = []
-    for r in REACTIONS:
-        v = doc["reactions"][r]["Cont_R"]["mean"]
-        if v is not None and v > CONT_R_FLAG and doc["reactions"][r]["GF_Dy"]["mean"] is not None:
-            out.append(r)
-    return out
+def cont_r_flags(doc: dict[str, Any], state: str = "recommended") -> list[str]:
+    """Reactions whose ``"dynamic_analysis"`` flag is ``state`` ("recommended": the 95 % interval
+    of Cont_R lies above :data:`CONT_R_FLAG`; "inconclusive": it straddles it; docs/method.md)."""
+    return [r for r in REACTIONS if doc["reactions"][r].get("dynamic_analysis") == state]
 
 
 # --------------------------------------------------------------------------- compare

@@ -10,7 +10,7 @@ from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.widgets import DataTable, RadioButton, RadioSet, Static, TabbedContent, TabPane
 
 from .. import figures
-from ..formatting import (CONT_R_FLAG, REACTIONS, cont_r_flags, davenport_lines, sanity_rows, spectral_compare_rows, spectral_rows,
+from ..formatting import (REACTIONS, cont_r_flags, davenport_lines, how_to_read, sanity_rows, spectral_compare_rows, spectral_rows,
                           summary_rows, summary_title)
 from ..plotting import PlotView
 from ..runner import RunOutput
@@ -134,8 +134,14 @@ class ResultsView(Vertical):
                      "** : GF undefined, mean zero by symmetry or < 1 % of the largest mean. "
                      "Cont_R: share of the peak a quasi-static analysis misses.", style="dim")
         if flagged:
-            notes.append(f"\nCont_R above {CONT_R_FLAG:.0%} for {', '.join(flagged)} (highlighted): "
-                         "dynamic analysis recommended.", style="bold yellow")
+            notes.append(f"\nCont_R above 10 % (95 % interval) for {', '.join(flagged)}: dynamic analysis recommended.",
+                         style="bold yellow")
+        unsure = cont_r_flags(doc, "inconclusive")
+        if unsure:
+            notes.append(f"\nCont_R interval straddles 10 % for {', '.join(unsure)}: inconclusive, run more "
+                         "realizations (linecheck run --until 1%).", style="yellow")
+        for line in how_to_read(doc):
+            notes.append("\n" + line, style="dim")
         if isinstance(doc.get("models"), dict):
             notes.append("\n" + models_text(doc))
         sa = doc.get("still_air", {}).get("reactions", {})

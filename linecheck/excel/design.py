@@ -1,0 +1,100 @@
+"""The "Design values" block of the Summary sheet (issue 18): per case and reaction (R_x, R_y, R_z)
+the Gumbel design peak, the total (still air + wind) design reaction, GF_Dy / GF_QS / Cont_R with
+their 95 % intervals, the Cont_R flag state, and a "how to read" block where GF < 1 or a negative
+Cont_BG occurs.  Names, units and meanings come from the one statistics table
+(:data:`linecheck.io.document.STAT_TABLE`)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from openpyxl.styles import Font
+from openpyxl.worksheet.worksheet import Worksheet
+
+from ..io.display import flag_text, how_to_read
+from . import template as tpl
+from .cells import GF_UNDEFINED, KN, PCT, RATIO, Cursor, align, is_num
+
+REACTIONS_ALL = ("Rx", "Ry", "Rz")
+HEADERS = (("Case", 16), ("Reaction", 8), ("still air\n(kN)", 9), ("design peak\nwind (kN)", 10),
+           ("design total\n(kN)", 10), ("ppcc", 7), ("GF_Dy", 8), ("GF_Dy\n95 % CI", 13), ("GF_QS", 8),
+           ("GF_QS\n95 % CI", 13), ("Cont_R\n(%)", 8), ("Cont_R\n95 % CI", 13), ("dynamic analysis", 30))
+
+
+def _ci(entry: dict[str, Any], pct: bool = False) -> str:
+    ci = entry.get("ci") or [None, None]
+    if not (is_num(ci[0]) and is_num(ci[1])):
+        return ""
+    if pct:
+        return f"[{100 * ci[0]:.1f}, {100 * ci[1]:.1f}] %"
+    return f"[{ci[0]:.3f}, {ci[1]:.3f}]"
+
+
+def write_design_block(ws: Worksheet, docs: list[dict], top: int, left: int = 1) -> int:
+    """Write the block from row ``top``; returns the next free row."""
+    ok = [d for d in docs if "error" not in d and "reactions" in d]
+    cur = Cursor(ws, top)
+    if not ok:
+        return top
+    p = {d.get("design_fractile", 0.5) for d in ok}
+    ptxt = ", ".join(f"{x:g}" for x in sorted(p))
+    cur.put(top, left, f"Design values at the tower of interest (Gumbel fractile {ptxt} of the peak; "
+                       "95 % confidence intervals of the mean over the realizations)", "lc_text")
+    ws.cell(row=top, column=left).font = Font(name="Calibri", size=11, bold=True)
+    cur.row = top + 1
+    for k, (label, _w) in enumerate(HEADERS):
+        cur.put(cur.row, left + k, label, "lc_header")
+    ws.row_dimensions[cur.row].height = 30
+    row = cur.row + 1
+    notes: list[str] = []
+    for doc in ok:
+        still = (doc.get("still_air") or {}).get("reactions") or {}
+        for r in REACTIONS_ALL:
+            e = doc["reactions"].get(r) or {}
+            pk = ((e.get("peak_dynamic") or {}).get("gumbel") or {})
+            tot = ((e.get("peak_dynamic_total") or {}).get("gumbel") or {})
+            sa = still.get(r)
+            vals: list[tuple[Any, str | None]] = [
+                (doc["case"], None), (r, None),
+                (sa / 1000.0 if is_num(sa) else None, KN),
+                (pk.get("design") / 1000.0 if is_num(pk.get("design")) else None, KN),
+                (tot.get("design") / 1000.0 if is_num(tot.get("design")) else None, KN),
+                (pk.get("ppcc") if is_num(pk.get("ppcc")) else None, "0.000"),
+            ]
+            for key, pct in (("GF_Dy", False), ("GF_QS", False), ("Cont_R", True)):
+                ent = e.get(key) or {}
+                m = ent.get("mean")
+                if pct:
+                    vals.append((m if is_num(m) else None, PCT))
+                else:
+                    vals.append((m if is_num(m) else GF_UNDEFINED, RATIO))
+                vals.append((_ci(ent, pct), None))
+            state = e.get("dynamic_analysis")
+            vals.append((flag_text(state), None))
+            for k, (v, fmt) in enumerate(vals):
+                style = "lc_text" if k in (0, 1, 7, 9, 11, 12) else "lc_number"
+                cell = cur.put(row, left + k, v, style, fmt)
+                if k == 1:
+                    align(cell, horizontal="center")
+            if state is not None:
+                ws.cell(row=row, column=left + len(vals) - 1).font = Font(
+                    name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT if state == "recommended" else "9C5700")
+            row += 1
+        for line in how_to_read(doc):
+            if line not in notes:
+                notes.append(line)
+    cur.row = row + 1
+    cur.note("Design peak: Gumbel (EV-I) fit of the realization peaks by moments, value at the design fractile "
+             "([analysis] design_fractile, default 0.5 = median peak); ppcc: probability-plot correlation of the fit. "
+             "Design total: the same for still air + wind.")
+    cur.note("dynamic analysis: 'recommended' where the 95 % interval of Cont_R lies above 10 %, 'inconclusive: run "
+             "more realizations' where it straddles 10 % (linecheck run --until 1%); none where GF is ** or the "
+             "wind-induced peak is below 5 % of the still-air reaction.")
+    if notes:
+        cur.row += 1
+        cur.put(cur.row, left, "How to read", "lc_text")
+        ws.cell(row=cur.row, column=left).font = Font(name="Calibri", size=11, bold=True)
+        cur.row += 1
+        for line in notes:
+            cur.note(line)
+    return cur.row

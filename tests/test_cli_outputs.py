@@ -6,6 +6,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import errno
+import json
 import os
 import re
 import sys
@@ -415,3 +416,24 @@ def test_run_output_legend_flag_and_burn_in_note_once(short_case):
     assert notes[0].startswith("note: damping = \"paper\" leaves the") and "use damping = \"quasi-steady\"" in notes[0]
     assert "A flagged resonant component" not in out  # the note already says why, not twice
     assert burn_in_note(replace(d, burn_in=replace(d.burn_in, sufficient=True))) is None
+
+
+# --------------------------------------------------------------------------- the typed document
+def test_saved_run_and_batch_json_read_back_byte_for_byte(short_case, tmp_path):
+    """Every front end reads the typed RunDocument; a saved `run --json` file and a batch result
+    (with its case_file/case_hash keys) read with from_json and written again are the same bytes,
+    keys in the same order -- the typed layer adds nothing to and drops nothing from the public JSON."""
+    from linecheck.batch import run_batch
+
+    js = tmp_path / "r.json"
+    res = runner.invoke(app, ["run", str(short_case), "--json", str(js)])
+    assert res.exit_code == 0, res.output
+    out = tmp_path / "batch"
+    assert run_batch([short_case], json_dir=out).exit_code == 0
+    for path in (js, out / f"{short_case.stem}.json"):
+        text = path.read_text()
+        typed = RunDocument.from_json(json.loads(text), source=str(path))
+        assert typed.blocks == {}, f"untyped blocks in {path.name}: {sorted(typed.blocks)}"
+        again = write_json(tmp_path / f"again-{path.name}", typed)
+        assert again.read_text() == text, path.name
+    assert typed.batch is not None and typed.batch.case_file == str(short_case)

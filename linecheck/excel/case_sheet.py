@@ -167,7 +167,7 @@ def _still_air_and_step1(cur: Cursor, doc: RunDocument) -> None:
         for r in REACTIONS:
             cur.put(cur.row, 1, f"{r} still air", "lc_text")
             cur.put(cur.row, 2, "kN", "lc_text")
-            cur.put(cur.row, 3, kn(still.reactions.get(r)), fmt=KN3)
+            cur.put(cur.row, 3, kn(still.reactions[r]), fmt=KN3)
             cur.row += 1
         for label, v, unit, fmt in (("sag S", still.sag, "m", "0.00"),
                                     ("nominal tension T0 = W Lx² / 8S", kn(still.tension_nominal), "kN", KN3)):
@@ -182,7 +182,7 @@ def _still_air_and_step1(cur: Cursor, doc: RunDocument) -> None:
     cur.section(f"Step 1: mean state (tower {toi})" + (", extreme over the event" if series else ""))
     cur.header(["Quantity", "Unit", "Value", "at t (s)" if series else ""])
     for r in REACTIONS:
-        v, k = _argmax_abs(static.reactions_wind.get(r) or [])
+        v, k = _argmax_abs(static.reactions_wind[r])
         cur.put(cur.row, 1, f"{r} mean, wind-induced M" + (" at max |M|" if series else ""), "lc_text")
         cur.put(cur.row, 2, "kN", "lc_text")
         cur.put(cur.row, 3, kn(v), fmt=KN3)
@@ -190,7 +190,7 @@ def _still_air_and_step1(cur: Cursor, doc: RunDocument) -> None:
             cur.put(cur.row, 4, times[k], fmt=SEC)
         cur.row += 1
     for key in ("dx", "dy", "dz"):
-        v, k = _argmax_abs(static.displacement.get(key) or [])
+        v, k = _argmax_abs(static.displacement[key])
         if v is None:
             continue
         cur.put(cur.row, 1, f"{key} insulator end" + (" at max |d|" if series else ""), "lc_text")
@@ -346,7 +346,7 @@ def _spectral(cur: Cursor, doc: RunDocument) -> None:
         cur.put(cur.row, 2, "Hz" if st is None else st.display_unit, "lc_text")
         fmt = "0.000" if st is None else excel_format(st)
         for k, r in enumerate(REACTIONS):
-            v = sp.exact[r].get(key)
+            v = sp.exact[r][key]
             cur.put(cur.row, 3 + k, v if st is None else stat_cell(st, v), fmt=fmt)
             cur.put(cur.row, 6 + k, None if st is None else stat_cell(st, doc.reactions[r][td].mean), fmt=fmt)
         cur.row += 1

@@ -101,8 +101,8 @@ def case_charts(ws: Worksheet, doc: Any, chart_points: int, contrib_rows: tuple[
         t = as_array(th.time)
         series: dict[str, dict[str, np.ndarray]] = {}
         for r in ("Rx", "Ry"):
-            comp = th.series.get(r) or {}
-            m, b, rr = as_array(comp.get("M")), as_array(comp.get("B")), as_array(comp.get("R"))
+            comp = th.series[r]
+            m, b, rr = as_array(comp["M"]), as_array(comp["B"]), as_array(comp["R"])
             if m.size == t.size and b.size == t.size and rr.size == t.size:
                 series[r] = {"M": m / 1e3, "M+B": (m + b) / 1e3, "M+B+R": (m + b + rr) / 1e3}
         if series:

@@ -246,7 +246,7 @@ def spectral_compare_rows(doc: RunDocument) -> list[tuple[str, ...]]:
         row = [st.label if fkey != "mean" else "mean", st.display_unit]
         for r in REACTIONS:
             row.append(_scaled(doc.reactions[r][tkey].mean, st))
-            row.append(_scaled(exact[r].get(fkey), st))
+            row.append(_scaled(exact[r][fkey], st))
         rows.append(tuple(row))
     return rows
 

@@ -13,10 +13,10 @@ Contract:
   bit-identical to ``service.run_case(case)`` whatever the chunking, ``--jobs`` or
   scheduler.
 - A case whose chunks are all in is saved at once (``<json_dir>/<file stem>.json``,
-  the :func:`~linecheck.io.jsonout.run_to_dict` document plus ``"case_file"`` and
-  ``"case_hash"``, written atomically), so an interrupted batch loses only running
-  cases.  With ``resume`` a case whose saved JSON carries the same file hash is
-  skipped and its saved document reused.
+  the typed :func:`~linecheck.io.jsonout.run_document` plus its ``BatchSource``
+  (``"case_file"``, ``"case_hash"``), written atomically), so an interrupted batch loses
+  only running cases.  With ``resume`` a case whose saved JSON carries the same file hash
+  (and reads as the current schema version) is skipped and its saved document reused.
 - One failing case (bad file, non-convergence, any LinecheckError, a crashed worker)
   is reported in its :class:`CaseOutcome`; the other cases complete.  When a process-pool
   worker dies (out-of-memory kill), the pool is restarted (:meth:`Executor.restart`): the

@@ -1,7 +1,7 @@
 """The run job of the TUI: service calls only, no Textual (runs in a thread worker).
 
-``execute`` runs steps 1-3 (:func:`linecheck.service.run_case`), builds the JSON
-document exactly as ``linecheck run`` does (:func:`linecheck.io.jsonout.run_to_dict`),
+``execute`` runs steps 1-3 (:func:`linecheck.service.run_case`), builds the typed
+document exactly as ``linecheck run`` does (:func:`linecheck.io.jsonout.run_document`),
 then the natural frequencies and the wind at point p for the extra result tabs.
 Progress goes through ``progress(stage, done, total)``; ``cancel`` is a plain
 :class:`threading.Event` checked by the service and between the jobs.

@@ -208,9 +208,15 @@ def codes_block(res: Any) -> dict[str, Any]:
     :class:`~linecheck.io.document.CodeCheck`): the design codes beside the run's peaks; a code
     outside its validity is reported, not raised (``linecheck codes`` raises instead)."""
     from ..service import codes_analysis
+
+    return codes_document(codes_analysis(res.case, res, strict=False))
+
+
+def codes_document(cr: Any) -> dict[str, Any]:
+    """The typed form of :func:`codes_to_dict`: per code a :class:`~linecheck.io.document.CodeCheck`."""
     from .document import CodeCheck
 
-    return {k: CodeCheck.from_json(v) for k, v in codes_to_dict(codes_analysis(res.case, res, strict=False)).items()}
+    return {k: CodeCheck.from_json(v) for k, v in codes_to_dict(cr).items()}
 
 
 def with_models(doc: Any, model: str, reactions: dict[str, Any], failed: dict[str, str] | None = None) -> Any:

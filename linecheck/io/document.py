@@ -549,7 +549,7 @@ class RunDocument:
     def from_json(cls, d: dict[str, Any], *, source: str | None = None) -> RunDocument:
         """Read a saved document; :class:`CaseError` (exit 2) for another schema version or a
         document that is not a run result, saying how to regenerate it."""
-        where = source or "result document"
+        what = "is " if source else "result document is "  # CaseError puts the file name first
         if not isinstance(d, dict) or "reactions" not in d or "case" not in d:
             raise CaseError("is not a linecheck run result (no \"case\"/\"reactions\"): expected the JSON of "
                             "`linecheck run --json` or of a batch", file=source)
@@ -582,8 +582,8 @@ class RunDocument:
                 models_failed=d.get("models_failed"),
             )
         except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
-            raise CaseError(f"{where} is incomplete or damaged ({type(exc).__name__}: {exc}): regenerate it with "
-                            "`linecheck run CASE.toml --json FILE.json`", file=source) from None
+            raise CaseError(f"{what}incomplete or damaged ({type(exc).__name__}: {exc}): regenerate it with "
+                            f"`linecheck run CASE.toml --json {source or 'FILE.json'}`", file=source) from None
         typed = {k for k, _ in HEADER_FIELDS} | {"reactions", "towers", "until"} | set(BLOCK_FIELDS) | set(_BATCH_KEYS)
         blocks = {k: v for k, v in d.items() if k not in typed}
         return cls(**head, reactions=reactions, towers=towers, until=until, **opts, blocks=blocks)

@@ -6,11 +6,11 @@ Without ``--from``, four representative paper cases (downburst/synoptic, single/
 spans) are run once with 2 realizations over their full records, and their result
 documents are cloned onto the 24 paper case files (names, spans, V_ref, L_x and
 parameters of each file), so every document has the size of a real one: full-length
-records thinned peak-preserving by ``run_to_dict`` (6,000 to 8,000 samples per
+records thinned peak-preserving by ``run_document`` (6,000 to 8,000 samples per
 history).  With ``--from DIR`` the ``*.json`` run results in DIR are used (e.g. the
 ``--json-dir`` of a real ``linecheck batch``).
 
-Timed: ``write_workbook`` from the dicts (``run``/``batch --excel``) and
+Timed: ``write_workbook`` from the typed documents (``run``/``batch --excel``) and
 ``load_result_docs`` + ``write_workbook`` from saved JSON files (``linecheck export``).
 ``--full-histories`` adds a row with un-thinned histories (what ``--full-histories``
 runs produce), for information: that size is the user's explicit choice.
@@ -19,7 +19,6 @@ runs produce), for information: that size is the user's explicit choice.
 from __future__ import annotations
 
 import argparse
-import copy
 import dataclasses
 import sys
 import tempfile
@@ -32,7 +31,8 @@ sys.path.insert(0, str(ROOT))
 from linecheck import service  # noqa: E402
 from linecheck.core.case import case_to_dict, load_case  # noqa: E402
 from linecheck.excel.writer import load_result_docs, write_workbook  # noqa: E402
-from linecheck.io.jsonout import run_to_dict, write_json  # noqa: E402
+from linecheck.io.document import RunDocument  # noqa: E402
+from linecheck.io.jsonout import run_document, write_json  # noqa: E402
 
 PAPER = ROOT / "cases" / "paper"
 REPRESENTATIVE = ("case01-six", "case05-single", "case09-six", "case11-single")
@@ -40,32 +40,31 @@ TARGET_S = 10.0
 TARGET_MB = 10.0
 
 
-def representative_docs(full: bool) -> dict[tuple[str, int], dict]:
+def representative_docs(full: bool) -> dict[tuple[str, int], RunDocument]:
     out = {}
     for name in REPRESENTATIVE:
         case = load_case(PAPER / f"{name}.toml")
         case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, realizations=2))
         t0 = time.perf_counter()
         res = service.run_case(case)
-        doc = run_to_dict(res, full_histories=full)
-        print(f"  ran {name}: {time.perf_counter() - t0:.1f} s, {len(doc['time_histories']['time'])} samples "
+        doc = run_document(res, full_histories=full)
+        print(f"  ran {name}: {time.perf_counter() - t0:.1f} s, {len(doc.time_histories.time)} samples "
               f"per history", file=sys.stderr)
         out[(case.wind.type, case.line.spans)] = doc
     return out
 
 
-def paper_batch(reps: dict[tuple[str, int], dict]) -> list[dict]:
+def paper_batch(reps: dict[tuple[str, int], RunDocument]) -> list[RunDocument]:
     docs = []
     for path in sorted(PAPER.glob("case*.toml")):
         case = load_case(path)
-        doc = copy.deepcopy(reps[(case.wind.type, case.line.spans)])
-        doc.update(case=case.name, description=case.description, v_ref=case.wind.v_ref,
-                   span_length=case.line.span_length, parameters=case_to_dict(case))
-        docs.append(doc)
+        docs.append(dataclasses.replace(reps[(case.wind.type, case.line.spans)], case=case.name,
+                                        description=case.description, v_ref=case.wind.v_ref,
+                                        span_length=case.line.span_length, parameters=case_to_dict(case)))
     return docs
 
 
-def measure(label: str, docs: list[dict], tmp: Path, repeat: int) -> dict:
+def measure(label: str, docs: list[RunDocument], tmp: Path, repeat: int) -> dict:
     out = tmp / f"{label.replace(' ', '_')}.xlsx"
     t_dicts = t_export = float("inf")
     for _ in range(repeat):
@@ -76,7 +75,7 @@ def measure(label: str, docs: list[dict], tmp: Path, repeat: int) -> dict:
     jdir.mkdir(exist_ok=True)
     files = []
     for k, doc in enumerate(docs):
-        files.append(write_json(jdir / f"{k:02d}-{doc['case']}.json", doc))
+        files.append(write_json(jdir / f"{k:02d}-{doc.case}.json", doc))
     json_mb = sum(f.stat().st_size for f in files) / 1e6
     for _ in range(repeat):
         t0 = time.perf_counter()
@@ -111,7 +110,7 @@ def main(argv: list[str] | None = None) -> int:
         ok &= within or "full" in r["label"]
         print(f"{r['label']:<26} {r['cases']:>5} {r['json_mb']:>8.1f} {r['write_s']:>8.2f} {r['export_s']:>9.2f} "
               f"{r['xlsx_mb']:>8.2f}  <= {TARGET_S:g} s, <= {TARGET_MB:g} MB: {'ok' if within else 'MISSED'}")
-    print(f"write s: write_workbook from the result dicts (run/batch --excel); export s: load the saved JSON "
+    print(f"write s: write_workbook from the typed documents (run/batch --excel); export s: load the saved JSON "
           f"+ write (linecheck export); best of {args.repeat} (full histories: 1 run).")
     return 0 if ok else 1
 

@@ -219,7 +219,7 @@ def test_non_convergence_fails_only_its_case(short_cases, monkeypatch):
     assert sum(s == "done" for s in status.values()) == len(short_cases) - 1
     failed = rep.failed[0]
     assert failed.error_kind == "ConvergenceError" and "did not converge" in failed.error
-    assert failed.excel_doc() == {"case": victim, "error": failed.error}
+    assert failed.excel_doc().to_json() == {"case": victim, "error": failed.error}
     assert rep.exit_code == 1
 
 
@@ -238,8 +238,8 @@ def test_excel_gets_results_and_errors(short_cases, tmp_path, monkeypatch):
     r = runner.invoke(app, ["batch", str(short_cases[1]), str(bad), "--jobs", "1", "--excel", str(xlsx)])
     assert r.exit_code == 1, r.output
     docs = seen["docs"]
-    assert docs[0]["case"] == load_case(short_cases[1]).name and "reactions" in docs[0]
-    assert docs[1]["case"] == "broken" and "missing required table" in docs[1]["error"]
+    assert docs[0].case == load_case(short_cases[1]).name and docs[0].reactions["Ry"]  # typed documents
+    assert docs[1].case == "broken" and "missing required table" in docs[1].error
     assert seen["kw"]["force"] is False
     assert (tmp_path / "results" / f"{short_cases[1].stem}.json").exists()  # default: next to the workbook
     # an existing workbook without --force is a usage error before any work
@@ -256,7 +256,7 @@ def test_resume_redoes_only_missing_cases(short_cases, tmp_path):
     before = (out / f"{short_cases[0].stem}.json").read_bytes()
     again = run_batch(short_cases, json_dir=out, resume=True)
     assert [o.status for o in again.outcomes] == ["skipped", "done", "skipped"]
-    assert again.outcomes[0].doc is not None and again.outcomes[0].excel_doc()["case"] == first.outcomes[0].name
+    assert again.outcomes[0].doc is not None and again.outcomes[0].excel_doc().case == first.outcomes[0].name
     assert (out / f"{short_cases[0].stem}.json").read_bytes() == before
     # editing a case file invalidates its saved result
     p = short_cases[2]
@@ -548,19 +548,25 @@ def test_summary_flags_cont_r_and_failed_sanity_check(short_cases):
     from linecheck.batch import BatchReport
     from linecheck.cli.batch_cmd import summary_notes, summary_table
 
+    from linecheck.io.document import RunDocument
+
     clean = run_batch([short_cases[1]]).outcomes[0]  # synoptic: has the sanity check
-    assert clean.doc["spectral"]["sanity_check"], "synoptic results carry the sanity check"
+    assert clean.doc.spectral.sanity_check, "synoptic results carry the sanity check"
     flagged = copy.deepcopy(clean)
     flagged.name = "flagged"
-    flagged.doc["reactions"]["Ry"]["Cont_R"]["mean"] = 0.25
-    flagged.doc["reactions"]["Ry"]["dynamic_analysis"] = "recommended"  # interval above 10 % (issue 18)
-    flagged.doc["spectral"]["sanity_check"][0].update(reaction="Rz", quantity="rms_fluctuating", time_domain=176.0,
-                                                      frequency_domain=212.0, allowed_difference=20.0, ok=False)
-    for item in clean.doc["spectral"]["sanity_check"]:
+    d = flagged.doc.to_json()  # edit the JSON, read it back typed (as a saved result would be)
+    d["reactions"]["Ry"]["Cont_R"]["mean"] = 0.25
+    d["reactions"]["Ry"]["dynamic_analysis"] = "recommended"  # interval above 10 % (issue 18)
+    d["spectral"]["sanity_check"][0].update(reaction="Rz", quantity="rms_fluctuating", time_domain=176.0,
+                                            frequency_domain=212.0, allowed_difference=20.0, ok=False)
+    flagged.doc = RunDocument.from_json(d)
+    d = clean.doc.to_json()
+    for item in d["spectral"]["sanity_check"]:
         item["ok"] = True
-    clean.doc["reactions"]["Ry"]["Cont_R"]["mean"] = 0.05
+    d["reactions"]["Ry"]["Cont_R"]["mean"] = 0.05
     for r in ("Rx", "Ry", "Rz"):
-        clean.doc["reactions"][r]["dynamic_analysis"] = None
+        d["reactions"][r]["dynamic_analysis"] = None
+    clean.doc = RunDocument.from_json(d)
     report = BatchReport([clean, flagged])
 
     def render(obj) -> str:

@@ -24,6 +24,7 @@ from linecheck.core.errors import CaseError
 from linecheck.excel import template as tpl
 from linecheck.excel.summary import SANITY_HEADER
 from linecheck.excel.writer import write_workbook
+from linecheck.io.document import RunDocument
 from linecheck.io.jsonout import run_to_dict, write_json
 
 from .conftest import CASES
@@ -385,7 +386,7 @@ def test_run_table_fits_120_columns_and_flags_cont_r(doc):
     for r, state in (("Rx", "recommended"), ("Ry", None), ("Rz", "recommended")):  # issue 18 flag states
         d["reactions"][r]["dynamic_analysis"] = state
     con = Console(width=120, record=True, color_system="truecolor", force_terminal=True)
-    con.print(results_table(d))
+    con.print(results_table(RunDocument.from_json(d)))  # the console reads the typed document
     text = con.export_text(clear=False)
     assert "…" not in text
     assert max(len(ln) for ln in text.splitlines()) <= 120
@@ -401,14 +402,38 @@ def test_run_output_legend_flag_and_burn_in_note_once(short_case):
     assert res.exit_code == 0, res.output
     out = res.output
     assert "Cont_R: share of the peak that a quasi-static analysis misses" in out
-    d = json.loads(json.dumps(run_to_dict(service.run_case(load_case(short_case)))))
-    from linecheck.cli.run_cmd import burn_in_note, cont_r_flagged
+    from dataclasses import replace
 
+    from linecheck.cli.run_cmd import burn_in_note, cont_r_flagged
+    from linecheck.io.jsonout import run_document
+
+    d = run_document(service.run_case(load_case(short_case)))
     assert ("Cont_R above 10 %" in out) == any(cont_r_flagged(d, r) for r in ("Rx", "Ry"))
     # the paper's damping: the burn-in is never reached; one line says what it means and what to do
-    assert d["damping"] == "paper" and not d["burn_in"]["sufficient"]
+    assert d.damping == "paper" and not d.burn_in.sufficient
     notes = [ln for ln in out.splitlines() if "burn-in" in ln]
     assert len(notes) == 1, out
     assert notes[0].startswith("note: damping = \"paper\" leaves the") and "use damping = \"quasi-steady\"" in notes[0]
     assert "A flagged resonant component" not in out  # the note already says why, not twice
-    assert burn_in_note({**d, "burn_in": {**d["burn_in"], "sufficient": True}}) is None
+    assert burn_in_note(replace(d, burn_in=replace(d.burn_in, sufficient=True))) is None
+
+
+# --------------------------------------------------------------------------- the typed document
+def test_saved_run_and_batch_json_read_back_byte_for_byte(short_case, tmp_path):
+    """Every front end reads the typed RunDocument; a saved `run --json` file and a batch result
+    (with its case_file/case_hash keys) read with from_json and written again are the same bytes,
+    keys in the same order -- the typed layer adds nothing to and drops nothing from the public JSON."""
+    from linecheck.batch import run_batch
+
+    js = tmp_path / "r.json"
+    res = runner.invoke(app, ["run", str(short_case), "--json", str(js)])
+    assert res.exit_code == 0, res.output
+    out = tmp_path / "batch"
+    assert run_batch([short_case], json_dir=out).exit_code == 0
+    for path in (js, out / f"{short_case.stem}.json"):
+        text = path.read_text()
+        typed = RunDocument.from_json(json.loads(text), source=str(path))
+        assert typed.blocks == {}, f"untyped blocks in {path.name}: {sorted(typed.blocks)}"
+        again = write_json(tmp_path / f"again-{path.name}", typed)
+        assert again.read_text() == text, path.name
+    assert typed.batch is not None and typed.batch.case_file == str(short_case)

@@ -283,13 +283,14 @@ def test_excel_codes_sheet(short_run):
 
     from linecheck.excel import template as tpl
     from linecheck.excel.codes_sheet import write_codes
+    from linecheck.io.document import RunDocument
     from linecheck.io.jsonout import run_to_dict
 
     doc = json.loads(json.dumps(run_to_dict(short_run)))
     wb = Workbook()
     tpl.ensure_styles(wb)
     ws = wb.active
-    assert write_codes(ws, [doc]) == 4 * 2  # four codes x two towers x Ry
+    assert write_codes(ws, [RunDocument.from_json(doc)]) == 4 * 2  # four codes x two towers x Ry
     rows = list(ws.iter_rows(min_row=4, max_row=11, values_only=True))
     asce = doc["codes"]["ASCE74"]["towers"][0]["Ry"]
     assert rows[0][1] == "ASCE74" and rows[0][4] == 1 and rows[0][5] == "Ry"
@@ -299,6 +300,7 @@ def test_excel_codes_sheet(short_run):
 async def test_tui_codes_tab_shows_the_run_document(short_run):
     from textual.widgets import DataTable, TabbedContent
 
+    from linecheck.io.document import RunDocument
     from linecheck.io.jsonout import run_to_dict
     from linecheck.tui.app import LinecheckApp
     from linecheck.tui.widgets.codes import CodesView
@@ -306,7 +308,7 @@ async def test_tui_codes_tab_shows_the_run_document(short_run):
     doc = json.loads(json.dumps(run_to_dict(short_run)))
     app = LinecheckApp([ROOT / "no-such-folder"])
     async with app.run_test(size=(160, 50)) as pilot:
-        app.query_one(CodesView).show(doc)
+        app.query_one(CodesView).show(RunDocument.from_json(doc))  # the TUI reads the typed document
         await pilot.press("5")
         await pilot.pause()
         assert app.query_one("#main-tabs", TabbedContent).active == "codes"

@@ -101,10 +101,11 @@ def _table_at(ws, top, left):
 
 
 KN = 1e-3
-STAT_COLS = {"mean_max\n(kN)": ("mean_max", KN), "peak QS\n(kN)": ("peak_quasi_static", KN),
+# headers: the short label and unit of the one statistics table (linecheck.io.document.STAT_TABLE)
+STAT_COLS = {"mean M\n(kN)": ("mean_max", KN), "peak QS\n(kN)": ("peak_quasi_static", KN),
              "peak Dy\n(kN)": ("peak_dynamic", KN), "GF_Dy": ("GF_Dy", None), "GF_QS": ("GF_QS", None),
              "Cont_M\n(%)": ("Cont_M", 1.0), "Cont_BG\n(%)": ("Cont_BG", 1.0), "Cont_R\n(%)": ("Cont_R", 1.0),
-             "peak /\n(g*yp Lx)": ("peak_normalised", 1.0)}
+             "peak / g*yp Lx": ("peak_normalised", 1.0)}
 
 
 def _conv(value, scale, stat):
@@ -190,8 +191,10 @@ def test_threshold_changes_flags(light, tmp_path):
     write_workbook(light, path, cont_r_threshold=0.001)
     _, _, rows = _summary_table(load_workbook(path))
     from linecheck.io.display import flag_state
+    from linecheck.io.document import RunDocument
 
-    want = sum(1 for d in light for r in SUMMARY_REACTIONS if flag_state(d, r, 0.001) == "recommended")
+    typed = [RunDocument.from_json(d) for d in light]
+    want = sum(1 for d in typed for r in SUMMARY_REACTIONS if flag_state(d, r, 0.001) == "recommended")
     assert want > 0  # the rule is recomputed at the threshold from the intervals
     assert sum(1 for r in rows if r["Note"] == FLAG_NOTE) == want
     ws = load_workbook(path)["Summary"]
@@ -430,8 +433,11 @@ def test_histories_thinned_unless_full(docs, tmp_path):
 
 
 def test_missing_optional_blocks(light, tmp_path):
-    """A minimal result (no histories, static, parameters, spectral) still gives a sheet."""
-    doc = {k: v for k, v in light[0].items() if k in ("case", "wind", "reactions", "realizations", "tower_of_interest")}
+    """A minimal result (no histories, static, parameters, spectral, codes: the schema's required
+    keys only) still gives a sheet."""
+    from linecheck.io.document import HEADER_FIELDS
+
+    doc = {k: v for k, v in light[0].items() if k in {h for h, _ in HEADER_FIELDS} | {"reactions", "towers"}}
     path = write_workbook([doc], tmp_path / "min.xlsx")
     wb = load_workbook(path)
     assert [type(c).__name__ for c in wb[doc["case"]]._charts] == ["BarChart"]
@@ -457,7 +463,9 @@ def test_load_result_docs_errors(tmp_path, light):
         load_result_docs([static])
     both = tmp_path / "both.json"
     both.write_text(json.dumps(light[:2]))
-    assert [d["case"] for d in load_result_docs([both])] == [d["case"] for d in light[:2]]
+    loaded = load_result_docs([both])  # typed documents, byte for byte the saved JSON
+    assert [d.case for d in loaded] == [d["case"] for d in light[:2]]
+    assert json.dumps([d.to_json() for d in loaded]) == json.dumps(light[:2])
 
 
 # --------------------------------------------------------------------------- CLI

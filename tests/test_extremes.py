@@ -156,29 +156,41 @@ def test_flag_three_states():
 
 def test_flag_state_at_another_threshold():
     """export --cont-r-threshold: the three-state rule recomputed from the interval in the JSON."""
+    from types import SimpleNamespace
+
     from linecheck.io.display import flag_state
+    from linecheck.io.document import ReactionResult, StatValue, StillAir
+
+    def value(mean=None, ci=None):
+        return StatValue(mean, None, None, None, None, None, ci=ci)
 
     def block(lo, hi, gf=1.3, peak=2000.0, state="x"):
-        return {"Cont_R": {"ci": [lo, hi]}, "GF_Dy": {"mean": gf}, "peak_dynamic": {"mean": peak},
-                "dynamic_analysis": state}
+        return ReactionResult({"Cont_R": value(ci=(lo, hi)), "GF_Dy": value(gf), "peak_dynamic": value(peak)}, state)
 
-    doc = {"still_air": {"reactions": {"Rx": 30_000.0, "Ry": 0.0, "Rz": 40_000.0}},  # |still air| 50 kN
-           "reactions": {"Rx": block(0.06, 0.09), "Ry": block(0.03, 0.07), "Rz": block(0.06, 0.09, peak=2400.0)}}
+    reactions = {"Rx": block(0.06, 0.09), "Ry": block(0.03, 0.07), "Rz": block(0.06, 0.09, peak=2400.0)}
+    doc = SimpleNamespace(reactions=reactions,  # |still air| 50 kN
+                          still_air=StillAir({"Rx": 30_000.0, "Ry": 0.0, "Rz": 40_000.0}, [], None, 1.0))
     assert flag_state(doc, "Rx") == "x"  # 10 %: the document's own state
     assert flag_state(doc, "Rx", 0.05) is None  # peak 2 kN < 5 % of 50 kN
     assert flag_state(doc, "Rz", 0.05) is None  # 2.4 kN < 2.5 kN
-    doc["still_air"]["reactions"] = {"Rx": 0.0, "Ry": 0.0, "Rz": 10_000.0}
+    doc.still_air = StillAir({"Rx": 0.0, "Ry": 0.0, "Rz": 10_000.0}, [], None, 1.0)
     assert flag_state(doc, "Rx", 0.05) == "recommended"
     assert flag_state(doc, "Ry", 0.05) == "inconclusive"
     assert flag_state(doc, "Ry", 0.08) is None
 
 
 def test_how_to_read_notes_only_when_they_apply():
+    from types import SimpleNamespace
+
     from linecheck.io.display import HOW_TO_READ_GF_BELOW_1, HOW_TO_READ_NEGATIVE_CONT_BG, how_to_read
+    from linecheck.io.document import ReactionResult, StatValue
+
+    def means(**kw):
+        return ReactionResult({k: StatValue(m, None, None, None, None, None) for k, m in kw.items()}, None)
 
     def doc(gf, bg):
-        return {"reactions": {"Rx": {"GF_Dy": {"mean": 1.2}, "GF_QS": {"mean": gf}, "Cont_BG": {"mean": bg}},
-                              "Ry": {"GF_Dy": {"mean": None}, "GF_QS": {"mean": None}, "Cont_BG": {"mean": 0.1}}}}
+        return SimpleNamespace(reactions={"Rx": means(GF_Dy=1.2, GF_QS=gf, Cont_BG=bg),
+                                          "Ry": means(GF_Dy=None, GF_QS=None, Cont_BG=0.1)})
 
     assert how_to_read(doc(1.1, 0.05)) == []
     assert how_to_read(doc(0.94, -0.04)) == [HOW_TO_READ_GF_BELOW_1, HOW_TO_READ_NEGATIVE_CONT_BG]

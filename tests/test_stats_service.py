@@ -123,9 +123,22 @@ def test_document_keys_roundtrip_and_old_files(run9, tmp_path):
     typed = RunDocument.from_json(doc)
     assert typed.to_json() == doc
     assert typed.reactions["Ry"]["GF_Dy"].mean == ry["GF_Dy"]["mean"]
-    # extra blocks (e.g. "codes") pass through
-    d2 = dict(doc, codes={"x": 1})
-    assert RunDocument.from_json(d2).to_json()["codes"] == {"x": 1}
+    # byte for byte, keys in the same order: what a front end reads is what was written
+    assert json.dumps(typed.to_json(), indent=2) == json.dumps(doc, indent=2)
+    # every block is typed (attribute access for the front ends) ...
+    assert typed.still_air.reactions["Ry"] == doc["still_air"]["reactions"]["Ry"]
+    assert typed.time_histories.series["Ry"]["R"] == doc["time_histories"]["Ry"]["R"]
+    assert typed.spectral is None and "spectral" not in doc  # spectral_check=False (typed: test_cli_outputs)
+    code = next(iter(doc["codes"]))
+    assert typed.codes[code].towers[0].index == doc["codes"][code]["towers"][0]["index"]
+    assert typed.burn_in.seconds == doc["burn_in"]["seconds"] and typed.blocks == {}
+    # ... and a key this version does not know passes through, after the typed ones
+    d2 = dict(doc, custom={"x": 1})
+    assert list(RunDocument.from_json(d2).to_json())[-1] == "custom"
+    assert RunDocument.from_json(d2).to_json()["custom"] == {"x": 1}
+    # a damaged typed block fails with the regenerate message (exit 2), not a traceback
+    with pytest.raises(CaseError, match="incomplete or damaged"):
+        RunDocument.from_json(dict(doc, burn_in={"seconds": 1.0}), source="cut.json")
     # an old (pre-issue-18) document fails with a message saying how to regenerate it
     old = {k: v for k, v in doc.items() if k != "schema_version"}
     with pytest.raises(CaseError, match="regenerate it with `linecheck run"):

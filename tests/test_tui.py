@@ -20,6 +20,7 @@ from typer.testing import CliRunner
 from linecheck import service
 from linecheck.core.case import case_to_toml, load_case, with_value
 from linecheck.core.errors import CaseError
+from linecheck.io.document import RunDocument
 from linecheck.io.jsonout import run_to_dict
 
 textual = pytest.importorskip("textual")
@@ -162,7 +163,7 @@ async def test_session_open_edit_run_tabs_export_compare(short_case: Path, tmp_p
         await pilot.press("r")
         await wait_for(pilot, lambda: of_type(messages, msg.RunFinished), "RunFinished", messages)
         assert {m.stage for m in of_type(messages, msg.RunProgress)} >= {"step 1: mean states", "steps 2-3: dynamics"}
-        doc = of_type(messages, msg.RunFinished)[-1].output.doc
+        doc = of_type(messages, msg.RunFinished)[-1].output.doc.to_json()  # the TUI reads the typed document
         expected = run_to_dict(service.run_case(app.case))  # what `linecheck run --json` writes
         assert doc["reactions"] == expected["reactions"]
         assert doc["seed"] == expected["seed"] and doc["v_ref"] == 30.0
@@ -471,7 +472,6 @@ async def test_switching_case_with_unsaved_edits_asks(short_case: Path) -> None:
 
 
 async def test_compare_with_a_zero_pinned_value_shows_the_absolute_difference(short_case: Path) -> None:
-    import copy
     import dataclasses
 
     messages = Recorder()
@@ -482,15 +482,15 @@ async def test_compare_with_a_zero_pinned_value_shows_the_absolute_difference(sh
         await wait_for(pilot, lambda: of_type(messages, msg.RunFinished), "RunFinished", messages)
         first = app.output
         # a pinned peak about zero (as a symmetric case gives: 1e-13 N), beside a real one
-        doc = copy.deepcopy(first.doc)
+        doc = first.doc.to_json()
         doc["reactions"]["Ry"]["peak_dynamic"]["mean"] = 1e-13
-        app.output = dataclasses.replace(first, doc=doc)
+        app.output = dataclasses.replace(first, doc=RunDocument.from_json(doc))
         await pilot.press("p")
         await edit(pilot, app, "wind.v_ref", "25")
         await pilot.press("r")
         await wait_for(pilot, lambda: len(of_type(messages, msg.RunFinished)) == 2, "second RunFinished", messages)
         await pilot.pause()
-        current = app.output.doc["reactions"]
+        current = app.output.doc.to_json()["reactions"]
         table = app.query_one("#compare-table", DataTable)
         rows = [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
         reaction = ""
@@ -503,7 +503,7 @@ async def test_compare_with_a_zero_pinned_value_shows_the_absolute_difference(sh
         assert b > 10.0  # a real peak [N]: a relative change would be astronomically large
         assert by_key["Ry", "peak dynamic M+B+R"][5] == f"{(b - 1e-13) / 1e3:+.3f} kN"
         # a value well above the floor keeps the relative difference, computed here from the JSON
-        a, b = first.doc["reactions"]["Rx"]["mean_max"]["mean"], current["Rx"]["mean_max"]["mean"]
+        a, b = first.doc.reactions["Rx"]["mean_max"].mean, current["Rx"]["mean_max"]["mean"]
         assert by_key["Rx", "mean max"][5] == f"{(b - a) / abs(a) * 100:+.1f} %"
         assert not any("e+" in row[5] for row in rows)
 
@@ -578,17 +578,22 @@ async def test_parameter_table_lists_the_wind_types_keys_uncut(short_case: Path,
 
 
 def test_export_description_marks_edits_unless_the_user_rewrote_it() -> None:
+    import dataclasses
+
     from linecheck.tui.files import doc_for_export
 
     original = load_case(ROOT / "cases" / "paper" / "case09-single.toml")
     assert "Vref = 40 m/s" in original.description
-    doc = {"case": original.name, "description": original.description}
+    doc = RunDocument(schema_version=2, case=original.name, description=original.description, wind="synoptic",
+                      units="SI", tower_of_interest=1, g_yp_L=None, v_ref=40.0, span_length=1.0, spans=1,
+                      realizations=1, seed=0, duration=None, time_step=0.1, peak_window=None, windows=1,
+                      design_fractile=0.5, reactions={}, towers=())  # only the description matters here
     assert doc_for_export(doc, original, original) is doc  # not edited: as it is
     edited = with_value(with_value(original, "wind.v_ref", 30.0), "line.sag", 12.0)
-    assert doc_for_export(doc, edited, original)["description"] == (
+    assert doc_for_export(doc, edited, original).description == (
         f"{original.description} (edited: line.sag {original.line.sag:g} → 12, wind.v_ref 40 → 30)")
     rewritten = with_value(edited, "description", "my variant at 30 m/s")
-    own = {**doc, "description": rewritten.description}
+    own = dataclasses.replace(doc, description=rewritten.description)
     assert doc_for_export(own, rewritten, original) is own  # the user's own words stay
 
 
@@ -606,7 +611,7 @@ async def test_model_spread_action(tmp_path: Path) -> None:
         await wait_for(pilot, lambda: of_type(messages, msg.CaseOpened), "CaseOpened", messages)
         await pilot.press("m")
         await wait_for(pilot, lambda: of_type(messages, msg.RunFinished), "RunFinished", messages)
-        doc = of_type(messages, msg.RunFinished)[-1].output.doc
+        doc = of_type(messages, msg.RunFinished)[-1].output.doc.to_json()
         assert list(doc["models"]) == ["holmes-oliver", "ring-jet"]
         assert doc["models"]["holmes-oliver"] == doc["reactions"]
         notes = str(app.query_one("#summary-notes", Static).render())

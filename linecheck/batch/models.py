@@ -1,12 +1,11 @@
 """Model spread in a batch (issue 15): one run per (case, downburst model), then one document per
-case with the ``"models"`` block and the envelope (:func:`linecheck.io.jsonout.models_from_reactions`)."""
+case with the typed ``models`` block and the envelope (:func:`linecheck.io.jsonout.with_models`)."""
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
-
 from ..core.case import load_case
+from ..io.document import FailedRun, RunDocument
 from ..service import model_changes, parse_models
 from .runner import BatchReport, RunJob
 
@@ -30,12 +29,15 @@ def model_jobs(paths: list[Path], models: str) -> tuple[list[RunJob], dict[Path,
     return jobs, plan
 
 
-def combined_documents(report: BatchReport, plan: dict[Path, list[tuple[str, int]]]) -> list[dict[str, Any]]:
-    """One document per case file: the run under the case's own model (else the first model that
-    ran) with ``"model"``, ``"models"`` and ``"models_envelope"``; ``{"case", "error"}`` if none ran."""
-    from ..io.jsonout import models_from_reactions
+def combined_documents(report: BatchReport, plan: dict[Path, list[tuple[str, int]]]) -> list[RunDocument | FailedRun]:
+    """One typed document per case file: the run under the case's own model (else the first model
+    that ran) with ``model``, ``models`` and ``models_envelope`` (and ``models_failed``); a
+    :class:`FailedRun` if none ran."""
+    from dataclasses import replace
 
-    out = []
+    from ..io.jsonout import with_models
+
+    out: list[RunDocument | FailedRun] = []
     for path, entries in plan.items():
         if entries[0][0] == "":  # synoptic: its own document
             out.append(report.outcomes[entries[0][1]].excel_doc())
@@ -44,16 +46,11 @@ def combined_documents(report: BatchReport, plan: dict[Path, list[tuple[str, int
         done = {m: o.doc for m, o in runs.items() if o.ok and o.doc is not None}
         if not done:
             first = runs[entries[0][0]]
-            out.append({"case": first.name, "error": first.error or first.status})
+            out.append(FailedRun(first.name, first.error or first.status))
             continue
-        own = load_case(path).wind.downburst.model_name
-        main = own if own in done else next(iter(done))
-        doc = dict(done[main])
-        doc["case"] = load_case(path).name
-        doc["model"] = main
-        doc.update(models_from_reactions({m: d["reactions"] for m, d in done.items()}))
+        case = load_case(path)
+        main = case.wind.downburst.model_name if case.wind.downburst.model_name in done else next(iter(done))
         failed = {m: o.error for m, o in runs.items() if m not in done}
-        if failed:
-            doc["models_failed"] = failed
-        out.append(doc)
+        out.append(with_models(replace(done[main], case=case.name), main,
+                               {m: d.reactions for m, d in done.items()}, failed))
     return out

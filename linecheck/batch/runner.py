@@ -13,10 +13,10 @@ Contract:
   bit-identical to ``service.run_case(case)`` whatever the chunking, ``--jobs`` or
   scheduler.
 - A case whose chunks are all in is saved at once (``<json_dir>/<file stem>.json``,
-  the :func:`~linecheck.io.jsonout.run_to_dict` document plus ``"case_file"`` and
-  ``"case_hash"``, written atomically), so an interrupted batch loses only running
-  cases.  With ``resume`` a case whose saved JSON carries the same file hash is
-  skipped and its saved document reused.
+  the typed :func:`~linecheck.io.jsonout.run_document` plus its ``BatchSource``
+  (``"case_file"``, ``"case_hash"``), written atomically), so an interrupted batch loses
+  only running cases.  With ``resume`` a case whose saved JSON carries the same file hash
+  (and reads as the current schema version) is skipped and its saved document reused.
 - One failing case (bad file, non-convergence, any LinecheckError, a crashed worker)
   is reported in its :class:`CaseOutcome`; the other cases complete.  When a process-pool
   worker dies (out-of-memory kill), the pool is restarted (:meth:`Executor.restart`): the
@@ -44,6 +44,7 @@ from typing import Any
 
 from ..core.case import Case, case_hash, load_case
 from ..core.errors import Cancelled, CaseError, LinecheckError
+from ..io.document import BatchSource, FailedRun, RunDocument
 from .executors import Executor, SequentialExecutor, describe_exit
 from .merge import merge_runs
 from .tasks import Failure, apply_changes, run_chunk
@@ -101,7 +102,7 @@ class CaseOutcome:
     hash: str | None = None
     realizations: int = 0
     json_path: Path | None = None
-    doc: dict[str, Any] | None = None
+    doc: RunDocument | None = None
     result: Any = None
     error: str | None = None
     error_kind: str | None = None
@@ -111,11 +112,11 @@ class CaseOutcome:
     def ok(self) -> bool:
         return self.status in ("done", "skipped")
 
-    def excel_doc(self) -> dict[str, Any]:
-        """The document handed to the Excel writer: the result, or ``{"case", "error"}``."""
+    def excel_doc(self) -> RunDocument | FailedRun:
+        """The document handed to the Excel writer: the result, or a :class:`FailedRun`."""
         if self.doc is not None:
             return self.doc
-        return {"case": self.name, "error": self.error or self.status}
+        return FailedRun(self.name, self.error or self.status)
 
 
 @dataclass
@@ -142,8 +143,8 @@ class BatchReport:
             return 130
         return 1 if self.failed else 0
 
-    def docs(self) -> list[dict[str, Any]]:
-        """Per-case documents for the Excel workbook (errors as ``{"case", "error"}``)."""
+    def docs(self) -> list[RunDocument | FailedRun]:
+        """Per-case documents for the Excel workbook (errors as :class:`FailedRun`)."""
         return [o.excel_doc() for o in self.outcomes if o.status != "pending"]
 
 
@@ -184,24 +185,25 @@ def json_name_for(path: Path) -> str:
     return f"{path.stem}.json"
 
 
-def saved_result(json_path: Path, digest: str, changes: Mapping[str, Any] | None = None) -> dict[str, Any] | None:
-    """The saved document at ``json_path`` if it carries ``digest`` as its case hash
-    (and the same key ``changes``, for runs that alter the file's case)."""
+def saved_result(json_path: Path, digest: str, changes: Mapping[str, Any] | None = None) -> RunDocument | None:
+    """The saved document at ``json_path``, typed, if it carries ``digest`` as its case hash
+    (and the same key ``changes``, for runs that alter the file's case); None when it is
+    missing, damaged, of another schema version or of another case (it is then run again)."""
     from ..core.case import MAX_RESULT_BYTES, read_text_file
 
     try:  # only a regular file of bounded size (a FIFO or /dev/zero there must not hang; issue 14)
         doc = json.loads(read_text_file(json_path, "a saved JSON result", MAX_RESULT_BYTES))
     except (CaseError, ValueError):
         return None
-    if not isinstance(doc, dict) or doc.get("case_hash") != digest or "reactions" not in doc:
+    try:  # saved by an older linecheck, or damaged: run it again
+        typed = RunDocument.from_json(doc, source=str(json_path))
+    except CaseError:
         return None
-    from ..io.document import SCHEMA_VERSION
-
-    if doc.get("schema_version") != SCHEMA_VERSION:  # saved by an older linecheck: run it again
+    if typed.batch is None or typed.batch.case_hash != digest:
         return None
-    if doc.get("changes") != (json.loads(json.dumps(dict(changes))) if changes else None):
+    if typed.batch.changes != (json.loads(json.dumps(dict(changes))) if changes else None):
         return None
-    return doc
+    return typed
 
 
 def check_writable(folder: Path) -> None:
@@ -219,16 +221,16 @@ def check_writable(folder: Path) -> None:
     Path(probe).unlink(missing_ok=True)
 
 
-def result_document(result: Any, path: Path, digest: str | None, changes: Mapping[str, Any] | None = None) -> dict[str, Any]:
-    """The per-case JSON document: ``run_to_dict`` plus ``case_file``, ``case_hash`` (and ``changes``)."""
-    from ..io.jsonout import run_to_dict
+def result_document(result: Any, path: Path, digest: str | None,
+                    changes: Mapping[str, Any] | None = None) -> RunDocument:
+    """The per-case typed document: the run's plus its :class:`BatchSource` (``"case_file"``,
+    ``"case_hash"`` and ``"changes"`` in the JSON)."""
+    from dataclasses import replace
 
-    doc = run_to_dict(result)
-    doc["case_file"] = str(path)
-    doc["case_hash"] = digest
-    if changes:
-        doc["changes"] = {k: v for k, v in changes.items()}
-    return doc
+    from ..io.jsonout import run_document
+
+    return replace(run_document(result),
+                   batch=BatchSource(str(path), digest, {k: v for k, v in changes.items()} if changes else None))
 
 
 # --------------------------------------------------------------------------- the runner

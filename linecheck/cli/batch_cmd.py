@@ -20,6 +20,8 @@ from rich.progress import BarColumn, Progress, TaskID, TextColumn, TimeElapsedCo
 from rich.table import Table
 
 from ..core.errors import CaseError
+from ..io.display import STAT_ROWS
+from ..io.document import RunDocument, SanityItem
 from .app import CaseArg, app, console, err_console, handle_errors, read_case
 from .limits import MaxMemoryOpt, apply_max_memory
 from .export_cmd import EngineerOpt, LineOpt, ProjectOpt, RevisionOpt, TitleOpt, title_block
@@ -78,7 +80,7 @@ def _check_excel(excel: Path | None, force: bool, template: Path | None) -> None
     check_excel_target(excel, force=force, template=template)
 
 
-def _write_excel(docs: list[dict[str, Any]], excel: Path, force: bool, template: Path | None,
+def _write_excel(docs: list[Any], excel: Path, force: bool, template: Path | None,
                  title: dict[str, str] | None = None) -> None:
     try:
         from ..excel.writer import write_workbook
@@ -214,12 +216,12 @@ class BatchDisplay:
                 b.console.print(f"[red]failed[/]  {escape(ev.name)}: {escape(ev.message)}", highlight=False, soft_wrap=True)
 
 
-def _kn(doc: dict[str, Any] | None, reaction: str, stat: str, scale: float = 1e-3, fmt: str = "{:.2f}") -> str:
-    try:
-        v = doc["reactions"][reaction][stat]["mean"]  # type: ignore[index]
-    except (KeyError, TypeError):
+def _kn(doc: RunDocument | None, reaction: str, stat: str, fmt: str = "{:.2f}") -> str:
+    """The realization mean of ``stat`` in its shown unit (statistics table), "" without a result."""
+    if doc is None:
         return ""
-    return "**" if v is None else fmt.format(v * scale)
+    v = doc.reactions[reaction][stat].mean
+    return "**" if v is None else fmt.format(v * STAT_ROWS[stat].scale)
 
 
 #: Cont_R above this (a fraction) is flagged "dynamic analysis recommended" (the paper's conclusion;
@@ -229,35 +231,28 @@ REACTION_NAMES = ("Rx", "Ry", "Rz")
 QUANTITY_TEXT = {"rms_background": "background r.m.s.", "rms_fluctuating": "fluctuating r.m.s."}
 
 
-def cont_r_flags(doc: dict[str, Any] | None, state: str = "recommended") -> list[str]:
-    """Reactions whose ``"dynamic_analysis"`` flag is ``state`` ("recommended": the 95 % interval
+def cont_r_flags(doc: RunDocument | None, state: str = "recommended") -> list[str]:
+    """Reactions whose ``dynamic_analysis`` flag is ``state`` ("recommended": the 95 % interval
     of Cont_R lies above :data:`CONT_R_FLAG`; "inconclusive": it straddles it; issue 18)."""
-    out = []
-    for r in REACTION_NAMES:
-        try:
-            if doc["reactions"][r].get("dynamic_analysis") == state:  # type: ignore[index]
-                out.append(r)
-        except (KeyError, TypeError, AttributeError):
-            continue
-    return out
-
-
-def sanity_failures(doc: dict[str, Any] | None) -> list[dict[str, Any]]:
-    """The failed items of the time- vs frequency-domain sanity check of a synoptic result."""
-    try:
-        items = doc["spectral"]["sanity_check"]  # type: ignore[index]
-    except (KeyError, TypeError):
+    if doc is None:
         return []
-    return [i for i in items or [] if isinstance(i, dict) and i.get("ok") is False]
+    return [r for r in REACTION_NAMES if doc.reactions[r].dynamic_analysis == state]
 
 
-def _sanity_text(item: dict[str, Any]) -> str:
+def sanity_failures(doc: RunDocument | None) -> list[SanityItem]:
+    """The failed items of the time- vs frequency-domain sanity check of a synoptic result."""
+    if doc is None or doc.spectral is None:
+        return []
+    return [i for i in doc.spectral.sanity_check or () if not i.ok]
+
+
+def _sanity_text(item: SanityItem) -> str:
     def kn(v: Any) -> str:
         return "?" if v is None else f"{v / 1e3:.3f}"
 
-    return (f"{item.get('reaction')} {QUANTITY_TEXT.get(item.get('quantity'), item.get('quantity'))} "
-            f"{kn(item.get('time_domain'))} vs {kn(item.get('frequency_domain'))} kN "
-            f"(allowed difference {kn(item.get('allowed_difference'))})")
+    return (f"{item.reaction} {QUANTITY_TEXT.get(item.quantity, item.quantity)} "
+            f"{kn(item.time_domain)} vs {kn(item.frequency_domain)} kN "
+            f"(allowed difference {kn(item.allowed_difference)})")
 
 
 def summary_table(report: Any) -> Table:
@@ -275,7 +270,7 @@ def summary_table(report: Any) -> Table:
     for o in report.outcomes:
         d = o.doc
         flagged = cont_r_flags(d)
-        cont_ry = _kn(d, "Ry", "Cont_R", 100.0, "{:.1f}")
+        cont_ry = _kn(d, "Ry", "Cont_R", "{:.1f}")
         if "Ry" in flagged:
             cont_ry = f"[bold yellow]{cont_ry}[/]"
         flags = []
@@ -288,9 +283,9 @@ def summary_table(report: Any) -> Table:
             flags.append("[bold red]t/f check[/]")
         t.add_row(
             escape(o.name), f"[{colours.get(o.status, 'white')}]{o.status}[/]",
-            str(d.get("realizations", "")) if d else "",
+            str(d.realizations) if d else "",
             _kn(d, "Rx", "peak_dynamic"), _kn(d, "Ry", "peak_dynamic"),
-            _kn(d, "Rx", "GF_Dy", 1.0, "{:.3f}"), _kn(d, "Ry", "GF_Dy", 1.0, "{:.3f}"),
+            _kn(d, "Rx", "GF_Dy", "{:.3f}"), _kn(d, "Ry", "GF_Dy", "{:.3f}"),
             cont_ry, " ".join(flags),
             f"{o.elapsed:.1f}" if o.status == "done" else "",
             escape(o.error if o.error else (str(o.json_path) if o.json_path and o.ok else "")),
@@ -391,10 +386,10 @@ def batch(
         from ..io.jsonout import write_json
 
         docs = combined_documents(report, plan)
-        for path, doc in zip(plan, docs):
-            if "models" in doc:
-                write_json(out_dir / f"{path.stem}.json", doc)
-        console.print(f"model spread: {sum('models' in d for d in docs)} case document(s) with a \"models\" block "
+        spread = [(path, d) for path, d in zip(plan, docs) if isinstance(d, RunDocument) and d.models is not None]
+        for path, doc in spread:
+            write_json(out_dir / f"{path.stem}.json", doc)
+        console.print(f"model spread: {len(spread)} case document(s) with a \"models\" block "
                       f"in {out_dir}",
                       highlight=False)
     if excel is not None:
@@ -443,8 +438,8 @@ def dynamic_table(report: Any) -> Table:
         d = o.doc
         t.add_row(escape(o.name), o.status if not o.error else escape(f"failed: {o.error}"),
                   _kn(d, "Rx", "peak_dynamic"), _kn(d, "Ry", "peak_dynamic"),
-                  _kn(d, "Rx", "GF_Dy", 1.0, "{:.3f}"), _kn(d, "Ry", "GF_Dy", 1.0, "{:.3f}"),
-                  _kn(d, "Rx", "Cont_R", 100.0, "{:.1f}"), _kn(d, "Ry", "Cont_R", 100.0, "{:.1f}"))
+                  _kn(d, "Rx", "GF_Dy", "{:.3f}"), _kn(d, "Ry", "GF_Dy", "{:.3f}"),
+                  _kn(d, "Rx", "Cont_R", "{:.1f}"), _kn(d, "Ry", "Cont_R", "{:.1f}"))
     return t
 
 

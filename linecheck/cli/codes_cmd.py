@@ -9,13 +9,14 @@ from rich.table import Table
 
 from .. import service
 from ..io.atomic import check_target
-from ..io.jsonout import codes_to_dict, write_json
+from ..io.document import CodeCheck
+from ..io.jsonout import codes_document, codes_to_dict, write_json
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .progress import progress_bar
 
 
-def codes_table(codes: dict, title: str) -> Table:
-    """Rich table of a ``{"codes": ...}`` block (kN at display)."""
+def codes_table(codes: dict[str, CodeCheck], title: str) -> Table:
+    """Rich table of a typed ``codes`` block (kN at display)."""
     t = Table(title=title, title_justify="left")
     for col in ("code", "verified", "tower", "code load kN", "linecheck peak kN", "ratio", "verdict"):
         t.add_column(col, justify="left" if col in ("code", "verdict") else "right")
@@ -24,17 +25,17 @@ def codes_table(codes: dict, title: str) -> Table:
         return "-" if x is None else f"{x / 1e3:.3f}"
 
     for name, block in codes.items():
-        for k, tower in enumerate(block["towers"]):
-            ry = tower["Ry"]
-            t.add_row(name if k == 0 else "", ("yes" if block["verified"] else "no") if k == 0 else "",
-                      str(tower["index"]), kn(ry["code_load"]), kn(ry["linecheck_peak"]),
-                      "-" if ry["ratio"] is None else f"{ry['ratio']:.3f}", ry["verdict"])
+        for k, tower in enumerate(block.towers):
+            ry = tower.reactions["Ry"]
+            t.add_row(name if k == 0 else "", ("yes" if block.verified else "no") if k == 0 else "",
+                      str(tower.index), kn(ry.code_load), kn(ry.linecheck_peak),
+                      "-" if ry.ratio is None else f"{ry.ratio:.3f}", ry.verdict)
     return t
 
 
-def print_codes_notes(codes: dict) -> None:
+def print_codes_notes(codes: dict[str, CodeCheck]) -> None:
     for name, block in codes.items():
-        console.print(f"[dim]{name} ({block['edition']}): {block['note']}[/]", highlight=False)
+        console.print(f"[dim]{name} ({block.edition}): {block.note}[/]", highlight=False)
 
 
 @app.command()
@@ -55,9 +56,10 @@ def codes(
             run = service.run_case(case, spectral_check=False, progress=cb)
     res = service.codes_analysis(case, run)
     doc = {"case": case.name, "units": "SI", "peak": res.peak, "codes": codes_to_dict(res)}
-    console.print(codes_table(doc["codes"], f"{case.name}: conductor wind load on Ry, design codes vs linecheck "
+    typed = codes_document(res)
+    console.print(codes_table(typed, f"{case.name}: conductor wind load on Ry, design codes vs linecheck "
                                             f"(v_ref {case.wind.v_ref:g} m/s, terrain \"{case.codes.terrain}\")"))
-    print_codes_notes(doc["codes"])
+    print_codes_notes(typed)
     console.print("[dim]linecheck peak: " + res.peak + ". Unverified codes are shown, not judged (docs/codes.md).[/]",
                   highlight=False)
     if json_out is not None:

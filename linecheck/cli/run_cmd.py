@@ -12,8 +12,9 @@ from .. import service
 from ..core.case import Case
 from ..core.results import REACTIONS
 from ..io.atomic import check_target
-from ..io.display import SUMMARY_STATS, stat_text
-from ..io.jsonout import _num, run_to_dict, write_json
+from ..io.display import STAT_ROWS, SUMMARY_STATS, number_text, stat_text
+from ..io.document import RunDocument, StatDef
+from ..io.jsonout import _num, run_document, write_json
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .export_cmd import (
     EngineerOpt,
@@ -48,13 +49,21 @@ def override(case: Case, realizations: int | None, seed: int | None) -> Case:
                                "--seed": ("analysis.seed", seed)})
 
 
-#: Column headers of the console table: at most 7 characters a line, so that the table with its
-#: ``± std`` lines fits a 120-column terminal; :data:`TABLE_LEGEND` explains them.
-SHORT_HEADERS = {
-    "mean_max": "M\nkN", "rms_background": "rms B\nkN", "rms_resonant": "rms R\nkN",
-    "peak_quasi_static": "peak QS\nkN", "peak_dynamic": "peak Dy\nkN", "GF_Dy": "GF_Dy", "GF_QS": "GF_QS",
-    "Cont_M": "Cont_M\n%", "Cont_BG": "Cont_BG\n%", "Cont_R": "Cont_R\n%", "peak_normalised": "peak /\ngypL",
-}
+def console_header(st: StatDef, width: int = 7) -> str:
+    """Column header of the console table from the statistics table's short label and unit, in
+    lines of at most ``width`` characters, so that the table with its ``± std`` lines fits a
+    120-column terminal; :data:`TABLE_LEGEND` explains them."""
+    lines: list[str] = []
+    for word in st.short.split():
+        if lines and len(lines[-1]) + 1 + len(word) <= width:
+            lines[-1] += " " + word
+        else:
+            lines.append(word)
+    if st.display_unit != "-":
+        lines.append(st.display_unit)
+    return "\n".join(lines)
+
+
 #: Cont_R (fraction) above which the table marks a reaction: "dynamic analysis recommended" (as the
 #: Excel design sheet's default --cont-r-threshold; paper Sect. 5).
 CONT_R_FLAG = 0.10
@@ -62,50 +71,39 @@ CONT_R_FLAG = 0.10
 #: wind-induced part is small beside the conductor weight, its Cont_R is not a design signal).
 FLAGGED_REACTIONS = ("Rx", "Ry")
 TABLE_LEGEND = (
-    "M: largest wind-induced mean; rms B, rms R: background and resonant r.m.s.; peak QS = M+B (quasi-static), "
+    "mean M: largest wind-induced mean; rms B, rms R: background and resonant r.m.s.; peak QS = M+B (quasi-static), "
     "peak Dy = M+B+R (dynamic); GF ** : mean zero by symmetry (or < 1 % of the largest mean); Cont_R: share of "
-    "the peak that a quasi-static analysis misses; peak / gypL: peak Dy / (g*yp L_x) (Eq. 17).")
+    "the peak that a quasi-static analysis misses; peak / g*yp Lx: peak Dy / (g*yp L_x) (Eq. 17).")
 
 
-def _cell(entry: dict, stat, n: int) -> str:
-    """``mean`` over ``± std`` (two lines, when there are several realizations); ``**`` when undefined."""
-    m, sd = entry.get("mean"), entry.get("std")
-    if m is None:
-        return "**"
-    text = stat.fmt.format(m * stat.scale)
-    if n > 1 and sd is not None:
-        text += "\n±" + stat.fmt.format(sd * stat.scale)
-    return text
-
-
-def results_table(doc: dict) -> Table:
-    """Rich table of the statistics at the tower of interest (kN, %); a Cont_R above 10 % in bold red."""
-    n = doc["realizations"]
-    t = Table(title=f"{doc['case']}: reactions at tower {doc['tower_of_interest']} "
-                    f"({doc['wind']}, V_ref = {doc['v_ref']:g} m/s, {n} realization{'s' if n > 1 else ''})",
+def results_table(doc: RunDocument) -> Table:
+    """Rich table of the statistics at the tower of interest (kN, %); a Cont_R above 10 % in bold red.
+    Cells: ``mean`` over ``± std`` (two lines, when there are several realizations), ``**`` when undefined."""
+    n = doc.realizations
+    t = Table(title=f"{doc.case}: reactions at tower {doc.tower_of_interest} "
+                    f"({doc.wind}, V_ref = {doc.v_ref:g} m/s, {n} realization{'s' if n > 1 else ''})",
               title_justify="left")
     t.add_column("", justify="right", no_wrap=True)
     for st in SUMMARY_STATS:
-        t.add_column(SHORT_HEADERS.get(st.key, st.label), justify="right", no_wrap=True)
+        t.add_column(console_header(st), justify="right", no_wrap=True)
     for r in REACTIONS:
         cells = []
         for st in SUMMARY_STATS:
-            entry = doc["reactions"][r][st.key]
-            text = escape(_cell(entry, st, n))
-            if st.key == "Cont_R" and cont_r_flagged(doc, r):
+            text = escape(stat_text(doc.reactions[r][st.name], st, n, sep="\n±"))
+            if st.name == "Cont_R" and cont_r_flagged(doc, r):
                 text = f"[bold red]{text}[/]"
             cells.append(text)
         t.add_row(r, *cells)
     return t
 
 
-def cont_r_flagged(doc: dict, reaction: str) -> bool:
+def cont_r_flagged(doc: RunDocument, reaction: str) -> bool:
     """Whether ``reaction`` (Rx, Ry only) has the flag "recommended": the 95 % interval of its
     Cont_R lies above :data:`CONT_R_FLAG` (issue 18, docs/method.md)."""
-    return reaction in FLAGGED_REACTIONS and doc["reactions"][reaction].get("dynamic_analysis") == "recommended"
+    return reaction in FLAGGED_REACTIONS and doc.reactions[reaction].dynamic_analysis == "recommended"
 
 
-def print_legend(doc: dict) -> None:
+def print_legend(doc: RunDocument) -> None:
     """The legend of :func:`results_table`, and the Cont_R flag when a reaction has it."""
     console.print(f"[dim]{TABLE_LEGEND}[/]", highlight=False)
     flagged = [r for r in FLAGGED_REACTIONS if cont_r_flagged(doc, r)]
@@ -116,62 +114,59 @@ def print_legend(doc: dict) -> None:
                       highlight=False)
 
 
-def burn_in_note(doc: dict) -> str | None:
+def burn_in_note(doc: RunDocument) -> str | None:
     """One line on a synoptic record that is not stationary: what it means and what to do (issue 10, 14).
 
     ``None`` when the burn-in is sufficient (or the run is not synoptic).
     """
-    b = doc.get("burn_in")
-    if not b or doc.get("wind") != "synoptic" or b["sufficient"]:
+    b = doc.burn_in
+    if b is None or doc.wind != "synoptic" or b.sufficient:
         return None
-    need = "never (undamped)" if b["required"] is None else f"{b['required']:,.0f} s"
-    mode = f"the {b['mode_hz']:.3f} Hz mode (zeta {b['zeta']:.2g}) would need a burn-in of {need}"
-    if doc.get("damping") == "paper" and b["seconds"] == 0:
-        return (f"[yellow]note:[/] damping = \"paper\" leaves the {b['mode_hz']:.3f} Hz mode almost undamped "
-                f"(zeta {b['zeta']:.2g}; stationary only after a burn-in of {need}): as in the paper, its resonant "
+    need = "never (undamped)" if b.required is None else f"{b.required:,.0f} s"
+    mode = f"the {b.mode_hz:.3f} Hz mode (zeta {b.zeta:.2g}) would need a burn-in of {need}"
+    if doc.damping == "paper" and b.seconds == 0:
+        return (f"[yellow]note:[/] damping = \"paper\" leaves the {b.mode_hz:.3f} Hz mode almost undamped "
+                f"(zeta {b.zeta:.2g}; stationary only after a burn-in of {need}): as in the paper, its resonant "
                 "part comes from a record starting at rest, below the stationary level the frequency-domain check "
                 "assumes; for a design value use damping = \"quasi-steady\" (docs/method.md, Damping).")
-    return (f"[yellow]note:[/] record not stationary: {mode}, {b['seconds']:,.0f} s used ({b['source']}); its "
+    return (f"[yellow]note:[/] record not stationary: {mode}, {b.seconds:,.0f} s used ({b.source}); its "
             "resonant part is below its stationary level: raise analysis.duration (the derived burn-in is capped "
             "at 10 x duration) or analysis.burn_in, or set analysis.structural_damping (docs/method.md, Damping).")
 
 
-def models_table(doc: dict) -> Table:
+def models_table(doc: RunDocument) -> Table:
     """Rich table of the model spread (issue 15): one row per model and the envelope."""
-    by_key = {st.key: st for st in SUMMARY_STATS}
-    stat_by_key = by_key.__getitem__
-    n = doc["realizations"]
+    n = doc.realizations
     keys = ("mean_max", "peak_dynamic", "GF_Dy", "GF_QS", "peak_normalised")
-    t = Table(title=f"{doc['case']}: downburst model spread at tower {doc['tower_of_interest']}", title_justify="left")
+    t = Table(title=f"{doc.case}: downburst model spread at tower {doc.tower_of_interest}", title_justify="left")
     t.add_column("model", justify="left", no_wrap=True)
     for r in ("Rx", "Ry"):
         for k in keys:
-            st = stat_by_key(k)
-            t.add_column(f"{r} {st.label}" + (f" {st.unit}" if st.unit != "-" else ""), justify="right")
-    for name, blk in doc["models"].items():
-        t.add_row(name, *(stat_text(blk[r][k], stat_by_key(k), n) for r in ("Rx", "Ry") for k in keys))
-    env = doc["models_envelope"]
+            st = STAT_ROWS[k]
+            t.add_column(f"{r} {st.label}" + (f" {st.display_unit}" if st.display_unit != "-" else ""), justify="right")
+    for name, blk in (doc.models or {}).items():
+        t.add_row(name, *(stat_text(blk[r][k], STAT_ROWS[k], n) for r in ("Rx", "Ry") for k in keys))
+    env = doc.models_envelope or {}
     cells = []
     for r in ("Rx", "Ry"):
         for k in keys:
             e = env[r][k]
-            st = stat_by_key(k)
-            cells.append("" if e["value"] is None else f"{st.fmt.format(e['value'] * st.scale)} ({e['model']})")
+            cells.append("" if e.value is None else f"{number_text(e.value, STAT_ROWS[k])} ({e.model})")
     t.add_row("[bold]envelope[/]", *cells)
     return t
 
 
-def print_burn_in(doc: dict) -> None:
+def print_burn_in(doc: RunDocument) -> None:
     """Say how much of a synoptic record was discarded, and when it is not enough (issue 10): one line."""
-    b = doc.get("burn_in")
-    if not b or doc.get("wind") != "synoptic":
+    b = doc.burn_in
+    if b is None or doc.wind != "synoptic":
         return
     note = burn_in_note(doc)
     if note is not None:
         console.print(note, highlight=False, soft_wrap=True)
     else:
-        console.print(f"[dim]burn-in {b['seconds']:.0f} s discarded ({b['source']}); statistics from a stationary "
-                      f"response (slowest significant mode {b['mode_hz']:.3f} Hz, zeta {b['zeta']:.3g}).[/]",
+        console.print(f"[dim]burn-in {b.seconds:.0f} s discarded ({b.source}); statistics from a stationary "
+                      f"response (slowest significant mode {b.mode_hz:.3f} Hz, zeta {b.zeta:.3g}).[/]",
                       highlight=False)
 
 
@@ -219,12 +214,11 @@ def run(
                                     spectral_check=not no_check, warn=limits_warn)
         else:
             res = service.run_case(case, progress=cb, spectral_check=not no_check, warn=limits_warn)
-    doc = run_to_dict(res, full_histories=full_histories)
+    doc = run_document(res, full_histories=full_histories)
     if names:
-        from ..io.jsonout import models_block
+        from ..io.jsonout import model_reactions, with_models
 
-        doc["model"] = res.case.wind.downburst.model_name
-        doc.update(models_block(spread))
+        doc = with_models(doc, res.case.wind.downburst.model_name, model_reactions(spread))
     console.print(results_table(doc))
     console.print(design_table(doc))
     for note in stats_notes(doc):

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from rich.table import Table
 
 from .. import service
@@ -53,22 +55,22 @@ def spectral(case_file: CaseArg, json_out: JsonOpt = None) -> None:
         console.print(f"wrote {json_out}")
 
 
-def print_sanity(doc: dict, *, explained: bool = False) -> None:
+def print_sanity(doc: Any, *, explained: bool = False) -> None:
     """The run's "sanity check" line(s): time vs frequency domain.
 
     ``explained``: the burn-in note (a record that is not stationary) was printed, which is
     the usual reason of a flag; the hint is then not repeated.
     """
-    sp = doc.get("spectral")
-    if not sp:
+    sp = doc.spectral
+    if sp is None:
         return
-    items = sp.get("sanity_check", [])
-    bad = [i for i in items if not i["ok"]]
+    items = sp.sanity_check or ()
+    bad = [i for i in items if not i.ok]
     parts = []
     for i in items:
-        tag = "" if i["ok"] else " [bold red]FLAG[/]"
-        parts.append(f"{i['reaction']} {i['quantity'].replace('rms_', 'rms ')}: time {i['time_domain'] / 1e3:.3f} "
-                     f"vs freq {i['frequency_domain'] / 1e3:.3f} kN{tag}")
+        tag = "" if i.ok else " [bold red]FLAG[/]"
+        parts.append(f"{i.reaction} {i.quantity.replace('rms_', 'rms ')}: time {i.time_domain / 1e3:.3f} "
+                     f"vs freq {i.frequency_domain / 1e3:.3f} kN{tag}")
     head = "[green]sanity check ok[/]" if not bad else (
         f"[bold red]sanity check: {len(bad)} difference(s) larger than sampling error explains[/]")
     console.print(head + ": " + "; ".join(parts), highlight=False)

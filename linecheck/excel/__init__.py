@@ -1,7 +1,8 @@
 """Excel design sheets (front-end side: imports openpyxl; never imported by the core).
 
 :func:`write_workbook` writes the workbook of one or more run result documents
-(``run_to_dict`` dicts or the same dicts loaded from JSON); ``linecheck run --excel``,
+(typed :class:`~linecheck.io.document.RunDocument`, or their saved JSON read through
+``RunDocument.from_json``); ``linecheck run --excel``,
 ``linecheck batch --excel`` and ``linecheck export`` all call it.
 """
 

@@ -12,6 +12,8 @@ from openpyxl.styles import Alignment, Font
 from openpyxl.worksheet.hyperlink import Hyperlink
 from openpyxl.worksheet.worksheet import Worksheet
 
+from ..io.document import StatDef
+
 REACTIONS = ("Rx", "Ry", "Rz")
 #: Reactions of the Summary and Peaks sheets by default: the paper's Table 5 and Fig. 13 (Rz, the
 #: vertical reaction, whose wind-induced part is small beside the conductor weight, is on the case sheets).
@@ -25,41 +27,31 @@ PCT = "0.00%"
 NORM = "0.000"
 SEC = "0.0"
 
-#: Summary columns after the identification columns: (statistic, header, format, kind, with ± std).
-SUMMARY_STATS: tuple[tuple[str, str, str, str, bool], ...] = (
-    ("mean_max", "mean_max\n(kN)", KN, "kN", False),
-    ("peak_quasi_static", "peak QS\n(kN)", KN, "kN", True),
-    ("peak_dynamic", "peak Dy\n(kN)", KN, "kN", True),
-    ("GF_Dy", "GF_Dy", RATIO, "gf", True),
-    ("GF_QS", "GF_QS", RATIO, "gf", True),
-    ("Cont_M", "Cont_M\n(%)", PCT, "pct", True),
-    ("Cont_BG", "Cont_BG\n(%)", PCT, "pct", True),
-    ("Cont_R", "Cont_R\n(%)", PCT, "pct", True),
-    ("peak_normalised", "peak /\n(g*yp Lx)", NORM, "ratio", True),
-)
+#: Summary columns after the identification columns (paper Table 5): names of the one statistics
+#: table (:data:`linecheck.io.document.STAT_TABLE`), whose labels, units and formats they use.
+SUMMARY_STATS: tuple[str, ...] = ("mean_max", "peak_quasi_static", "peak_dynamic", "GF_Dy", "GF_QS", "Cont_M",
+                                  "Cont_BG", "Cont_R", "peak_normalised")
 SUMMARY_IDS = (("Case", 16), ("Wind", 14), ("Spans", 6), ("L_x\n(m)", 7), ("V_ref\n(m/s)", 7),
                ("Tower", 6), ("n", 5), ("Reaction", 8))
 
-def _stat_info() -> dict[str, tuple[str, str, str, str]]:
-    """Statistics of the case sheets from the one statistics table (:data:`linecheck.io.document.STAT_TABLE`):
-    key -> (shown unit, Excel format, cell kind, meaning)."""
-    from ..io.document import STAT_TABLE
 
-    out = {}
-    for s in STAT_TABLE:
-        if s.kind == "force":
-            out[s.name] = ("kN", KN3, "kN", s.meaning)
-        elif s.kind == "fraction":
-            out[s.name] = ("%", PCT, "pct", s.meaning)
-        elif s.name.startswith("GF_"):
-            out[s.name] = ("-", RATIO, "gf", s.meaning)
-        else:
-            out[s.name] = ("-", NORM, "ratio", s.meaning)
-    return out
+def excel_format(stat: StatDef, *, summary: bool = False) -> str:
+    """The Excel number format of a statistic of the one table (forces to 2 decimals in the
+    Summary, 3 on the case sheets; Cont_* as %; gust factors 2 decimals; other ratios 3)."""
+    if stat.kind == "force":
+        return KN if summary else KN3
+    if stat.kind == "fraction":
+        return PCT
+    return RATIO if stat.ci else NORM
 
 
-#: Statistics of the case sheets: key -> (unit, format, kind, meaning).
-STAT_INFO = _stat_info()
+def stat_cell(stat: StatDef, v: float | None) -> Any:
+    """The cell value of a statistic's SI value: kN for forces, fractions as they are (shown by
+    the % format), ``**`` for an undefined gust factor, empty otherwise."""
+    if not is_num(v):
+        return GF_UNDEFINED if stat.kind == "ratio" and stat.ci else None
+    return v * stat.scale if stat.kind == "force" else v
+
 
 #: Default thinning of the time histories for the charts (points per case).
 CHART_POINTS = 1000
@@ -105,15 +97,6 @@ def is_num(v: Any) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
-def cell_value(v: Any, kind: str) -> Any:
-    """The cell value of JSON value ``v``: kN for forces, fractions for %, ``**`` for a null GF."""
-    if not is_num(v):
-        return GF_UNDEFINED if kind == "gf" else None
-    if kind == "kN":
-        return v / 1000.0
-    return v
-
-
 def kn(v: Any) -> Any:
     return v / 1000.0 if is_num(v) else None
 
@@ -131,12 +114,11 @@ def sheet_name(name: str, taken: set[str]) -> str:
     return cand
 
 
-def wind_label(doc: dict) -> str:
-    wind = str(doc.get("wind", ""))
-    params = doc.get("parameters") or {}
-    db = (params.get("wind") or {}).get("downburst") or {}
+def wind_label(doc: Any) -> str:
+    """``"downburst <preset>"`` or the wind type of a RunDocument."""
+    db = ((doc.parameters or {}).get("wind") or {}).get("downburst")
     preset = db.get("preset") if isinstance(db, dict) else None
-    return f"{wind} {preset}" if preset else wind
+    return f"{doc.wind} {preset}" if preset else doc.wind
 
 
 def align(cell, **changes: Any) -> None:

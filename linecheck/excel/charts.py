@@ -86,7 +86,7 @@ def _scatter(title: str, xtitle: str, ytitle: str, yfmt: str = "0") -> ScatterCh
     return ch
 
 
-def case_charts(ws: Worksheet, doc: dict, chart_points: int, contrib_rows: tuple[int, int]) -> list:
+def case_charts(ws: Worksheet, doc: Any, chart_points: int, contrib_rows: tuple[int, int]) -> list:
     """Charts of a case sheet (histories of Rx and Ry, tension H/T0, contributions); data from column U.
 
     ``contrib_rows``: first and last row of the sheet's contributions table (reaction in
@@ -96,26 +96,26 @@ def case_charts(ws: Worksheet, doc: dict, chart_points: int, contrib_rows: tuple
     col = DATA_COL
     ws.cell(row=1, column=col, value="Chart data (from the JSON result; time histories thinned keeping "
                                      "each block's extremes unless saved with --full-histories)").style = "lc_note"
-    th = doc.get("time_histories")
-    if isinstance(th, dict) and th.get("time"):
-        t = as_array(th["time"])
+    th = doc.time_histories
+    if th is not None and th.time:
+        t = as_array(th.time)
         series: dict[str, dict[str, np.ndarray]] = {}
         for r in ("Rx", "Ry"):
-            comp = th.get(r) or {}
-            m, b, rr = as_array(comp.get("M")), as_array(comp.get("B")), as_array(comp.get("R"))
+            comp = th.series[r]
+            m, b, rr = as_array(comp["M"]), as_array(comp["B"]), as_array(comp["R"])
             if m.size == t.size and b.size == t.size and rr.size == t.size:
                 series[r] = {"M": m / 1e3, "M+B": (m + b) / 1e3, "M+B+R": (m + b + rr) / 1e3}
         if series:
-            full = th.get("decimated") is False
+            full = th.decimated is False
             idx = np.arange(t.size) if full else chart_indices(
                 [s[k] for s in series.values() for k in ("M+B+R", "M+B")], chart_points)
             row0 = 3
             _write_column(ws, col, row0, "t (s)", t[idx])
             xcol = col
             col += 1
-            real = th.get("realization", 1)
+            real = th.realization
             for r, s in series.items():
-                ch = _scatter(f"{r} at tower {doc['tower_of_interest']}: M, M+B, M+B+R (realization {real})",
+                ch = _scatter(f"{r} at tower {doc.tower_of_interest}: M, M+B, M+B+R (realization {real})",
                               "time (s)", f"{r} (kN)", "0.0")
                 cols = {}
                 for key in ("M", "M+B", "M+B+R"):
@@ -131,16 +131,15 @@ def case_charts(ws: Worksheet, doc: dict, chart_points: int, contrib_rows: tuple
                 charts.append(ch)
             col += 1
     # ---- Fig. 7: running-mean tension / T0 of the spans next to the tower of interest
-    static = doc.get("static")
-    still = doc.get("still_air") or {}
-    t0 = still.get("tension_nominal") if isinstance(still, dict) else None
-    if isinstance(static, dict) and static.get("tension") and is_num(t0) and t0 > 0:
-        times = as_array(static.get("time"))
-        h = np.asarray([[np.nan if v is None else v for v in row] for row in static["tension"]], dtype=float)
-        toi = int(doc["tower_of_interest"])
+    static = doc.static
+    t0 = doc.still_air.tension_nominal if doc.still_air is not None else None
+    if static is not None and static.tension and is_num(t0) and t0 > 0:
+        times = as_array(static.time)
+        h = np.asarray([[np.nan if v is None else v for v in row] for row in static.tension], dtype=float)
+        toi = doc.tower_of_interest
         spans = [s for s in (toi - 1, toi) if 1 <= s <= h.shape[1]]
         if times.size == 1:  # synoptic: constant over the record
-            dur = doc.get("duration") if is_num(doc.get("duration")) else 600.0
+            dur = doc.duration if is_num(doc.duration) else 600.0
             times = np.array([0.0, float(dur)])
             h = np.repeat(h, 2, axis=0)
         if times.size == h.shape[0] and spans:

@@ -1,14 +1,14 @@
 """The "Codes" sheet: design-code conductor wind loads beside linecheck's peaks (issue 19).
 
-Reads the ``"codes"`` block of each run document (:func:`linecheck.io.jsonout.codes_block`);
+Reads the typed ``codes`` block of each :class:`~linecheck.io.document.RunDocument`;
 it computes nothing itself.
 """
 
 from __future__ import annotations
 
-from typing import Any
-
 from openpyxl.worksheet.worksheet import Worksheet
+
+from ..io.document import RunDocument
 
 from .cells import KN3, RATIO, Cursor, kn, page_setup
 
@@ -16,7 +16,7 @@ COLUMNS = (("Case", 18), ("Code", 11), ("Edition", 30), ("Verified", 9), ("Tower
            ("Code load\n(kN)", 11), ("linecheck peak\n(kN)", 13), ("Ratio", 8), ("Verdict", 26), ("Note", 60))
 
 
-def write_codes(ws: Worksheet, docs: list[dict[str, Any]], like: Worksheet | None = None) -> int:
+def write_codes(ws: Worksheet, docs: list[RunDocument], like: Worksheet | None = None) -> int:
     """Fill ``ws`` with one row per case, code, tower and reaction; returns the rows written."""
     from openpyxl.utils import get_column_letter
 
@@ -29,26 +29,21 @@ def write_codes(ws: Worksheet, docs: list[dict[str, Any]], like: Worksheet | Non
     ws.row_dimensions[3].height = 30
     n = 0
     for doc in docs:
-        block = doc.get("codes") if "error" not in doc else None
-        if not block:
-            continue
-        for code, c in block.items():
-            for t in c.get("towers", []):
-                for r, v in t.items():
-                    if r == "index":
-                        continue
+        for code, c in (doc.codes or {}).items():
+            for t in c.towers:
+                for r, v in t.reactions.items():
                     row = cur.row
-                    cur.put(row, 1, doc.get("case"), "lc_text")
+                    cur.put(row, 1, doc.case, "lc_text")
                     cur.put(row, 2, code, "lc_text")
-                    cur.put(row, 3, c.get("edition"), "lc_text")
-                    cur.put(row, 4, "yes" if c.get("verified") else "no", "lc_text")
-                    cur.put(row, 5, t["index"])
+                    cur.put(row, 3, c.edition, "lc_text")
+                    cur.put(row, 4, "yes" if c.verified else "no", "lc_text")
+                    cur.put(row, 5, t.index)
                     cur.put(row, 6, r, "lc_text")
-                    cur.put(row, 7, kn(v.get("code_load")), fmt=KN3)
-                    cur.put(row, 8, kn(v.get("linecheck_peak")), fmt=KN3)
-                    cur.put(row, 9, v.get("ratio"), fmt=RATIO)
-                    cur.put(row, 10, v.get("verdict"), "lc_text")
-                    cur.put(row, 11, c.get("note"), "lc_note")
+                    cur.put(row, 7, kn(v.code_load), fmt=KN3)
+                    cur.put(row, 8, kn(v.linecheck_peak), fmt=KN3)
+                    cur.put(row, 9, v.ratio, fmt=RATIO)
+                    cur.put(row, 10, v.verdict, "lc_text")
+                    cur.put(row, 11, c.note, "lc_note")
                     cur.row += 1
                     n += 1
     cur.row += 1

@@ -12,8 +12,9 @@ from openpyxl.styles import Font
 from openpyxl.worksheet.worksheet import Worksheet
 
 from ..io.display import flag_text, how_to_read
+from ..io.document import STAT_BY_NAME, RunDocument, StatValue
 from . import template as tpl
-from .cells import GF_UNDEFINED, KN, PCT, RATIO, Cursor, align, is_num
+from .cells import KN, Cursor, align, excel_format, is_num, stat_cell
 
 REACTIONS_ALL = ("Rx", "Ry", "Rz")
 HEADERS = (("Case", 16), ("Reaction", 8), ("still air\n(kN)", 9), ("design peak\nwind (kN)", 10),
@@ -21,8 +22,8 @@ HEADERS = (("Case", 16), ("Reaction", 8), ("still air\n(kN)", 9), ("design peak\
            ("GF_QS\n95 % CI", 13), ("Cont_R\n(%)", 8), ("Cont_R\n95 % CI", 13), ("dynamic analysis", 30))
 
 
-def _ci(entry: dict[str, Any], pct: bool = False) -> str:
-    ci = entry.get("ci") or [None, None]
+def _ci(entry: StatValue, pct: bool = False) -> str:
+    ci = entry.ci or (None, None)
     if not (is_num(ci[0]) and is_num(ci[1])):
         return ""
     if pct:
@@ -30,13 +31,13 @@ def _ci(entry: dict[str, Any], pct: bool = False) -> str:
     return f"[{ci[0]:.3f}, {ci[1]:.3f}]"
 
 
-def write_design_block(ws: Worksheet, docs: list[dict], top: int, left: int = 1) -> int:
-    """Write the block from row ``top``; returns the next free row."""
-    ok = [d for d in docs if "error" not in d and "reactions" in d]
+def write_design_block(ws: Worksheet, docs: list, top: int, left: int = 1) -> int:
+    """Write the block from row ``top`` (``docs``: RunDocument or FailedRun); returns the next free row."""
+    ok = [d for d in docs if isinstance(d, RunDocument)]
     cur = Cursor(ws, top)
     if not ok:
         return top
-    p = {d.get("design_fractile", 0.5) for d in ok}
+    p = {d.design_fractile for d in ok}
     ptxt = ", ".join(f"{x:g}" for x in sorted(p))
     cur.put(top, left, f"Design values at the tower of interest (Gumbel fractile {ptxt} of the peak; "
                        "95 % confidence intervals of the mean over the realizations)", "lc_text")
@@ -48,28 +49,24 @@ def write_design_block(ws: Worksheet, docs: list[dict], top: int, left: int = 1)
     row = cur.row + 1
     notes: list[str] = []
     for doc in ok:
-        still = (doc.get("still_air") or {}).get("reactions") or {}
+        still = doc.still_air.reactions if doc.still_air is not None else {}
+        pk_def, tot_def = STAT_BY_NAME["peak_dynamic"], STAT_BY_NAME["peak_dynamic_total"]
         for r in REACTIONS_ALL:
-            e = doc["reactions"].get(r) or {}
-            pk = ((e.get("peak_dynamic") or {}).get("gumbel") or {})
-            tot = ((e.get("peak_dynamic_total") or {}).get("gumbel") or {})
+            e = doc.reactions[r]
+            pk, tot = e[pk_def.name].gumbel, e[tot_def.name].gumbel
             sa = still.get(r)
             vals: list[tuple[Any, str | None]] = [
-                (doc["case"], None), (r, None),
+                (doc.case, None), (r, None),
                 (sa / 1000.0 if is_num(sa) else None, KN),
-                (pk.get("design") / 1000.0 if is_num(pk.get("design")) else None, KN),
-                (tot.get("design") / 1000.0 if is_num(tot.get("design")) else None, KN),
-                (pk.get("ppcc") if is_num(pk.get("ppcc")) else None, "0.000"),
+                (stat_cell(pk_def, pk.design if pk else None), KN),
+                (stat_cell(tot_def, tot.design if tot else None), KN),
+                (pk.ppcc if pk and is_num(pk.ppcc) else None, "0.000"),
             ]
-            for key, pct in (("GF_Dy", False), ("GF_QS", False), ("Cont_R", True)):
-                ent = e.get(key) or {}
-                m = ent.get("mean")
-                if pct:
-                    vals.append((m if is_num(m) else None, PCT))
-                else:
-                    vals.append((m if is_num(m) else GF_UNDEFINED, RATIO))
-                vals.append((_ci(ent, pct), None))
-            state = e.get("dynamic_analysis")
+            for key in ("GF_Dy", "GF_QS", "Cont_R"):
+                st = STAT_BY_NAME[key]
+                vals.append((stat_cell(st, e[key].mean), excel_format(st)))
+                vals.append((_ci(e[key], st.kind == "fraction"), None))
+            state = e.dynamic_analysis
             vals.append((flag_text(state), None))
             for k, (v, fmt) in enumerate(vals):
                 style = "lc_text" if k in (0, 1, 7, 9, 11, 12) else "lc_number"

@@ -12,38 +12,39 @@ from openpyxl.utils import get_column_letter
 from openpyxl.worksheet.worksheet import Worksheet
 
 from . import template as tpl
+from ..io.display import flag_state
+from ..io.document import STAT_BY_NAME, FailedRun, RunDocument
 from .cells import (
     FLAG_NOTE,
     GF_UNDEFINED,
-    NORM,
     SUMMARY_IDS,
     SUMMARY_STATS,
     Cursor,
     align,
-    cell_value,
-    is_num,
+    excel_format,
     link,
     page_setup,
+    stat_cell,
     wind_label,
 )
-from ..io.display import flag_state
 from .charts import chart_title
 
 INCONCLUSIVE_NOTE = "inconclusive: run more realizations"
 
 
 # --------------------------------------------------------------------------- Summary
-def write_summary(ws: Worksheet, docs: list[dict], names: list[str | None], threshold: float,
+def write_summary(ws: Worksheet, docs: list[RunDocument | FailedRun], names: list[str | None], threshold: float,
                   top: int, left: int, summary_reactions: Sequence[str]) -> None:
     """The Table 5 table from (top, left): one row per case and reaction, flags, notes, print setup."""
-    with_std = any(int(d.get("realizations") or 1) > 1 for d in docs if "error" not in d)
-    cols: list[tuple[str, Any, int]] = []  # (header, spec, width)
+    with_std = any(d.realizations > 1 for d in docs if isinstance(d, RunDocument))
+    cols: list[tuple[str, Any, int]] = []  # (header, (statistic, "mean" | "std"), width)
     for label, width in SUMMARY_IDS:
         cols.append((label, None, width))
-    for spec in SUMMARY_STATS:
-        cols.append((spec[1], (spec, "mean"), 9))
-        if with_std and spec[4]:
-            cols.append(("±", (spec, "std"), 7))
+    for name in SUMMARY_STATS:
+        stat = STAT_BY_NAME[name]
+        cols.append((stat.header(), (stat, "mean"), 9))
+        if with_std and stat.varies:
+            cols.append(("±", (stat, "std"), 7))
     cols.append((SANITY_HEADER, None, 14))
     cols.append(("Note", None, 44))
     cur = Cursor(ws, top)
@@ -57,14 +58,14 @@ def write_summary(ws: Worksheet, docs: list[dict], names: list[str | None], thre
     cont_r_col = None
     band = PatternFill("solid", fgColor=tpl.BAND_FILL)
     for n_doc, doc in enumerate(docs):
-        failed = "error" in doc
+        failed = isinstance(doc, FailedRun)
         reactions = ("—",) if failed else summary_reactions
         for r in reactions:
-            if failed:
-                idvals = [doc["case"], doc.get("wind", ""), None, None, None, None, None, None]
+            if isinstance(doc, FailedRun):
+                idvals = [doc.case, "", None, None, None, None, None, None]
             else:
-                idvals = [doc["case"], wind_label(doc), doc.get("spans"), doc.get("span_length"), doc.get("v_ref"),
-                          doc.get("tower_of_interest"), doc.get("realizations"), r]
+                idvals = [doc.case, wind_label(doc), doc.spans, doc.span_length, doc.v_ref,
+                          doc.tower_of_interest, doc.realizations, r]
             c = 0
             for k, v in enumerate(idvals):
                 cell = cur.put(row, left + c, v, "lc_text" if k in (0, 1, 7) else "lc_number")
@@ -77,17 +78,17 @@ def write_summary(ws: Worksheet, docs: list[dict], names: list[str | None], thre
                 c += 1
             note = ""
             for label, spec, _ in cols[len(SUMMARY_IDS):-2]:
-                (stat, _h, fmt, kind, _s), which = spec
+                stat, which = spec
                 if failed:
                     cur.put(row, left + c, None)
                 else:
-                    entry = doc["reactions"][r][stat]
-                    if which == "std" and int(doc.get("realizations") or 1) < 2:
-                        value = None
+                    entry = doc.reactions[r][stat.name]
+                    if which == "std":
+                        value = stat_cell(stat, entry.std) if doc.realizations > 1 and entry.std is not None else None
                     else:
-                        value = cell_value(entry.get(which), kind if which == "mean" else ("kN" if kind == "kN" else "x"))
-                    cur.put(row, left + c, value, "lc_number", fmt)
-                    if stat == "Cont_R" and which == "mean":
+                        value = stat_cell(stat, entry.mean)
+                    cur.put(row, left + c, value, "lc_number", excel_format(stat, summary=True))
+                    if stat.name == "Cont_R" and which == "mean":
                         cont_r_col = left + c
                         state = flag_state(doc, r, threshold)  # issue 18: on the 95 % interval
                         if state == "recommended":
@@ -102,8 +103,8 @@ def write_summary(ws: Worksheet, docs: list[dict], names: list[str | None], thre
                 ccell.font = Font(name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT)
                 ccell.fill = PatternFill("solid", fgColor=tpl.FLAG_FILL)
             c += 1
-            if failed:
-                note = f"FAILED: {doc['error']}"
+            if isinstance(doc, FailedRun):
+                note = f"FAILED: {doc.error}"
             ncell = cur.put(row, left + c, note, "lc_text")
             align(ncell, indent=1)
             if failed:
@@ -161,27 +162,25 @@ def write_summary(ws: Worksheet, docs: list[dict], names: list[str | None], thre
 SANITY_HEADER = "Time vs\nfreq."
 
 
-def sanity_text(doc: dict) -> tuple[str, bool]:
+def sanity_text(doc: RunDocument) -> tuple[str, bool]:
     """Summary text of a case's time-vs-frequency sanity check and whether it failed.
 
     ``"ok"``, ``"FLAG: Rz rms_resonant, ..."`` (the quantities that differ), ``"—"`` for a
     downburst (no check), ``"not run"`` for a synoptic result without a spectral block.
     """
-    if doc.get("wind") != "synoptic":
+    if doc.wind != "synoptic":
         return "—", False
-    sp = doc.get("spectral")
-    checks = sp.get("sanity_check") if isinstance(sp, dict) else None
-    if not isinstance(checks, list) or not checks:
+    checks = doc.spectral.sanity_check if doc.spectral is not None else None
+    if not checks:
         return "not run", False
-    bad = [f"{it.get('reaction', '')} {it.get('quantity', '')}".strip() for it in checks
-           if isinstance(it, dict) and not it.get("ok")]
+    bad = [f"{it.reaction} {it.quantity}" for it in checks if not it.ok]
     if bad:
         return "FLAG: " + ", ".join(bad), True
     return "ok", False
 
 
 # --------------------------------------------------------------------------- Peaks
-def write_peaks(ws: Worksheet, cases: list[tuple[dict, str]], like: Worksheet,
+def write_peaks(ws: Worksheet, cases: list[tuple[RunDocument, str]], like: Worksheet,
                 reactions: Sequence[str]) -> None:
     """Normalised peaks of every case and their bar chart (Fig. 13)."""
     docs = [d for d, _ in cases]
@@ -190,7 +189,8 @@ def write_peaks(ws: Worksheet, cases: list[tuple[dict, str]], like: Worksheet,
     cur.put(2, 1, "g*yp = ½ ρ C_d V_ref² D (Eq. 17); reactions at the tower of interest; mean over realizations.",
             "lc_subtitle")
     cur.row = 4
-    with_std = any(int(d.get("realizations") or 1) > 1 for d in docs)
+    with_std = any(d.realizations > 1 for d in docs)
+    norm = STAT_BY_NAME["peak_normalised"]
     nr = len(reactions)
     labels = ["Case", "Wind", "Spans", "L_x\n(m)", "V_ref\n(m/s)", *reactions]
     if with_std:
@@ -203,18 +203,18 @@ def write_peaks(ws: Worksheet, cases: list[tuple[dict, str]], like: Worksheet,
     first = cur.row
     for doc, name in cases:
         r = cur.row
-        cell = cur.put(r, 1, doc["case"], "lc_text")
+        cell = cur.put(r, 1, doc.case, "lc_text")
         link(cell, name)
         cur.put(r, 2, wind_label(doc), "lc_text")
-        cur.put(r, 3, doc.get("spans"))
-        cur.put(r, 4, doc.get("span_length"), fmt="0.#")
-        cur.put(r, 5, doc.get("v_ref"), fmt="0.#")
-        n = int(doc.get("realizations") or 1)
+        cur.put(r, 3, doc.spans)
+        cur.put(r, 4, doc.span_length, fmt="0.#")
+        cur.put(r, 5, doc.v_ref, fmt="0.#")
         for k, rn in enumerate(reactions):
-            e = doc["reactions"][rn]["peak_normalised"]
-            cur.put(r, 6 + k, cell_value(e.get("mean"), "ratio"), fmt=NORM)
+            e = doc.reactions[rn][norm.name]
+            cur.put(r, 6 + k, stat_cell(norm, e.mean), fmt=excel_format(norm))
             if with_std:
-                cur.put(r, 6 + nr + k, cell_value(e.get("std"), "ratio") if n > 1 else None, fmt=NORM)
+                cur.put(r, 6 + nr + k, stat_cell(norm, e.std) if doc.realizations > 1 else None,
+                        fmt=excel_format(norm))
         cur.row += 1
     last = cur.row - 1
     ch = BarChart()

@@ -1,8 +1,9 @@
 """Excel design sheets from run result documents.
 
-Input: the JSON result documents of :func:`linecheck.io.jsonout.run_to_dict` (the
-dicts themselves, or the same dicts loaded from saved ``.json`` files), so every
-number in the workbook is the number of the JSON it came from.  ``run --excel``,
+Input: typed result documents (:class:`~linecheck.io.document.RunDocument`, or
+:class:`~linecheck.io.document.FailedRun` for a case of a batch that failed); their JSON
+(saved ``.json`` files) is read through ``RunDocument.from_json``, so every number in the
+workbook is the number of the JSON it came from and old files fail with a clear message.  ``run --excel``,
 ``batch --excel`` and ``export`` all go through :func:`write_workbook`.
 
 Cell values (never formulas, openpyxl writes no cached values):
@@ -37,6 +38,7 @@ from openpyxl import Workbook
 from ..core.case import MAX_RESULT_BYTES, read_text_file
 from ..core.errors import CaseError
 from ..io.atomic import atomic_path, check_target
+from ..io.document import FailedRun, RunDocument, load_document
 from . import template as tpl
 from .case_sheet import write_case
 from .cells import (
@@ -45,9 +47,8 @@ from .cells import (
     GF_UNDEFINED,
     REACTIONS,
     SUMMARY_REACTIONS,
-    SUMMARY_STATS,
-    cell_value,
     sheet_name,
+    stat_cell,
 )
 from .charts import chart_indices
 from .summary import write_peaks, write_summary
@@ -88,9 +89,9 @@ def write_workbook(
     """Write the design-sheet workbook of ``docs`` to ``path`` atomically.
 
     Args:
-        docs: run result documents (``run_to_dict`` dicts or loaded JSON); a failed
-            case may be given as ``{"case": name, "error": message}`` and is listed in
-            the summary with its error.
+        docs: run result documents (:class:`RunDocument`, or their JSON); a failed case
+            may be given as a :class:`FailedRun` (or ``{"case": name, "error": message}``)
+            and is listed in the summary with its error.
         path: ``.xlsx`` file; an existing file is replaced only with ``force``.
         template: workbook with the title-block defined names (default
             ``templates/design_sheet.xlsx``).
@@ -114,11 +115,9 @@ def write_workbook(
     reactions = tuple(reactions)
     if not reactions or any(r not in REACTIONS for r in reactions):
         raise CaseError(f"reactions {list(reactions)} not allowed: expected some of Rx, Ry, Rz", key="reactions")
-    docs = list(docs)
+    docs = [validate_doc(doc, f"result {i + 1}") for i, doc in enumerate(docs)]
     if not docs:
         raise CaseError("no results to write", file=str(p))
-    for i, doc in enumerate(docs):
-        validate_doc(doc, f"result {i + 1}")
     values = tpl.title_values(title)
     wb = tpl.load_template(template)
     build_workbook(wb, docs, values, float(cont_r_threshold), max(int(chart_points), 16), reactions)
@@ -159,36 +158,27 @@ def _umask() -> int:
     return umask
 
 
-def validate_doc(doc: Any, source: str) -> None:
-    """Check that ``doc`` is a run result document (or a failed-case entry)."""
+def validate_doc(doc: Any, source: str) -> RunDocument | FailedRun:
+    """The typed document of ``doc`` (a :class:`RunDocument`, a :class:`FailedRun`, or their JSON:
+    a run result or ``{"case", "error"}``); :class:`CaseError` naming ``source`` otherwise."""
+    if isinstance(doc, (RunDocument, FailedRun)):
+        return doc
     if not isinstance(doc, dict):
         raise CaseError("not a linecheck run result (expected a JSON object from `linecheck run --json`)",
                         file=source)
     if "error" in doc:
         if not isinstance(doc.get("case"), str):
             raise CaseError("failed-case entry needs a \"case\" name beside its \"error\"", file=source)
-        return
+        return load_document(doc, source=source)
     if "reactions" not in doc and "towers" in doc and "spans" in doc:
         raise CaseError("is a step-1 (static) result: export needs run results (`linecheck run --json`)",
                         file=source)
-    for key in ("case", "wind", "reactions", "realizations", "tower_of_interest"):
-        if key not in doc:
-            raise CaseError(f"not a linecheck run result: missing key \"{key}\" "
-                            "(expected the JSON of `linecheck run --json`)", file=source)
-    reactions = doc["reactions"]
-    for r in REACTIONS:
-        block = reactions.get(r) if isinstance(reactions, dict) else None
-        if not isinstance(block, dict):
-            raise CaseError(f"not a linecheck run result: \"reactions\" lacks \"{r}\"", file=source)
-        for stat, *_ in SUMMARY_STATS:
-            entry = block.get(stat)
-            if not isinstance(entry, dict) or "mean" not in entry:
-                raise CaseError(f"not a linecheck run result: reactions.{r}.{stat} needs a \"mean\"", file=source)
+    return load_document(doc, source=source)  # schema version and layout (issue 18)
 
 
-def load_result_docs(paths: Iterable[str | Path]) -> list[dict[str, Any]]:
-    """Read saved run results (one JSON object, or a list of them, per file)."""
-    docs: list[dict[str, Any]] = []
+def load_result_docs(paths: Iterable[str | Path]) -> list[RunDocument | FailedRun]:
+    """Read saved run results (one JSON object, or a list of them, per file) as typed documents."""
+    docs: list[RunDocument | FailedRun] = []
     for path in paths:
         p = Path(path)
         text = read_text_file(p, "a JSON result of `linecheck run --json`", MAX_RESULT_BYTES)
@@ -198,20 +188,14 @@ def load_result_docs(paths: Iterable[str | Path]) -> list[dict[str, Any]]:
             raise CaseError(f"invalid JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}", file=str(p)) from None
         items = data if isinstance(data, list) else [data]
         for k, doc in enumerate(items):
-            where = str(p) if len(items) == 1 else f"{p}[{k}]"
-            if isinstance(doc, dict) and "reactions" in doc and "error" not in doc:
-                from ..io.document import RunDocument  # saved files: schema version and layout (issue 18)
-
-                RunDocument.from_json(doc, source=where)
-            validate_doc(doc, where)
-            docs.append(doc)
+            docs.append(validate_doc(doc, str(p) if len(items) == 1 else f"{p}[{k}]"))
     if not docs:
         raise CaseError("no results to export (empty list)")
     return docs
 
 
 # =========================================================================== workbook
-def build_workbook(wb: Workbook, docs: list[dict], title: dict[str, Any], threshold: float,
+def build_workbook(wb: Workbook, docs: list[RunDocument | FailedRun], title: dict[str, Any], threshold: float,
                    chart_points: int = CHART_POINTS, reactions: Sequence[str] = SUMMARY_REACTIONS) -> None:
     """Fill a loaded template with the summary, peaks and case sheets (in place)."""
     tpl.ensure_styles(wb)
@@ -225,7 +209,7 @@ def build_workbook(wb: Workbook, docs: list[dict], title: dict[str, Any], thresh
         summary = wb["Summary"] if "Summary" in wb.sheetnames else wb.create_sheet("Summary", 0)
         top, left = (summary.max_row + 2 if summary.max_row > 1 or summary["A1"].value is not None else 1), 1
     taken = {n.lower() for n in wb.sheetnames}
-    names = [None if "error" in d else sheet_name(d["case"], taken) for d in docs]
+    names = [None if isinstance(d, FailedRun) else sheet_name(d.case, taken) for d in docs]
     ok = [(d, n) for d, n in zip(docs, names) if n is not None]
     peaks_name = "Peaks" if "peaks" not in {n.lower() for n in wb.sheetnames} else sheet_name("Peaks (linecheck)", taken)
     write_summary(summary, docs, names, threshold, top, left, reactions)
@@ -235,7 +219,7 @@ def build_workbook(wb: Workbook, docs: list[dict], title: dict[str, Any], thresh
     for d, name in ok:
         ws = wb.create_sheet(name)
         write_case(ws, d, threshold, chart_points, summary, header_text, reactions)
-    if any(d.get("codes") for d, _ in ok):  # design codes (issue 19)
+    if any(d.codes for d, _ in ok):  # design codes (issue 19)
         from .codes_sheet import write_codes
 
         at = wb.sheetnames.index(peaks_name) + 1 if peaks_name in wb.sheetnames else None
@@ -244,5 +228,5 @@ def build_workbook(wb: Workbook, docs: list[dict], title: dict[str, Any], thresh
 
 
 __all__ = ["write_workbook", "check_excel_target", "load_result_docs", "validate_doc", "build_workbook",
-           "cell_value", "chart_indices", "sheet_name", "FLAG_NOTE", "GF_UNDEFINED", "SUMMARY_REACTIONS",
+           "stat_cell", "chart_indices", "sheet_name", "FLAG_NOTE", "GF_UNDEFINED", "SUMMARY_REACTIONS",
            "CHART_POINTS"]

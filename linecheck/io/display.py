@@ -8,26 +8,14 @@ statistics table, :data:`linecheck.io.document.STAT_TABLE`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
-from .document import STAT_TABLE
+from .document import STAT_BY_NAME, STAT_TABLE, StatDef, StatValue
 
-
-@dataclass(frozen=True)
-class Stat:
-    """One summary row: JSON key, label, shown unit, scale to the shown unit, format."""
-
-    key: str
-    label: str
-    unit: str
-    scale: float
-    fmt: str
-
-
-SUMMARY_STATS: tuple[Stat, ...] = tuple(
-    Stat(s.name, s.label, s.display_unit, s.scale, s.fmt) for s in STAT_TABLE if s.summary)
-STAT_ROWS: dict[str, Stat] = {s.name: Stat(s.name, s.label, s.display_unit, s.scale, s.fmt) for s in STAT_TABLE}
+#: The statistics of the summary tables (console, TUI, Excel Summary), in table order.
+SUMMARY_STATS: tuple[StatDef, ...] = tuple(s for s in STAT_TABLE if s.summary)
+#: Every statistic by name (label, display unit, scale, format).
+STAT_ROWS: dict[str, StatDef] = STAT_BY_NAME
 
 FLAG_TEXT = {"recommended": "dynamic analysis recommended",
              "inconclusive": "inconclusive: run more realizations",
@@ -41,30 +29,32 @@ HOW_TO_READ_NEGATIVE_CONT_BG = (
     "realizations; it is sampling, not a relief the design can count on.")
 
 
-def stat_text(entry: dict[str, Any], stat: Stat, n_real: int) -> str:
-    """``mean`` (``± std`` when ``n_real`` > 1) of one statistic entry, ``**`` when null."""
-    m, s = entry.get("mean"), entry.get("std")
-    if m is None:
+def number_text(value: float | None, stat: StatDef) -> str:
+    """``value`` (SI) in the statistic's shown unit and format, "" when None."""
+    return "" if value is None else stat.fmt.format(value * stat.scale)
+
+
+def stat_text(entry: StatValue, stat: StatDef, n_real: int, sep: str = " ± ") -> str:
+    """``mean`` (``± std`` when ``n_real`` > 1) of one statistic, ``**`` when undefined."""
+    if entry.mean is None:
         return "**"
-    text = stat.fmt.format(m * stat.scale)
-    if n_real > 1 and s is not None:
-        text += " ± " + stat.fmt.format(s * stat.scale)
+    text = number_text(entry.mean, stat)
+    if n_real > 1 and entry.std is not None:
+        text += sep + number_text(entry.std, stat)
     return text
 
 
-def ci_text(entry: dict[str, Any], stat: Stat) -> str:
+def ci_text(entry: StatValue, stat: StatDef) -> str:
     """``[low, high]`` of a statistic's 95 % interval in the shown unit, "" when absent or null."""
-    ci = entry.get("ci")
-    if not ci or ci[0] is None or ci[1] is None:
+    ci = entry.ci
+    if ci is None or ci[0] is None or ci[1] is None:
         return ""
-    return "[" + stat.fmt.format(ci[0] * stat.scale) + ", " + stat.fmt.format(ci[1] * stat.scale) + "]"
+    return "[" + number_text(ci[0], stat) + ", " + number_text(ci[1], stat) + "]"
 
 
-def design_text(entry: dict[str, Any], stat: Stat) -> str:
+def design_text(entry: StatValue, stat: StatDef) -> str:
     """The Gumbel design value of a peak in the shown unit, "" when absent or null."""
-    g = entry.get("gumbel") or {}
-    d = g.get("design")
-    return "" if d is None else stat.fmt.format(d * stat.scale)
+    return "" if entry.gumbel is None else number_text(entry.gumbel.design, stat)
 
 
 def flag_text(state: str | None) -> str:
@@ -72,37 +62,34 @@ def flag_text(state: str | None) -> str:
     return FLAG_TEXT.get(state, str(state))
 
 
-def how_to_read(doc: dict[str, Any]) -> list[str]:
-    """The "how to read" notes that apply to ``doc`` (GF < 1, negative Cont_BG at the tower of interest)."""
+def how_to_read(doc: Any) -> list[str]:
+    """The "how to read" notes that apply to ``doc`` (a RunDocument: GF < 1, negative Cont_BG at
+    the tower of interest)."""
     notes = []
-    reactions = doc.get("reactions") or {}
-    gf_low = any(((reactions.get(r) or {}).get(k) or {}).get("mean") is not None
-                 and reactions[r][k]["mean"] < 1.0 for r in reactions for k in ("GF_Dy", "GF_QS"))
-    bg_neg = any(((reactions.get(r) or {}).get("Cont_BG") or {}).get("mean") is not None
-                 and reactions[r]["Cont_BG"]["mean"] < 0.0 for r in reactions)
-    if gf_low:
+    means = [(k, blk[k].mean) for blk in doc.reactions.values() for k in ("GF_Dy", "GF_QS", "Cont_BG")]
+    if any(m is not None and m < 1.0 for k, m in means if k != "Cont_BG"):
         notes.append(HOW_TO_READ_GF_BELOW_1)
-    if bg_neg:
+    if any(m is not None and m < 0.0 for k, m in means if k == "Cont_BG"):
         notes.append(HOW_TO_READ_NEGATIVE_CONT_BG)
     return notes
 
 
-def flag_state(doc: dict[str, Any], reaction: str, threshold: float | None = None) -> str | None:
-    """The Cont_R flag state of ``reaction`` at the tower of interest: the document's
-    ``"dynamic_analysis"``, or -- with a ``threshold`` other than 10 % (``export
+def flag_state(doc: Any, reaction: str, threshold: float | None = None) -> str | None:
+    """The Cont_R flag state of ``reaction`` at the tower of interest of ``doc`` (a RunDocument):
+    its ``dynamic_analysis``, or -- with a ``threshold`` other than 10 % (``export
     --cont-r-threshold``) -- the same three-state rule recomputed at that threshold from the
-    interval (docs/method.md).  None for a document without intervals (schema 1)."""
+    interval (docs/method.md)."""
     from ..core.extremes import CONT_R_THRESHOLD, MIN_WIND_SHARE
 
-    block = (doc.get("reactions") or {}).get(reaction) or {}
+    block = doc.reactions[reaction]
     if threshold is None or threshold == CONT_R_THRESHOLD:
-        return block.get("dynamic_analysis")
-    ci = (block.get("Cont_R") or {}).get("ci")
-    if not ci or ci[0] is None or ci[1] is None or (block.get("GF_Dy") or {}).get("mean") is None:
+        return block.dynamic_analysis
+    ci = block["Cont_R"].ci
+    if ci is None or ci[0] is None or ci[1] is None or block["GF_Dy"].mean is None:
         return None
-    sa = (doc.get("still_air") or {}).get("reactions") or {}
+    sa = doc.still_air.reactions if doc.still_air is not None else {}
     norm = sum(float(v) ** 2 for v in sa.values() if v is not None) ** 0.5
-    peak = (block.get("peak_dynamic") or {}).get("mean")
+    peak = block["peak_dynamic"].mean
     if peak is None or peak < MIN_WIND_SHARE * norm:
         return None
     if ci[0] > threshold:

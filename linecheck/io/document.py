@@ -1,12 +1,16 @@
 """The typed run-result document (issue 18) and the one statistics table every front end reads.
 
-:class:`RunDocument` is the frozen form of what ``linecheck run --json`` and a batch write:
-``to_json()`` gives the public JSON layout (docs/results.schema.json, generated from this
-module by ``tools/make_result_schema.py``), ``from_json()`` reads it back and rejects a
-document of another schema version with a :class:`~linecheck.core.errors.CaseError` that
-says how to regenerate it.  Blocks this module does not type (still air, step-1 series,
-spectral check, time histories, case parameters, and blocks added by other features such as
-``"codes"`` or ``"models"``) are kept verbatim in :attr:`RunDocument.blocks`.
+:class:`RunDocument` is the frozen form of what ``linecheck run --json`` and a batch write, and
+the only form the front ends (console tables, batch summary, Excel, TUI) read: ``to_json()``
+gives the public JSON layout (docs/results.schema.json, generated from this module by
+``tools/make_result_schema.py``), ``from_json()`` reads it back and rejects a document of
+another schema version with a :class:`~linecheck.core.errors.CaseError` that says how to
+regenerate it.  Every block is a typed field or a typed optional sub-document (None = absent
+from the JSON): still air, step-1 series, case parameters, burn-in, spectral check, design
+codes, time histories, the batch source, the downburst model spread and ``--until``; only keys
+this version does not know are kept verbatim in :attr:`RunDocument.blocks`.  ``to_json``
+writes the keys in the order ``run``/``batch`` always wrote them, so a document read and
+written again is byte for byte the same.
 
 Forces in N, Cont_* as fractions; no UI imports.
 """
@@ -14,7 +18,7 @@ Forces in N, Cont_* as fractions; no UI imports.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 from ..core.errors import CaseError
@@ -31,14 +35,18 @@ FLAG_STATES = ("recommended", "inconclusive")
 # --------------------------------------------------------------------------- statistics table
 @dataclass(frozen=True)
 class StatDef:
-    """One statistic: JSON key, label, SI unit, kind, display unit, scale to it, format.
+    """One statistic: JSON key, label, short label (column headers), SI unit, kind, display unit,
+    scale to it, format.
 
     kind: "force" [N], "ratio" [-] or "fraction" [-] (Cont_*, shown in %); ``peak``: has a
-    Gumbel fit; ``ci``: has a 95 % interval; ``summary``: shown in the summary tables.
+    Gumbel fit; ``ci``: has a 95 % interval (GF_Dy, GF_QS, Cont_R: a null GF is shown ``**``);
+    ``summary``: shown in the summary tables; ``varies``: differs between realizations (the
+    largest mean does not, so no ``± std`` column).
     """
 
     name: str
     label: str
+    short: str
     unit: str
     kind: str
     display_unit: str
@@ -48,34 +56,45 @@ class StatDef:
     ci: bool = False
     summary: bool = True
     meaning: str = ""
+    varies: bool = True
+
+    def header(self, unit_format: str = "\n({})") -> str:
+        """Column header: the short label and, unless dimensionless, the shown unit."""
+        return self.short + ("" if self.display_unit == "-" else unit_format.format(self.display_unit))
 
 
-def _force(name, label, meaning, peak=False, summary=True):
-    return StatDef(name, label, "N", "force", "kN", 1e-3, "{:.3f}", peak=peak, summary=summary, meaning=meaning)
+def _force(name, label, short, meaning, peak=False, summary=True, varies=True):
+    return StatDef(name, label, short, "N", "force", "kN", 1e-3, "{:.3f}", peak=peak, summary=summary, meaning=meaning,
+                   varies=varies)
+
+
+def _ratio(name, label, short, meaning, **kw):
+    return StatDef(name, label, short, "-", "ratio", "-", 1.0, "{:.3f}", meaning=meaning, **kw)
+
+
+def _fraction(name, meaning, **kw):
+    return StatDef(name, name, name, "-", "fraction", "%", 100.0, "{:.1f}", meaning=meaning, **kw)
 
 
 STAT_TABLE: tuple[StatDef, ...] = (
-    _force("mean_max", "mean max", "largest wind-induced mean reaction max_t |M|"),
-    _force("rms_background", "rms background B", "r.m.s. of the background reaction B"),
-    _force("rms_resonant", "rms resonant R", "r.m.s. of the resonant reaction R = F - B"),
-    _force("rms_fluctuating", "rms fluctuating B+R", "r.m.s. of B + R", summary=False),
-    _force("peak_quasi_static", "peak quasi-static M+B", "max_t |M + B| (wind-induced)", peak=True),
-    _force("peak_dynamic", "peak dynamic M+B+R", "max_t |M + B + R| (wind-induced)", peak=True),
-    _force("peak_quasi_static_total", "peak quasi-static total", "max_t |still air + M + B|", peak=True,
+    _force("mean_max", "mean max", "mean M", "largest wind-induced mean reaction max_t |M|", varies=False),
+    _force("rms_background", "rms background B", "rms B", "r.m.s. of the background reaction B"),
+    _force("rms_resonant", "rms resonant R", "rms R", "r.m.s. of the resonant reaction R = F - B"),
+    _force("rms_fluctuating", "rms fluctuating B+R", "rms B+R", "r.m.s. of B + R", summary=False),
+    _force("peak_quasi_static", "peak quasi-static M+B", "peak QS", "max_t |M + B| (wind-induced)", peak=True),
+    _force("peak_dynamic", "peak dynamic M+B+R", "peak Dy", "max_t |M + B + R| (wind-induced)", peak=True),
+    _force("peak_quasi_static_total", "peak quasi-static total", "peak QS total", "max_t |still air + M + B|",
+           peak=True, summary=False),
+    _force("peak_dynamic_total", "peak dynamic total", "peak Dy total", "max_t |still air + M + B + R|", peak=True,
            summary=False),
-    _force("peak_dynamic_total", "peak dynamic total", "max_t |still air + M + B + R|", peak=True, summary=False),
-    StatDef("GF_Dy", "GF_Dy", "-", "ratio", "-", 1.0, "{:.3f}", ci=True,
-            meaning="dynamic gust factor peak_dynamic / mean_max (Eq. 15)"),
-    StatDef("GF_QS", "GF_QS", "-", "ratio", "-", 1.0, "{:.3f}", ci=True,
-            meaning="quasi-static gust factor peak_quasi_static / mean_max (Eq. 15)"),
-    StatDef("Cont_M", "Cont_M", "-", "fraction", "%", 100.0, "{:.1f}", meaning="mean share mean_max / peak_dynamic (Eq. 16)"),
-    StatDef("Cont_BG", "Cont_BG", "-", "fraction", "%", 100.0, "{:.1f}", meaning="background share (peak_QS - mean_max) / peak_dynamic (Eq. 16)"),
-    StatDef("Cont_R", "Cont_R", "-", "fraction", "%", 100.0, "{:.1f}", ci=True,
-            meaning="resonant share (peak_dynamic - peak_QS) / peak_dynamic (Eq. 16)"),
-    StatDef("peak_normalised", "peak / g*_yp L", "-", "ratio", "-", 1.0, "{:.3f}", peak=True,
-            meaning="peak_dynamic / (g*_yp L_x) (Eq. 17)"),
-    StatDef("peak_normalised_total", "peak total / g*_yp L", "-", "ratio", "-", 1.0, "{:.3f}", peak=True,
-            summary=False, meaning="peak_dynamic_total / (g*_yp L_x)"),
+    _ratio("GF_Dy", "GF_Dy", "GF_Dy", "dynamic gust factor peak_dynamic / mean_max (Eq. 15)", ci=True),
+    _ratio("GF_QS", "GF_QS", "GF_QS", "quasi-static gust factor peak_quasi_static / mean_max (Eq. 15)", ci=True),
+    _fraction("Cont_M", "mean share mean_max / peak_dynamic (Eq. 16)"),
+    _fraction("Cont_BG", "background share (peak_QS - mean_max) / peak_dynamic (Eq. 16)"),
+    _fraction("Cont_R", "resonant share (peak_dynamic - peak_QS) / peak_dynamic (Eq. 16)", ci=True),
+    _ratio("peak_normalised", "peak / g*_yp L", "peak / g*yp Lx", "peak_dynamic / (g*_yp L_x) (Eq. 17)", peak=True),
+    _ratio("peak_normalised_total", "peak total / g*_yp L", "peak total / g*yp Lx", "peak_dynamic_total / (g*_yp L_x)",
+           peak=True, summary=False),
 )
 STAT_BY_NAME = {s.name: s for s in STAT_TABLE}
 
@@ -187,6 +206,247 @@ class Until:
                    int(d.get("max_realizations", 0)))
 
 
+# --------------------------------------------------------------------------- typed blocks
+def _out(v: Any) -> Any:
+    """JSON value of a field: sub-documents by their ``to_json``, containers element-wise."""
+    if hasattr(v, "to_json"):
+        return v.to_json()
+    if isinstance(v, dict):
+        return {k: _out(x) for k, x in v.items()}
+    if isinstance(v, tuple):
+        return [_out(x) for x in v]
+    return v
+
+
+class _Block:
+    """A JSON object whose keys are the dataclass's fields, in order; values are JSON values kept
+    exactly as read or written (no float/int coercion: a document read and written again is byte
+    for byte the same).  Subclasses with typed members override ``from_json``."""
+
+    def to_json(self) -> dict[str, Any]:
+        return {f.name: _out(getattr(self, f.name)) for f in fields(self)}  # type: ignore[arg-type]
+
+    @classmethod
+    def from_json(cls, d: dict[str, Any]) -> Any:
+        return cls(**{f.name: d[f.name] for f in fields(cls)})  # type: ignore[arg-type]
+
+
+@dataclass(frozen=True)
+class StillAir(_Block):
+    """Still-air state: reactions at the tower of interest [N], span tensions [N], nominal tension [N], sag [m]."""
+
+    reactions: dict[str, float | None]
+    tension: list[float | None]
+    tension_nominal: float | None
+    sag: float
+
+
+@dataclass(frozen=True)
+class StaticSeries(_Block):
+    """Step-1 mean state over its instants (one for synoptic): time [s], wind-induced reactions at
+    the tower of interest [N] (``{"Rx": [...], ...}``), tensions [N] (instants x spans), tower
+    displacements [m] (``{"dx": [...], ...}``)."""
+
+    time: list[float]
+    reactions_wind: dict[str, list[float | None]]
+    tension: list[list[float | None]]
+    displacement: dict[str, list[float | None]]
+
+
+@dataclass(frozen=True)
+class BurnIn(_Block):
+    """Discarded start of a synoptic record: seconds used, required [s] (None: never), slowest
+    significant mode [Hz] and its damping ratio [-], whether enough, where the value came from."""
+
+    seconds: float
+    required: float | None
+    mode_hz: float | None
+    zeta: float | None
+    sufficient: bool
+    source: str
+
+
+@dataclass(frozen=True)
+class SanityItem(_Block):
+    """One line of the frequency-domain sanity check (forces [N] or ratios [-])."""
+
+    reaction: str
+    quantity: str
+    time_domain: float | None
+    time_domain_std: float | None
+    frequency_domain: float | None
+    allowed_difference: float | None
+    ok: bool
+
+
+@dataclass(frozen=True)
+class Davenport(_Block):
+    """Davenport closed form of Ry (GF_* None where not applicable); factors [-], f1 [Hz]."""
+
+    reaction: str
+    applicable: bool
+    note: str
+    background_factor: float | None
+    resonant_factor: float | None
+    peak_factor: float | None
+    f1_hz: float | None
+    zeta_a: float | None
+    GF_Dy: float | None
+    GF_QS: float | None
+    Cont_R: float | None
+    GF_ASCE74: float | None
+
+
+@dataclass(frozen=True)
+class Spectral(_Block):
+    """Frequency-domain check: record duration [s], band [Hz], exact linear random vibration per
+    reaction (``exact[R][key]``, N or -), the Davenport closed form, and the sanity check."""
+
+    duration: float | None
+    band_hz: list[float | None]
+    n_frequencies: int
+    exact: dict[str, dict[str, float | None]]
+    davenport: Davenport
+    not_applicable: dict[str, str]
+    sanity_check: tuple[SanityItem, ...] | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        d = super().to_json()
+        if self.sanity_check is None:
+            del d["sanity_check"]
+        return d
+
+    @classmethod
+    def from_json(cls, d: dict[str, Any]) -> Spectral:
+        sc = d.get("sanity_check")
+        return cls(d["duration"], d["band_hz"], d["n_frequencies"], d["exact"], Davenport.from_json(d["davenport"]),
+                   d["not_applicable"], None if sc is None else tuple(SanityItem.from_json(x) for x in sc))
+
+
+@dataclass(frozen=True)
+class CodeVerdict(_Block):
+    """A code's load beside linecheck's peak for one reaction [N], their ratio [-] and the verdict."""
+
+    code_load: float | None
+    linecheck_peak: float | None
+    ratio: float | None
+    verdict: str
+
+
+@dataclass(frozen=True)
+class CodeTower:
+    """A tower (1-based ``index``) of a code check: one :class:`CodeVerdict` per reaction."""
+
+    index: int
+    reactions: dict[str, CodeVerdict]
+
+    def to_json(self) -> dict[str, Any]:
+        return {"index": self.index, **{r: v.to_json() for r, v in self.reactions.items()}}
+
+    @classmethod
+    def from_json(cls, d: dict[str, Any]) -> CodeTower:
+        return cls(d["index"], {r: CodeVerdict.from_json(v) for r, v in d.items() if r != "index"})
+
+
+@dataclass(frozen=True)
+class CodeCheck(_Block):
+    """One design code beside the run (issue 19): provision, inputs, load per length [N/m], towers."""
+
+    edition: str
+    verified: bool
+    provision: str
+    inputs: dict[str, Any]
+    note: str
+    load_per_length: float | None
+    towers: tuple[CodeTower, ...]
+
+    @classmethod
+    def from_json(cls, d: dict[str, Any]) -> CodeCheck:
+        return cls(d["edition"], d["verified"], d["provision"], d["inputs"], d["note"], d["load_per_length"],
+                   tuple(CodeTower.from_json(t) for t in d["towers"]))
+
+
+@dataclass(frozen=True)
+class TimeHistories:
+    """Realization ``realization`` (1-based) at the tower of interest: time [s] and per reaction
+    the mean M, background B and resonant R parts [N] (``series[R]["M"]``), maybe thinned."""
+
+    realization: int
+    decimated: bool
+    time: list[float]
+    series: dict[str, dict[str, list[float | None]]]
+
+    def to_json(self) -> dict[str, Any]:
+        return {"realization": self.realization, "decimated": self.decimated, "time": self.time, **self.series}
+
+    @classmethod
+    def from_json(cls, d: dict[str, Any]) -> TimeHistories:
+        return cls(d["realization"], d["decimated"], d["time"],
+                   {r: d[r] for r in REACTIONS if r in d})
+
+
+@dataclass(frozen=True)
+class BatchSource:
+    """Where a batch result came from: the case file, its hash (resume) and key changes (``--models``)."""
+
+    case_file: str
+    case_hash: str | None
+    changes: dict[str, Any] | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        d: dict[str, Any] = {"case_file": self.case_file, "case_hash": self.case_hash}
+        if self.changes is not None:
+            d["changes"] = self.changes
+        return d
+
+
+@dataclass(frozen=True)
+class EnvelopeEntry(_Block):
+    """Model-spread envelope of one statistic: the realization mean of largest magnitude and its model."""
+
+    value: float | None
+    model: str | None
+
+
+@dataclass(frozen=True)
+class Tower:
+    """Tower ``index`` (1-based): support type and its typed reaction blocks."""
+
+    index: int
+    support: str
+    reactions: dict[str, ReactionResult]
+
+    def to_json(self) -> dict[str, Any]:
+        return {"index": self.index, "support": self.support, "reactions": _reactions_json(self.reactions)}
+
+
+@dataclass(frozen=True)
+class FailedRun:
+    """A case that did not run (batch): its name and the one-line error."""
+
+    case: str
+    error: str
+
+    def to_json(self) -> dict[str, Any]:
+        return {"case": self.case, "error": self.error}
+
+
+def models_of(reactions: dict[str, dict[str, ReactionResult]]) -> dict[str, dict[str, EnvelopeEntry]]:
+    """Model-spread envelope (issue 15) of each model's reaction blocks at the tower of interest:
+    per reaction and statistic, the realization mean of largest magnitude and its model."""
+    env: dict[str, dict[str, EnvelopeEntry]] = {}
+    for r in REACTIONS:
+        env[r] = {}
+        for s in STAT_TABLE:
+            best, who = None, None
+            for name, blk in reactions.items():
+                v = blk[r][s.name].mean
+                if v is not None and (best is None or abs(v) > abs(best)):
+                    best, who = v, name
+            env[r][s.name] = EnvelopeEntry(best, who)
+    return env
+
+
 #: Header fields of :class:`RunDocument`, in JSON order, with their JSON types (for the schema).
 HEADER_FIELDS: tuple[tuple[str, str], ...] = (
     ("schema_version", "integer"),
@@ -207,15 +467,22 @@ HEADER_FIELDS: tuple[tuple[str, str], ...] = (
     ("windows", "integer"),
     ("design_fractile", "number"),
 )
+#: Optional typed blocks after ``"towers"``, in JSON order (absent from the JSON when None).
+BLOCK_FIELDS = ("still_air", "static", "parameters", "burn_in", "damping", "structural_damping", "spectral",
+                "codes", "time_histories", "batch", "model", "models", "models_envelope", "models_failed")
+_BATCH_KEYS = ("case_file", "case_hash", "changes")
 
 
 @dataclass(frozen=True)
 class RunDocument:
     """A run result as saved and read by every front end (issue 18).
 
-    ``reactions``: the tower of interest; ``towers[k]``: tower k+1 (``support``, ``reactions``);
-    ``blocks``: the untyped blocks, kept verbatim and written after the typed keys (extra
-    blocks of later features -- ``"codes"``, ``"models"`` -- go here too).
+    ``reactions``: the tower of interest; ``towers[k]``: tower k+1.  Optional blocks (None =
+    absent): ``still_air``, ``static`` (step-1 series), ``parameters`` (the case's TOML
+    document), ``burn_in``, ``damping``/``structural_damping``, ``spectral``, ``codes`` (per
+    code), ``time_histories``, ``batch`` (written as the top-level keys ``"case_file"``,
+    ``"case_hash"``, ``"changes"``), ``model``/``models``/``models_envelope``/``models_failed``
+    (downburst model spread), ``until``.  ``blocks``: keys this version does not know, verbatim.
     """
 
     schema_version: int
@@ -236,21 +503,44 @@ class RunDocument:
     windows: int
     design_fractile: float
     reactions: dict[str, ReactionResult]
-    towers: tuple[dict[str, Any], ...]
+    towers: tuple[Tower, ...]
     until: Until | None = None
+    still_air: StillAir | None = None
+    static: StaticSeries | None = None
+    parameters: dict[str, Any] | None = None
+    burn_in: BurnIn | None = None
+    damping: str | None = None
+    structural_damping: float | None = None
+    spectral: Spectral | None = None
+    codes: dict[str, CodeCheck] | None = None
+    time_histories: TimeHistories | None = None
+    batch: BatchSource | None = None
+    model: str | None = None
+    models: dict[str, dict[str, ReactionResult]] | None = None
+    models_envelope: dict[str, dict[str, EnvelopeEntry]] | None = None
+    models_failed: dict[str, str] | None = None
     blocks: dict[str, Any] = field(default_factory=dict)
 
     def reaction(self, r: str) -> ReactionResult:
         return self.reactions[r]
 
     def to_json(self) -> dict[str, Any]:
-        """The public JSON layout (plain dict of JSON values)."""
+        """The public JSON layout (plain dict of JSON values, keys in the documented order)."""
         d: dict[str, Any] = {k: getattr(self, k) for k, _ in HEADER_FIELDS}
         if self.until is not None:
             d["until"] = self.until.to_json()
         d["reactions"] = _reactions_json(self.reactions)
-        d["towers"] = [{"index": t["index"], "support": t["support"], "reactions": _reactions_json(t["reactions"])}
-                       for t in self.towers]
+        d["towers"] = [t.to_json() for t in self.towers]
+        for k in BLOCK_FIELDS:
+            v = getattr(self, k)
+            if v is None:
+                continue
+            if k == "batch":
+                d.update(v.to_json())
+            elif k == "models":
+                d[k] = {m: _reactions_json(blk) for m, blk in v.items()}
+            else:
+                d[k] = _out(v)
         for k, v in self.blocks.items():
             d[k] = v
         return d
@@ -259,7 +549,7 @@ class RunDocument:
     def from_json(cls, d: dict[str, Any], *, source: str | None = None) -> RunDocument:
         """Read a saved document; :class:`CaseError` (exit 2) for another schema version or a
         document that is not a run result, saying how to regenerate it."""
-        where = source or "result document"
+        what = "is " if source else "result document is "  # CaseError puts the file name first
         if not isinstance(d, dict) or "reactions" not in d or "case" not in d:
             raise CaseError("is not a linecheck run result (no \"case\"/\"reactions\"): expected the JSON of "
                             "`linecheck run --json` or of a batch", file=source)
@@ -272,15 +562,41 @@ class RunDocument:
         try:
             head = {k: d[k] for k, _ in HEADER_FIELDS}
             reactions = _reactions_from(d["reactions"])
-            towers = tuple({"index": int(t["index"]), "support": t["support"],
-                            "reactions": _reactions_from(t["reactions"])} for t in d["towers"])
+            towers = tuple(Tower(int(t["index"]), t["support"], _reactions_from(t["reactions"])) for t in d["towers"])
             until = Until.from_json(d["until"]) if d.get("until") is not None else None
-        except (KeyError, TypeError, ValueError, IndexError) as exc:
-            raise CaseError(f"{where} is incomplete or damaged ({type(exc).__name__}: {exc}): regenerate it with "
-                            "`linecheck run CASE.toml --json FILE.json`", file=source) from None
-        typed = {k for k, _ in HEADER_FIELDS} | {"reactions", "towers", "until"}
+
+            def opt(key: str, read: Any) -> Any:
+                return None if d.get(key) is None else read(d[key])
+
+            opts = dict(
+                still_air=opt("still_air", StillAir.from_json), static=opt("static", StaticSeries.from_json),
+                parameters=d.get("parameters"), burn_in=opt("burn_in", BurnIn.from_json),
+                damping=d.get("damping"), structural_damping=d.get("structural_damping"),
+                spectral=opt("spectral", Spectral.from_json),
+                codes=opt("codes", lambda c: {k: CodeCheck.from_json(v) for k, v in c.items()}),
+                time_histories=opt("time_histories", TimeHistories.from_json),
+                batch=None if "case_file" not in d else BatchSource(d["case_file"], d.get("case_hash"), d.get("changes")),
+                model=d.get("model"), models=opt("models", lambda m: {k: _reactions_from(v) for k, v in m.items()}),
+                models_envelope=opt("models_envelope", lambda e: {
+                    r: {s: EnvelopeEntry.from_json(x) for s, x in st.items()} for r, st in e.items()}),
+                models_failed=d.get("models_failed"),
+            )
+        except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
+            raise CaseError(f"{what}incomplete or damaged ({type(exc).__name__}: {exc}): regenerate it with "
+                            f"`linecheck run CASE.toml --json {source or 'FILE.json'}`", file=source) from None
+        typed = {k for k, _ in HEADER_FIELDS} | {"reactions", "towers", "until"} | set(BLOCK_FIELDS) | set(_BATCH_KEYS)
         blocks = {k: v for k, v in d.items() if k not in typed}
-        return cls(**head, reactions=reactions, towers=towers, until=until, blocks=blocks)
+        return cls(**head, reactions=reactions, towers=towers, until=until, **opts, blocks=blocks)
+
+
+def load_document(d: Any, *, source: str | None = None) -> RunDocument | FailedRun:
+    """A front end's input: a :class:`RunDocument` or :class:`FailedRun` as is, a JSON dict
+    through :meth:`RunDocument.from_json` (``{"case", "error"}`` -> :class:`FailedRun`)."""
+    if isinstance(d, (RunDocument, FailedRun)):
+        return d
+    if isinstance(d, dict) and "error" in d and "reactions" not in d:
+        return FailedRun(str(d.get("case", "?")), str(d["error"]))
+    return RunDocument.from_json(d, source=source)
 
 
 # --------------------------------------------------------------------------- from a run
@@ -301,8 +617,9 @@ def reactions_of(summary: Any, tower: int) -> dict[str, ReactionResult]:
             for c, r in enumerate(REACTIONS)}
 
 
-def document_of(res: Any, blocks: dict[str, Any]) -> RunDocument:
-    """The :class:`RunDocument` of a :class:`~linecheck.service.RunResult` (``blocks``: untyped blocks)."""
+def document_of(res: Any, **blocks: Any) -> RunDocument:
+    """The :class:`RunDocument` of a :class:`~linecheck.service.RunResult` (``blocks``: its
+    optional typed blocks, :data:`BLOCK_FIELDS`)."""
     case = res.case
     summary = res.summary()
     j = res.tower_index
@@ -316,9 +633,9 @@ def document_of(res: Any, blocks: dict[str, Any]) -> RunDocument:
         peak_window=case.analysis.peak_window, windows=int(res.windows),
         design_fractile=case.analysis.design_fractile,
         reactions=reactions_of(summary, j),
-        towers=tuple({"index": k + 1, "support": case.line.supports[k], "reactions": reactions_of(summary, k)}
+        towers=tuple(Tower(k + 1, case.line.supports[k], reactions_of(summary, k))
                      for k in range(res.system.n_towers)),
-        until=until, blocks=blocks,
+        until=until, **blocks,
     )
 
 

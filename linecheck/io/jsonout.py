@@ -91,8 +91,10 @@ def static_to_dict(res: StaticResult) -> dict[str, Any]:
     return doc
 
 
-def write_json(path: str | Path, doc: dict[str, Any], *, force: bool = True) -> Path:
-    """Write a JSON document atomically."""
+def write_json(path: str | Path, doc: Any, *, force: bool = True) -> Path:
+    """Write a JSON document (a dict, or a typed document by its ``to_json()``) atomically."""
+    if hasattr(doc, "to_json"):
+        doc = doc.to_json()
     return write_text_atomic(path, json.dumps(doc, indent=2, allow_nan=False) + "\n", force=force, what="JSON")
 
 
@@ -121,80 +123,64 @@ def case_parameters(case: Any) -> dict[str, Any]:
     return case_to_dict(case)
 
 
-def run_to_dict(res: Any, *, full_histories: bool = False, max_points: int = 2000,
-                extra: dict[str, Any] | None = None) -> dict[str, Any]:
+def run_to_dict(res: Any, *, full_histories: bool = False, max_points: int = 2000) -> dict[str, Any]:
     """JSON document of a run: ``run_document(res, ...).to_json()`` (issue 18 contract,
     :class:`~linecheck.io.document.RunDocument`; layout in docs/results.schema.json)."""
-    return run_document(res, full_histories=full_histories, max_points=max_points, extra=extra).to_json()
+    return run_document(res, full_histories=full_histories, max_points=max_points).to_json()
 
 
-def run_document(res: Any, *, full_histories: bool = False, max_points: int = 2000,
-                 extra: dict[str, Any] | None = None) -> Any:
-    """The typed :class:`~linecheck.io.document.RunDocument` of a run.
+def run_document(res: Any, *, full_histories: bool = False, max_points: int = 2000) -> Any:
+    """The typed :class:`~linecheck.io.document.RunDocument` of a run, what every front end reads.
 
-    Typed: the header (``"schema_version"``, ``"case"``, ..., ``"realizations"``, ``"windows"``),
-    ``"reactions"`` at the tower of interest and ``"towers"`` (every statistic
+    Header, ``reactions`` at the tower of interest and ``towers`` (every statistic
     ``{"mean", "std", "se", "p05", "p50", "p95"}``, peaks with ``"gumbel"``, GF_Dy/GF_QS/Cont_R
-    with ``"ci"``, each reaction with ``"dynamic_analysis"``), ``"until"``.  Untyped blocks:
-    ``"still_air"``, ``"static"``, ``"parameters"``, ``"burn_in"``, ``"damping"``,
-    ``"spectral"``, ``"time_histories"`` and any ``extra`` blocks (e.g. ``"codes"``).
-    Forces in N, Cont_* as fractions, GF null where the mean vanishes.  Time histories are
-    those of realization 1 at the tower of interest, thinned to about ``max_points`` samples
-    keeping every block's extremes unless ``full_histories``.
+    with ``"ci"``, each reaction with ``"dynamic_analysis"``), ``until``, and the typed blocks
+    ``still_air``, ``static``, ``parameters``, ``burn_in``, ``damping``, ``spectral`` (synoptic,
+    with its sanity check), ``codes`` and ``time_histories``.  Forces in N, Cont_* as
+    fractions, GF null where the mean vanishes.  Time histories are those of realization 1 at
+    the tower of interest, thinned to about ``max_points`` samples keeping every block's
+    extremes unless ``full_histories``.
     """
     from ..core.results import REACTIONS
-    from .document import document_of
+    from .document import BurnIn, SanityItem, StaticSeries, StillAir, TimeHistories, document_of
 
     case = res.case
     j = res.tower_index
     still = res.static.mean.still_air
     m = res.static.mean
-    doc: dict[str, Any] = {
-        "still_air": {
-            "reactions": {r: _num(still.reactions[j, c]) for c, r in enumerate(REACTIONS)},
-            "tension": _num(still.tension),
-            "tension_nominal": _num(res.system.tension_nominal),
-            "sag": case.line.sag,
-        },
-        "static": {
-            "time": _num(m.time),
-            "reactions_wind": {r: _num(m.reactions_wind[:, j, c]) for c, r in enumerate(REACTIONS)},
-            "tension": _num(m.tension),
-            "displacement": {k: _num(m.displacement[:, j, c]) for c, k in enumerate(("dx", "dy", "dz"))},
-        },
+    blocks: dict[str, Any] = {
+        "still_air": StillAir({r: _num(still.reactions[j, c]) for c, r in enumerate(REACTIONS)}, _num(still.tension),
+                              _num(res.system.tension_nominal), case.line.sag),
+        "static": StaticSeries(_num(m.time), {r: _num(m.reactions_wind[:, j, c]) for c, r in enumerate(REACTIONS)},
+                               _num(m.tension),
+                               {k: _num(m.displacement[:, j, c]) for c, k in enumerate(("dx", "dy", "dz"))}),
         "parameters": case_parameters(case),
+        "damping": case.analysis.damping,
+        "structural_damping": case.analysis.structural_ratio,
     }
     if res.burn_in is not None:
         b = res.burn_in
-        doc["burn_in"] = {"seconds": _num(b.seconds), "required": _num(b.required), "mode_hz": _num(b.mode_hz),
-                          "zeta": _num(b.zeta), "sufficient": b.sufficient, "source": b.source}
-    doc["damping"] = case.analysis.damping
-    doc["structural_damping"] = case.analysis.structural_ratio
+        blocks["burn_in"] = BurnIn(_num(b.seconds), _num(b.required), _num(b.mode_hz), _num(b.zeta), b.sufficient,
+                                   b.source)
     if res.spectral is not None:
+        from dataclasses import replace
+
         from ..service import sanity_check
 
-        doc["spectral"] = spectral_to_dict(res.spectral)
-        doc["spectral"]["sanity_check"] = [
-            {"reaction": it.reaction, "quantity": it.quantity, "time_domain": _num(it.time_domain),
-             "time_domain_std": _num(it.time_domain_std), "frequency_domain": _num(it.frequency_domain),
-             "allowed_difference": _num(it.allowed), "ok": it.ok}
-            for it in sanity_check(res)
-        ]
-    doc["codes"] = codes_block(res)
+        blocks["spectral"] = replace(spectral_document(res.spectral), sanity_check=tuple(
+            SanityItem(it.reaction, it.quantity, _num(it.time_domain), _num(it.time_domain_std),
+                       _num(it.frequency_domain), _num(it.allowed), it.ok)
+            for it in sanity_check(res)))
+    blocks["codes"] = codes_block(res)
     M = res.mean[:, j, :]
     B = res.background[0]
     R = res.resonant[0]
     total = M + B + R
     idx = np.arange(res.time.size) if full_histories else decimate_keep_peaks(np.concatenate([total, M + B], axis=1), max_points)
-    doc["time_histories"] = {
-        "realization": int(res.realizations[0]) + 1,
-        "decimated": bool(idx.size < res.time.size),
-        "time": _num(res.time[idx]),
-        **{r: {"M": _num(M[idx, c]), "B": _num(B[idx, c]), "R": _num(R[idx, c])} for c, r in enumerate(REACTIONS)},
-    }
-    if extra:
-        doc.update(extra)
-    return document_of(res, doc)
+    blocks["time_histories"] = TimeHistories(
+        int(res.realizations[0]) + 1, bool(idx.size < res.time.size), _num(res.time[idx]),
+        {r: {"M": _num(M[idx, c]), "B": _num(B[idx, c]), "R": _num(R[idx, c])} for c, r in enumerate(REACTIONS)})
+    return document_of(res, **blocks)
 
 
 def codes_to_dict(cr: Any) -> dict[str, Any]:
@@ -218,44 +204,38 @@ def codes_to_dict(cr: Any) -> dict[str, Any]:
 
 
 def codes_block(res: Any) -> dict[str, Any]:
-    """The ``"codes"`` block of a run document: the design codes beside the run's peaks; a code
+    """The typed ``codes`` block of a run document (per code a
+    :class:`~linecheck.io.document.CodeCheck`): the design codes beside the run's peaks; a code
     outside its validity is reported, not raised (``linecheck codes`` raises instead)."""
     from ..service import codes_analysis
 
-    return codes_to_dict(codes_analysis(res.case, res, strict=False))
+    return codes_document(codes_analysis(res.case, res, strict=False))
 
 
-def reactions_block(res: Any, tower: int | None = None) -> dict[str, Any]:
-    """``{"Rx": {stat: {...}, "dynamic_analysis"}, "Ry": .., "Rz": ..}`` of one tower (0-based; default
-    the tower of interest) of a RunResult: the same typed block as the document's ``"reactions"``
-    (issue 18: mean, std, se, fractiles, Gumbel fits, intervals, the Cont_R flag)."""
-    from .document import _reactions_json, reactions_of
+def codes_document(cr: Any) -> dict[str, Any]:
+    """The typed form of :func:`codes_to_dict`: per code a :class:`~linecheck.io.document.CodeCheck`."""
+    from .document import CodeCheck
 
-    return _reactions_json(reactions_of(res.summary(), res.tower_index if tower is None else tower))
+    return {k: CodeCheck.from_json(v) for k, v in codes_to_dict(cr).items()}
 
 
-def models_block(results: dict[str, Any]) -> dict[str, Any]:
-    """Model spread of issue 15: ``{"models": {name: <same as "reactions">}, "models_envelope":
-    {R: {stat: {"value", "model"}}}}`` at the tower of interest.  The envelope takes, per
-    reaction and statistic, the realization mean of largest magnitude and names its model."""
-    return models_from_reactions({name: reactions_block(res) for name, res in results.items()})
+def with_models(doc: Any, model: str, reactions: dict[str, Any], failed: dict[str, str] | None = None) -> Any:
+    """``doc`` (a :class:`~linecheck.io.document.RunDocument`) with the downburst model spread of
+    issue 15: ``model`` (the run shown), ``models`` (each model's typed reaction blocks at the
+    tower of interest), ``models_envelope`` and, when some failed, ``models_failed``."""
+    from dataclasses import replace
+
+    from .document import models_of
+
+    return replace(doc, model=model, models=dict(reactions), models_envelope=models_of(reactions),
+                   models_failed=failed or None)
 
 
-def models_from_reactions(models: dict[str, Any]) -> dict[str, Any]:
-    """:func:`models_block` from each model's ``"reactions"`` block (e.g. of saved documents)."""
-    from ..core.results import REACTIONS, STATISTICS
+def model_reactions(results: dict[str, Any]) -> dict[str, Any]:
+    """Each model's typed reaction blocks at the tower of interest, from its RunResult."""
+    from .document import reactions_of
 
-    env: dict[str, Any] = {}
-    for r in REACTIONS:
-        env[r] = {}
-        for s in STATISTICS:
-            best, who = None, None
-            for name, blk in models.items():
-                v = blk[r][s]["mean"]
-                if v is not None and (best is None or abs(v) > abs(best)):
-                    best, who = v, name
-            env[r][s] = {"value": best, "model": who}
-    return {"models": models, "models_envelope": env}
+    return {name: reactions_of(res.summary(), res.tower_index) for name, res in results.items()}
 
 
 def spectral_to_dict(sp: Any) -> dict[str, Any]:
@@ -285,3 +265,12 @@ def spectral_to_dict(sp: Any) -> dict[str, Any]:
             "exact": exact, "davenport": dav,
             "not_applicable": {"Rx": "closed form ignores the longitudinal influence line",
                                "Rz": "closed form ignores the vertical influence line"}}
+
+
+def spectral_document(sp: Any) -> Any:
+    """The typed :class:`~linecheck.io.document.Spectral` block of a SpectralResult (no sanity check)."""
+    from .document import Davenport, Spectral
+
+    d = spectral_to_dict(sp)
+    return Spectral(d["duration"], d["band_hz"], d["n_frequencies"], d["exact"], Davenport.from_json(d["davenport"]),
+                    d["not_applicable"])

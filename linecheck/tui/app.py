@@ -11,7 +11,6 @@ from __future__ import annotations
 import threading
 import time
 from pathlib import Path
-from typing import Any
 
 from textual import on, work
 from textual.app import App, ComposeResult
@@ -22,6 +21,7 @@ from textual.worker import Worker, WorkerState
 
 from ..core.case import Case, load_case
 from ..core.errors import Cancelled, LinecheckError
+from ..io.document import RunDocument
 from . import files, runner
 from .formatting import case_differences
 from .catalog import discover
@@ -392,7 +392,7 @@ class LinecheckApp(App[None]):
         out = self.output
         # an edited case's description is marked with the edits (it describes the file's values)
         doc = files.doc_for_export(out.doc, out.case, self.output_original)
-        default = files.free_path(Path(f"{doc['case']}{suffix}"))
+        default = files.free_path(Path(f"{doc.case}{suffix}"))
 
         def done(answer: tuple[Path, bool] | None) -> None:
             if answer is not None:
@@ -407,5 +407,5 @@ class LinecheckApp(App[None]):
         self._export("json", "Export the result as JSON (linecheck run --json)", ".json")
 
     @work(thread=True, exclusive=True, exit_on_error=False, group="export")
-    def export_job(self, kind: str, doc: dict[str, Any], path: Path, replace: bool) -> tuple[str, Path]:
+    def export_job(self, kind: str, doc: RunDocument, path: Path, replace: bool) -> tuple[str, Path]:
         return kind, files.export(kind, doc, path, replace=replace)

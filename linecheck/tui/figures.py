@@ -12,6 +12,8 @@ from typing import Any
 
 import numpy as np
 
+from ..io.document import RunDocument
+
 REACTION_NAMES = {"Rx": "longitudinal Rx", "Ry": "transverse Ry", "Rz": "vertical Rz"}
 
 
@@ -39,22 +41,23 @@ class Figure:
     notes: tuple[str, ...] = field(default_factory=tuple)
 
 
-def reaction_history(doc: dict[str, Any], reaction: str) -> Figure:
+def reaction_history(doc: RunDocument, reaction: str) -> Figure:
     """M, M+B and M+B+R of one reaction at the tower of interest [kN] (paper Figs B1-B12).
 
-    From the JSON document's ``time_histories`` (realization 1, thinned keeping the peaks).
+    From the document's ``time_histories`` (realization 1, thinned keeping the peaks).
     """
-    th = doc["time_histories"]
-    t = np.asarray(th["time"], dtype=float)
-    blk = th[reaction]
+    th = doc.time_histories
+    assert th is not None
+    t = np.asarray(th.time, dtype=float)
+    blk = th.series[reaction]
 
     def arr(key: str) -> np.ndarray:
         return np.array([np.nan if v is None else v for v in blk[key]], dtype=float) / 1e3
 
     M, B, R = arr("M"), arr("B"), arr("R")
     return Figure(
-        title=f"{doc['case']}: {REACTION_NAMES[reaction]} at tower {doc['tower_of_interest']}, "
-              f"realization {th['realization']} (wind-induced)",
+        title=f"{doc.case}: {REACTION_NAMES[reaction]} at tower {doc.tower_of_interest}, "
+              f"realization {th.realization} (wind-induced)",
         xlabel="time (s)", ylabel="kN",
         series=(Series("M+B+R (dynamic)", t, M + B + R), Series("M+B (quasi-static)", t, M + B),
                 Series("M (mean)", t, M)),
@@ -125,7 +128,7 @@ def wind_at_p(w: Any) -> Figure:
     )
 
 
-def contributions(docs: list[tuple[str, dict[str, Any]]]) -> Figure:
+def contributions(docs: list[tuple[str, RunDocument]]) -> Figure:
     """Cont_M, Cont_BG, Cont_R of each reaction [%], stacked (paper Fig. 12).
 
     ``docs``: ``(label, doc)`` pairs; several give the bars side by side (compare).
@@ -134,7 +137,7 @@ def contributions(docs: list[tuple[str, dict[str, Any]]]) -> Figure:
     parts: dict[str, list[float]] = {"Cont_M": [], "Cont_BG": [], "Cont_R": []}
     for label, doc in docs:
         for r in ("Rx", "Ry", "Rz"):
-            vals = {k: doc["reactions"][r][k]["mean"] for k in parts}
+            vals = {k: doc.reactions[r][k].mean for k in parts}
             for k in parts:
                 parts[k].append(0.0 if vals[k] is None else 100.0 * vals[k])
             name = f"{label} {r}".strip()

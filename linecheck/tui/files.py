@@ -5,11 +5,12 @@ Every write is atomic and replaces an existing file only when ``replace`` is tru
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
-from typing import Any
 
 from ..core.case import Case, case_to_toml, with_value
 from ..io.atomic import write_text_atomic
+from ..io.document import RunDocument
 from .formatting import case_differences
 
 
@@ -77,7 +78,7 @@ def edit_note(case: Case, original: Case | None) -> str | None:
     return "edited: " + ", ".join(edits) if edits else None
 
 
-def doc_for_export(doc: dict[str, Any], case: Case, original: Case | None) -> dict[str, Any]:
+def doc_for_export(doc: RunDocument, case: Case, original: Case | None) -> RunDocument:
     """The run document as exported (Excel, JSON) from the TUI.
 
     A case's description is free text written for the values of its file ("Vref = 40 m/s");
@@ -90,8 +91,8 @@ def doc_for_export(doc: dict[str, Any], case: Case, original: Case | None) -> di
     note = edit_note(case, original)
     if note is None:
         return doc
-    text = doc.get("description") or ""
-    return {**doc, "description": f"{text} ({note})" if text else note}
+    text = doc.description or ""
+    return dataclasses.replace(doc, description=f"{text} ({note})" if text else note)
 
 
 def save_case(case: Case, path: Path, *, replace: bool) -> Path:
@@ -99,8 +100,8 @@ def save_case(case: Case, path: Path, *, replace: bool) -> Path:
     return write_text_atomic(path, case_to_toml(case), force=replace, what="case")
 
 
-def export(kind: str, doc: dict[str, Any], path: Path, *, replace: bool) -> Path:
-    """Write a ``run_to_dict`` document: ``kind`` "xlsx" (the Excel design sheet) or "json"."""
+def export(kind: str, doc: RunDocument, path: Path, *, replace: bool) -> Path:
+    """Write a run document: ``kind`` "xlsx" (the Excel design sheet) or "json"."""
     if kind == "xlsx":
         from ..excel.writer import write_workbook  # lazy: openpyxl only when exporting
 

@@ -1,4 +1,5 @@
-"""Text of the TUI tables, from the ``run_to_dict`` JSON document (plain Python, no Textual).
+"""Text of the TUI tables, from the typed run document (:class:`~linecheck.io.document.RunDocument`;
+plain Python, no Textual).
 
 The summary shows exactly the values of the JSON document, scaled as the CLI
 table does (forces in kN with 3 decimals, Cont_* in % with 1 decimal, ratios
@@ -17,56 +18,54 @@ from ..core.case import SCHEMA, Case, FieldSpec
 from ..io.display import (  # noqa: F401  (shared with the CLI)
     STAT_ROWS,
     SUMMARY_STATS,
-    Stat,
     ci_text,
     design_text,
     flag_text,
     how_to_read,
     stat_text,
 )
+from ..io.document import RunDocument, StatDef
 
 REACTIONS = ("Rx", "Ry", "Rz")
 CONT_R_FLAG = 0.10  # Cont_R above this: "dynamic analysis recommended" (paper's conclusion)
 
 
-def summary_rows(doc: dict[str, Any]) -> list[tuple[str, str, str, str, str]]:
+def summary_rows(doc: RunDocument) -> list[tuple[str, str, str, str, str]]:
     """Rows ``(statistic, unit, Rx, Ry, Rz)`` at the tower of interest."""
-    n = int(doc.get("realizations", 1))
     rows = []
     for st in SUMMARY_STATS:
-        rows.append((st.label, st.unit, *(stat_text(doc["reactions"][r][st.key], st, n) for r in REACTIONS)))
+        rows.append((st.label, st.display_unit,
+                     *(stat_text(doc.reactions[r][st.name], st, doc.realizations) for r in REACTIONS)))
     return rows + design_rows(doc)
 
 
-def design_rows(doc: dict[str, Any]) -> list[tuple[str, str, str, str, str]]:
+def design_rows(doc: RunDocument) -> list[tuple[str, str, str, str, str]]:
     """Issue 18 rows: Gumbel design peaks (wind-induced and total), 95 % intervals of GF_Dy, GF_QS
-    and Cont_R, and the Cont_R flag state, at the tower of interest (empty for an old document)."""
-    reactions = doc["reactions"]
-    if "dynamic_analysis" not in reactions.get("Ry", {}):
-        return []
-    p = doc.get("design_fractile", 0.5)
+    and Cont_R, and the Cont_R flag state, at the tower of interest."""
+    reactions = doc.reactions
+    p = doc.design_fractile
     rows = []
     for key, label in (("peak_dynamic", f"design peak (p = {p:g})"),
                        ("peak_dynamic_total", f"design total (p = {p:g})")):
         st = STAT_ROWS[key]
-        rows.append((label, st.unit, *(design_text(reactions[r][key], st) for r in REACTIONS)))
+        rows.append((label, st.display_unit, *(design_text(reactions[r][key], st) for r in REACTIONS)))
     for key in ("GF_Dy", "GF_QS", "Cont_R"):
         st = STAT_ROWS[key]
-        rows.append((f"{st.label} 95 % CI", st.unit, *(ci_text(reactions[r][key], st) for r in REACTIONS)))
-    rows.append(("dynamic analysis", "", *(flag_text(reactions[r].get("dynamic_analysis")) for r in REACTIONS)))
+        rows.append((f"{st.label} 95 % CI", st.display_unit, *(ci_text(reactions[r][key], st) for r in REACTIONS)))
+    rows.append(("dynamic analysis", "", *(flag_text(reactions[r].dynamic_analysis) for r in REACTIONS)))
     return rows
 
 
-def summary_title(doc: dict[str, Any]) -> str:
-    n = int(doc.get("realizations", 1))
-    return (f"{doc['case']}: reactions at tower {doc['tower_of_interest']} ({doc['wind']}, "
-            f"V_ref = {doc['v_ref']:g} m/s, {n} realization{'s' if n > 1 else ''}, seed {doc.get('seed')})")
+def summary_title(doc: RunDocument) -> str:
+    n = doc.realizations
+    return (f"{doc.case}: reactions at tower {doc.tower_of_interest} ({doc.wind}, "
+            f"V_ref = {doc.v_ref:g} m/s, {n} realization{'s' if n > 1 else ''}, seed {doc.seed})")
 
 
-def cont_r_flags(doc: dict[str, Any], state: str = "recommended") -> list[str]:
-    """Reactions whose ``"dynamic_analysis"`` flag is ``state`` ("recommended": the 95 % interval
+def cont_r_flags(doc: RunDocument, state: str = "recommended") -> list[str]:
+    """Reactions whose ``dynamic_analysis`` flag is ``state`` ("recommended": the 95 % interval
     of Cont_R lies above :data:`CONT_R_FLAG`; "inconclusive": it straddles it; docs/method.md)."""
-    return [r for r in REACTIONS if doc["reactions"][r].get("dynamic_analysis") == state]
+    return [r for r in REACTIONS if doc.reactions[r].dynamic_analysis == state]
 
 
 # --------------------------------------------------------------------------- compare
@@ -77,42 +76,42 @@ def cont_r_flags(doc: dict[str, Any], state: str = "recommended") -> list[str]:
 REL_FLOOR = 0.01
 
 
-def _delta(a: float | None, b: float | None, stat: Stat, floor: float = 0.0) -> str:
+def _delta(a: float | None, b: float | None, stat: StatDef, floor: float = 0.0) -> str:
     """Change from ``a`` to ``b``: relative (%) when ``|a| >= floor`` [SI units of the row], else
     absolute in the row's unit ("+0.012 kN"); in percentage points for Cont_*; empty when
     undefined or when both values show as zero at the table's precision."""
     if a is None or b is None:
         return ""
-    if stat.unit == "%":  # contributions: difference in percentage points
+    if stat.kind == "fraction":  # contributions: difference in percentage points
         return f"{(b - a) * stat.scale:+.1f} pp"
     shown_zero = 0.5 * 10.0 ** -int(stat.fmt[-3])  # "{:.3f}" -> 0.0005, in display units
     if abs(a * stat.scale) < shown_zero and abs(b * stat.scale) < shown_zero:
         return ""
     if a == 0 or abs(a) < floor:
-        unit = "" if stat.unit in ("-", "") else f" {stat.unit}"
+        unit = "" if stat.display_unit in ("-", "") else f" {stat.display_unit}"
         return stat.fmt.replace("{:", "{:+").format((b - a) * stat.scale) + unit
     return f"{(b - a) / abs(a) * 100:+.1f} %"
 
 
-def compare_rows(pinned: dict[str, Any], current: dict[str, Any]) -> list[tuple[str, ...]]:
+def compare_rows(pinned: RunDocument, current: RunDocument) -> list[tuple[str, ...]]:
     """Rows ``(reaction, statistic, unit, pinned, current, Δ)``, grouped by reaction.
 
     Δ is relative (%) for forces and ratios, absolute where the pinned value is below
     :data:`REL_FLOOR` of the largest pinned value of its unit, in percentage points for Cont_*.
     """
-    na, nb = int(pinned.get("realizations", 1)), int(current.get("realizations", 1))
+    na, nb = pinned.realizations, current.realizations
     largest: dict[str, float] = {}
     for r in REACTIONS:
         for st in SUMMARY_STATS:
-            v = pinned["reactions"][r][st.key].get("mean")
+            v = pinned.reactions[r][st.name].mean
             if v is not None and math.isfinite(v):
-                largest[st.unit] = max(largest.get(st.unit, 0.0), abs(v))
+                largest[st.display_unit] = max(largest.get(st.display_unit, 0.0), abs(v))
     rows = []
     for r in REACTIONS:
         for st in SUMMARY_STATS:
-            ea, eb = pinned["reactions"][r][st.key], current["reactions"][r][st.key]
-            rows.append((r, st.label, st.unit, stat_text(ea, st, na), stat_text(eb, st, nb),
-                         _delta(ea.get("mean"), eb.get("mean"), st, REL_FLOOR * largest.get(st.unit, 0.0))))
+            ea, eb = pinned.reactions[r][st.name], current.reactions[r][st.name]
+            rows.append((r, st.label, st.display_unit, stat_text(ea, st, na), stat_text(eb, st, nb),
+                         _delta(ea.mean, eb.mean, st, REL_FLOOR * largest.get(st.display_unit, 0.0))))
     return rows
 
 
@@ -199,21 +198,6 @@ def case_differences(a: Case, b: Case) -> list[tuple[str, str, str]]:
 
 
 # --------------------------------------------------------------------------- spectral
-def flatten(block: Any, prefix: str = "") -> list[tuple[str, Any]]:
-    """Scalar leaves of a nested JSON block as ``(dotted path, value)`` (lists of numbers skipped)."""
-    out: list[tuple[str, Any]] = []
-    if isinstance(block, dict):
-        for k, v in block.items():
-            out.extend(flatten(v, f"{prefix}.{k}" if prefix else str(k)))
-    elif isinstance(block, list):
-        if block and all(isinstance(v, dict) for v in block):
-            for i, v in enumerate(block):
-                out.extend(flatten(v, f"{prefix}[{i}]"))
-    else:
-        out.append((prefix, block))
-    return out
-
-
 def number_text(v: Any) -> str:
     if v is None:
         return "**"
@@ -226,7 +210,9 @@ def number_text(v: Any) -> str:
     return f"{v:.4g}" if abs(v) < 1e4 else f"{v:.6g}"
 
 
-SPECTRAL_STATS: tuple[tuple[str, str], ...] = (  # (frequency-domain key, time-domain key)
+#: Rows of the spectral comparison: frequency-domain key -> time-domain statistic (its label,
+#: unit and format from the one statistics table).
+SPECTRAL_STATS: tuple[tuple[str, str], ...] = (
     ("mean", "mean_max"),
     ("rms_background", "rms_background"),
     ("rms_resonant", "rms_resonant"),
@@ -239,107 +225,64 @@ SPECTRAL_STATS: tuple[tuple[str, str], ...] = (  # (frequency-domain key, time-d
 )
 
 
-def stat_of(key: str) -> Stat:
-    """Display rule of a statistic name (forces in kN, Cont in %, ratios as they are)."""
-    for st in SUMMARY_STATS:
-        if st.key == key:
-            return st
-    if key.startswith(("rms", "peak", "mean")):
-        return Stat(key, key.replace("_", " "), "kN", 1e-3, "{:.3f}")
-    if key.startswith("Cont"):
-        return Stat(key, key, "%", 100.0, "{:.1f}")
-    if key.startswith("nu_"):
-        return Stat(key, key, "Hz", 1.0, "{:.3f}")
-    return Stat(key, key, "-", 1.0, "{:.3f}")
-
-
-def _scaled(v: Any, st: Stat) -> str:
+def _scaled(v: Any, st: StatDef) -> str:
     if v is None or isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
         return "**"
     return st.fmt.format(v * st.scale)
 
 
-def spectral_compare_rows(doc: dict[str, Any]) -> list[tuple[str, ...]]:
+def spectral_compare_rows(doc: RunDocument) -> list[tuple[str, ...]]:
     """Rows ``(statistic, unit, Rx time, Rx freq, Ry time, Ry freq, Rz time, Rz freq)``.
 
-    Time domain: mean over realizations (``doc["reactions"]``); frequency domain: the
-    exact random-vibration estimate (``doc["spectral"]["exact"]``).  Empty when absent.
+    Time domain: mean over realizations (``doc.reactions``); frequency domain: the exact
+    random-vibration estimate (``doc.spectral.exact``).  Empty without a spectral block.
     """
-    exact = (doc.get("spectral") or {}).get("exact")
-    if not isinstance(exact, dict):
+    if doc.spectral is None:
         return []
+    exact = doc.spectral.exact
     rows = []
     for fkey, tkey in SPECTRAL_STATS:
-        st = stat_of(tkey)
-        row = [st.label if fkey != "mean" else "mean", st.unit]
+        st = STAT_ROWS[tkey]
+        row = [st.label if fkey != "mean" else "mean", st.display_unit]
         for r in REACTIONS:
-            td = doc.get("reactions", {}).get(r, {}).get(tkey, {})
-            row.append(_scaled(td.get("mean") if isinstance(td, dict) else None, st))
-            row.append(_scaled((exact.get(r) or {}).get(fkey), st))
+            row.append(_scaled(doc.reactions[r][tkey].mean, st))
+            row.append(_scaled(exact[r][fkey], st))
         rows.append(tuple(row))
     return rows
 
 
-def sanity_rows(doc: dict[str, Any]) -> list[tuple[str, ...]]:
+def sanity_rows(doc: RunDocument) -> list[tuple[str, ...]]:
     """Rows ``(reaction, quantity, time domain ± std, frequency domain, allowed, verdict)``."""
-    items = (doc.get("spectral") or {}).get("sanity_check")
-    if not isinstance(items, list):
+    if doc.spectral is None:
         return []
     rows = []
-    for it in items:
-        if not isinstance(it, dict):
-            continue
-        st = stat_of(str(it.get("quantity", "")))
-        td = _scaled(it.get("time_domain"), st)
-        if it.get("time_domain_std") is not None:
-            td += " ± " + _scaled(it.get("time_domain_std"), st)
-        rows.append((str(it.get("reaction", "")), st.label, td, _scaled(it.get("frequency_domain"), st),
-                     "± " + _scaled(it.get("allowed_difference"), st) + (f" {st.unit}" if st.unit != "-" else ""),
-                     "ok" if it.get("ok") else "DIFFERS"))
+    for it in doc.spectral.sanity_check or ():
+        st = STAT_ROWS[it.quantity]
+        td = _scaled(it.time_domain, st)
+        if it.time_domain_std is not None:
+            td += " ± " + _scaled(it.time_domain_std, st)
+        rows.append((it.reaction, st.label, td, _scaled(it.frequency_domain, st),
+                     "± " + _scaled(it.allowed_difference, st)
+                     + (f" {st.display_unit}" if st.display_unit != "-" else ""),
+                     "ok" if it.ok else "DIFFERS"))
     return rows
 
 
-def davenport_lines(doc: dict[str, Any]) -> list[str]:
+def davenport_lines(doc: RunDocument) -> list[str]:
     """The closed-form (Davenport/Castanheta) estimate in a few lines."""
-    sp = doc.get("spectral") or {}
-    d = sp.get("davenport")
+    if doc.spectral is None:
+        return []
+    d = doc.spectral.davenport
     out = []
-    if isinstance(d, dict):
-        r = d.get("reaction", "Ry")
-        if d.get("applicable"):
-            cont = d.get("Cont_R")
-            cont_text = "**" if cont is None else f"{100 * cont:.1f} %"
-            out.append(f"closed form (Davenport/Castanheta), {r}: GF_Dy {number_text(d.get('GF_Dy'))}, "
-                       f"GF_QS {number_text(d.get('GF_QS'))}, Cont_R {cont_text}; "
-                       f"ASCE 74 wire GRF {number_text(d.get('GF_ASCE74'))}"
-                       + (f" - {d['note']}" if d.get("note") else ""))
-        else:
-            out.append(f"closed form (Davenport/Castanheta), {r}: not shown - {d.get('note') or 'not applicable'}")
-    na = sp.get("not_applicable")
-    if isinstance(na, dict):
-        out += [f"closed form not applicable to {k}: {v}" for k, v in na.items()]
+    if d.applicable:
+        cont_text = "**" if d.Cont_R is None else f"{100 * d.Cont_R:.1f} %"
+        out.append(f"closed form (Davenport/Castanheta), {d.reaction}: GF_Dy {number_text(d.GF_Dy)}, "
+                   f"GF_QS {number_text(d.GF_QS)}, Cont_R {cont_text}; "
+                   f"ASCE 74 wire GRF {number_text(d.GF_ASCE74)}"
+                   + (f" - {d.note}" if d.note else ""))
+    else:
+        out.append(f"closed form (Davenport/Castanheta), {d.reaction}: not shown - {d.note or 'not applicable'}")
+    out += [f"closed form not applicable to {k}: {v}" for k, v in doc.spectral.not_applicable.items()]
     return out
 
 
-def spectral_rows(doc: dict[str, Any]) -> list[tuple[str, str, str]]:
-    """Fallback rows ``(quantity, spectral value, time-domain value)`` of any ``"spectral"`` block.
-
-    Used when the block has neither ``exact`` nor ``sanity_check``: every scalar is listed;
-    where its path names a reaction (Rx/Ry/Rz) and a statistic of the time-domain
-    document, the time-domain mean is shown beside it.  Values as stored (SI).
-    """
-    block = doc.get("spectral")
-    if not isinstance(block, dict):
-        return []
-    rows = []
-    for path, value in flatten(block):
-        parts = path.replace("[", ".").replace("]", "").split(".")
-        td = ""
-        r = next((p for p in parts if p in REACTIONS), None)
-        s = parts[-1]
-        if r is not None:
-            entry = doc.get("reactions", {}).get(r, {}).get(s)
-            if isinstance(entry, dict):
-                td = number_text(entry.get("mean"))
-        rows.append((path, number_text(value), td))
-    return rows

@@ -65,7 +65,7 @@ class RunProgress(Message):
 
 @dataclass
 class RunFinished(Message):
-    """A run completed; ``output.doc`` is the ``linecheck run`` JSON document."""
+    """A run completed; ``output.doc`` is the typed ``linecheck run`` document (RunDocument)."""
 
     output: RunOutput
 

@@ -1,7 +1,7 @@
 """The run job of the TUI: service calls only, no Textual (runs in a thread worker).
 
-``execute`` runs steps 1-3 (:func:`linecheck.service.run_case`), builds the JSON
-document exactly as ``linecheck run`` does (:func:`linecheck.io.jsonout.run_to_dict`),
+``execute`` runs steps 1-3 (:func:`linecheck.service.run_case`), builds the typed
+document exactly as ``linecheck run`` does (:func:`linecheck.io.jsonout.run_document`),
 then the natural frequencies and the wind at point p for the extra result tabs.
 Progress goes through ``progress(stage, done, total)``; ``cancel`` is a plain
 :class:`threading.Event` checked by the service and between the jobs.
@@ -12,12 +12,12 @@ from __future__ import annotations
 import threading
 import time
 from dataclasses import dataclass
-from typing import Any
 
 from .. import service
 from ..core.case import Case
 from ..core.errors import Cancelled
-from ..io.jsonout import run_to_dict
+from ..io.document import RunDocument
+from ..io.jsonout import run_document
 
 STAGE_MODES = "natural frequencies"
 STAGE_WIND_P = "wind at point p"
@@ -27,13 +27,13 @@ STAGE_WIND_P = "wind at point p"
 class RunOutput:
     """Everything the result tabs show for one run.
 
-    ``doc`` is the ``linecheck run`` JSON document of ``result``; ``modes`` and
+    ``doc`` is the typed ``linecheck run`` document of ``result``; ``modes`` and
     ``wind`` are ``None`` if they were not computed.
     """
 
     case: Case
     result: service.RunResult
-    doc: dict[str, Any]
+    doc: RunDocument
     modes: service.ModesResult | None
     wind: service.WindAtP | None
     seconds: float
@@ -66,17 +66,15 @@ def execute(
             progress(stage, done, total)
 
     if models is not None:
-        from ..io.jsonout import models_block
+        from ..io.jsonout import model_reactions, with_models
 
         spread = service.run_models(case, service.parse_models(case, models), progress=progress, cancel=cancel)
         own = case.wind.downburst.model_name
         result = spread[own] if own in spread else next(iter(spread.values()))
-        doc = run_to_dict(result)
-        doc["model"] = result.case.wind.downburst.model_name
-        doc.update(models_block(spread))
+        doc = with_models(run_document(result), result.case.wind.downburst.model_name, model_reactions(spread))
     else:
         result = service.run_case(case, progress=progress, cancel=cancel)
-        doc = run_to_dict(result)
+        doc = run_document(result)
     modes = wind = None
     if extras:
         check()

@@ -11,25 +11,24 @@ from textual.app import ComposeResult
 from textual.containers import Vertical
 from textual.widgets import DataTable, Static
 
+from ...io.document import CodeCheck, RunDocument
+
 HELP = "No result yet. Run a case (r): the four design codes' conductor wind loads appear here beside its peaks."
 PEAK_NOTE = ("linecheck peak: mean over realizations of the wind-induced dynamic peak; ratio = peak / code load. "
              "Unverified codes are shown, not judged (docs/codes.md).")
 
 
-def codes_rows(codes: dict) -> list[tuple[str, ...]]:
-    """Table rows (text, kN) of a ``"codes"`` block."""
+def codes_rows(codes: dict[str, CodeCheck]) -> list[tuple[str, ...]]:
+    """Table rows (text, kN) of a typed ``codes`` block."""
     def kn(x):
         return "-" if x is None else f"{x / 1e3:.3f}"
 
     rows = []
     for name, block in codes.items():
-        for t in block.get("towers", []):
-            for r, v in t.items():
-                if r == "index":
-                    continue
-                rows.append((name, "yes" if block.get("verified") else "no", str(t["index"]), r, kn(v["code_load"]),
-                             kn(v["linecheck_peak"]), "-" if v["ratio"] is None else f"{v['ratio']:.3f}",
-                             v["verdict"]))
+        for t in block.towers:
+            for r, v in t.reactions.items():
+                rows.append((name, "yes" if block.verified else "no", str(t.index), r, kn(v.code_load),
+                             kn(v.linecheck_peak), "-" if v.ratio is None else f"{v.ratio:.3f}", v.verdict))
     return rows
 
 
@@ -45,20 +44,20 @@ class CodesView(Vertical):
         t = self.query_one(DataTable)
         t.add_columns("code", "verified", "tower", "reaction", "code load kN", "linecheck peak kN", "ratio", "verdict")
 
-    def show(self, doc: dict | None) -> None:
+    def show(self, doc: RunDocument | None) -> None:
         title = self.query_one("#codes-title", Static)
         notes = self.query_one("#codes-notes", Static)
         table = self.query_one(DataTable)
         table.clear()
-        codes = (doc or {}).get("codes")
+        codes = doc.codes if doc is not None else None
         if not codes:
             title.update(HELP)
             notes.update("")
             return
-        title.update(Text(f"{doc.get('case')}: conductor wind load on Ry, design codes vs linecheck", style="bold"))
+        title.update(Text(f"{doc.case}: conductor wind load on Ry, design codes vs linecheck", style="bold"))
         for row in codes_rows(codes):
             table.add_row(*row)
         n = Text(PEAK_NOTE + "\n", style="dim")
         for name, block in codes.items():
-            n.append(f"{name} ({block.get('edition')}): {block.get('note')}\n", style="dim")
+            n.append(f"{name} ({block.edition}): {block.note}\n", style="dim")
         notes.update(n)

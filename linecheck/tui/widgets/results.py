@@ -10,8 +10,10 @@ from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.widgets import DataTable, RadioButton, RadioSet, Static, TabbedContent, TabPane
 
 from .. import figures
-from ..formatting import (REACTIONS, cont_r_flags, davenport_lines, how_to_read, sanity_rows, spectral_compare_rows, spectral_rows,
+from ..formatting import (REACTIONS, cont_r_flags, davenport_lines, how_to_read, sanity_rows, spectral_compare_rows,
                           summary_rows, summary_title)
+from ...io.display import STAT_ROWS, number_text
+from ...io.document import RunDocument
 from ..plotting import PlotView
 from ..runner import RunOutput
 
@@ -118,7 +120,7 @@ class ResultsView(Vertical):
         if self.output is not None:
             self.show(self.output, self.pinned, stale=stale)
 
-    def _summary(self, doc: dict) -> None:
+    def _summary(self, doc: RunDocument) -> None:
         t = self.query_one("#summary-table", DataTable)
         t.clear()
         flagged = cont_r_flags(doc)
@@ -142,9 +144,9 @@ class ResultsView(Vertical):
                          "realizations (linecheck run --until 1%).", style="yellow")
         for line in how_to_read(doc):
             notes.append("\n" + line, style="dim")
-        if isinstance(doc.get("models"), dict):
+        if doc.models is not None:
             notes.append("\n" + models_text(doc))
-        sa = doc.get("still_air", {}).get("reactions", {})
+        sa = doc.still_air.reactions if doc.still_air is not None else {}
         if sa:
             notes.append("\nstill air: " + ", ".join(f"{r} {v / 1e3:.3f} kN" for r, v in sa.items() if v is not None),
                          style="dim")
@@ -173,7 +175,7 @@ class ResultsView(Vertical):
             docs = [("pinned", self.pinned.doc), ("current", self.output.doc)]
         self.query_one("#plot-contrib", PlotView).show(figures.contributions(docs))
 
-    def _spectral(self, doc: dict) -> None:
+    def _spectral(self, doc: RunDocument) -> None:
         """Frequency-domain check beside the time domain (synoptic runs with a "spectral" block)."""
         notes = self.query_one("#spectral-notes", Static)
         table = self.query_one("#spectral-table", DataTable)
@@ -181,9 +183,9 @@ class ResultsView(Vertical):
         dav = self.query_one("#spectral-davenport", Static)
         table.clear(columns=True)
         sanity.clear()
-        if not isinstance(doc.get("spectral"), dict):
+        if doc.spectral is None:
             why = ("a downburst is non-stationary: the frequency-domain check applies to synoptic winds"
-                   if doc.get("wind") == "downburst" else "this result has no \"spectral\" block")
+                   if doc.wind == "downburst" else "this result has no \"spectral\" block")
             notes.update(Text(f"No spectral check: {why}.", style="dim"))
             for w in (table, sanity, dav):
                 w.display = False
@@ -191,17 +193,11 @@ class ResultsView(Vertical):
         compare = spectral_compare_rows(doc)
         checks = sanity_rows(doc)
         lines = davenport_lines(doc)
-        if compare:
-            table.add_columns("statistic", "unit", *(f"{r} {d}" for r in REACTIONS for d in ("time", "freq")))
-            for row in compare:
-                table.add_row(*row)
-            notes.update(Text("Time domain (mean over realizations) beside the frequency domain "
-                              "(exact linear random vibration of the same model).", style="dim"))
-        else:  # unknown layout: list every number
-            table.add_columns("quantity", "frequency domain", "time domain (mean)")
-            for row in spectral_rows(doc):
-                table.add_row(*row)
-            notes.update(Text("Frequency-domain block (SI units).", style="dim"))
+        table.add_columns("statistic", "unit", *(f"{r} {d}" for r in REACTIONS for d in ("time", "freq")))
+        for row in compare:
+            table.add_row(*row)
+        notes.update(Text("Time domain (mean over realizations) beside the frequency domain "
+                          "(exact linear random vibration of the same model).", style="dim"))
         table.display = True
         dav.display = bool(lines)
         dav.update(Text("\n".join(lines)))
@@ -229,18 +225,19 @@ class ResultsView(Vertical):
         notes.update(Text(text + "; dir: direction holding most of the mode's kinetic energy.", style="dim"))
 
 
-def models_text(doc: dict) -> str:
+def models_text(doc: RunDocument) -> str:
     """Downburst model spread (issue 15): peak dynamic Rx/Ry and GF_Dy per model, and the envelope."""
-    def fmt(v, scale, f):
-        return "**" if v is None else f.format(v * scale)
+    pk, gf = STAT_ROWS["peak_dynamic"], STAT_ROWS["GF_Dy"]
 
-    lines = [f"model spread (shown above: {doc.get('model', '?')}):"]
-    for name, blk in doc["models"].items():
-        lines.append(f"  {name:<14} peak Rx {fmt(blk['Rx']['peak_dynamic']['mean'], 1e-3, '{:.3f}')} kN, "
-                     f"Ry {fmt(blk['Ry']['peak_dynamic']['mean'], 1e-3, '{:.3f}')} kN; GF_Dy Rx "
-                     f"{fmt(blk['Rx']['GF_Dy']['mean'], 1, '{:.3f}')}, Ry {fmt(blk['Ry']['GF_Dy']['mean'], 1, '{:.3f}')}")
-    env = doc["models_envelope"]
+    def fmt(v, st):
+        return "**" if v is None else number_text(v, st)
+
+    lines = [f"model spread (shown above: {doc.model or '?'}):"]
+    for name, blk in (doc.models or {}).items():
+        lines.append(f"  {name:<14} peak Rx {fmt(blk['Rx'][pk.name].mean, pk)} kN, "
+                     f"Ry {fmt(blk['Ry'][pk.name].mean, pk)} kN; GF_Dy Rx "
+                     f"{fmt(blk['Rx'][gf.name].mean, gf)}, Ry {fmt(blk['Ry'][gf.name].mean, gf)}")
+    env = doc.models_envelope or {}
     lines.append("  envelope       " + ", ".join(
-        f"peak {r} {fmt(env[r]['peak_dynamic']['value'], 1e-3, '{:.3f}')} kN ({env[r]['peak_dynamic']['model']})"
-        for r in ("Rx", "Ry")))
+        f"peak {r} {fmt(env[r][pk.name].value, pk)} kN ({env[r][pk.name].model})" for r in ("Rx", "Ry")))
     return "\n".join(lines)

@@ -443,15 +443,16 @@ def dynamic_table(report: Any) -> Table:
     return t
 
 
-def _scan_each_model(case_file: Path, case: Any, grid: Any, names: tuple[str, ...], *, hold: str,
+def _scan_each_model(case_file: Path, case: Any, grid: Any, names: tuple[str | None, ...], *, hold: str,
                      csv_out: Path | None, dynamic: bool, json_dir: Path | None, jobs: int | None,
-                     scheduler: str | None) -> None:
-    """``scan --models``: the scan under each downburst model, then the critical position per model."""
+                     scheduler: str | None, connect_timeout: float = 10.0) -> None:
+    """The scan under each downburst model of ``names`` (None: the case's own model; ``scan
+    --models`` gives several), then the critical position per model."""
     from ..batch import make_executor, run_critical, run_scan, write_scan_csv
     from .progress import progress_bar
 
     cancel = threading.Event()
-    with make_executor(jobs, scheduler) as executor:
+    with make_executor(jobs, scheduler, connect_timeout) as executor:
         summary = []
         for model in names:
             try:
@@ -524,50 +525,15 @@ def scan(
 ) -> None:
     """Find the critical downburst configurations: step 1 over a grid of positions and sizes."""
     apply_max_memory(max_memory)  # each step-1 task checks its memory estimate
-    from ..batch import ScanGrid, make_executor, run_critical, run_scan, write_scan_csv
+    from ..batch import ScanGrid
     from ..io.atomic import check_target
-    from .progress import progress_bar
 
     case = read_case(case_file)
     grid = ScanGrid.from_options(case, distance, angle, jet_diameter)
     if csv_out is not None:
         check_target(csv_out, what="CSV")
-    cancel = threading.Event()
-    if models is not None:
-        from .. import service
+    from .. import service
 
-        _scan_each_model(case_file, case, grid, service.parse_models(case, models), hold=hold, csv_out=csv_out,
-                         dynamic=dynamic, json_dir=json_dir, jobs=jobs, scheduler=scheduler)
-        return
-    with make_executor(jobs, scheduler, connect_timeout) as executor:
-        try:
-            with progress_bar() as cb:
-                result = run_scan(case_file, grid, executor=executor, hold=hold, progress=cb, cancel=cancel)
-        except KeyboardInterrupt:
-            cancel.set()
-            raise
-        console.print(scan_table(result))
-        strength = (f"one storm, V_max = {result.v_max:.1f} m/s (the case's own configuration)"
-                    if result.hold == "jet" else f"V_ref = {case.wind.v_ref:g} m/s at point p everywhere")
-        console.print(f"[dim]{grid.size} configurations in {result.elapsed:.1f} s on {escape(result.executor)}; "
-                      f"{strength}; value = wind-induced mean reaction with the largest magnitude over the "
-                      "event.[/]", highlight=False)
-        if result.n_failed:
-            first = next(e for e in result.errors if e)
-            err_console.print(f"[yellow]warning:[/] {result.n_failed} configuration(s) failed and were left out, "
-                              f"e.g.: {escape(first)}", highlight=False, soft_wrap=True)
-        if csv_out is not None:
-            write_scan_csv(result, csv_out)
-            console.print(f"wrote {csv_out}")
-        if not result.criticals():
-            raise CaseError("no scan configuration could be analysed", file=str(case_file))
-        if dynamic:
-            console.print(f"[dim]full analysis at the critical configurations with the case's V_ref = "
-                          f"{case.wind.v_ref:g} m/s at point p[/]", highlight=False)
-            with BatchDisplay() as display:
-                report = run_critical(result, executor=executor, json_dir=json_dir, progress=display, cancel=cancel)
-            console.print(dynamic_table(report))
-            if report.cancelled:
-                raise typer.Exit(130)
-            if report.failed:
-                raise typer.Exit(1)
+    names = service.parse_models(case, models) if models is not None else (None,)  # None: the case's own model
+    _scan_each_model(case_file, case, grid, names, hold=hold, csv_out=csv_out, dynamic=dynamic, json_dir=json_dir,
+                     jobs=jobs, scheduler=scheduler, connect_timeout=connect_timeout)

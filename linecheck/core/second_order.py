@@ -59,6 +59,7 @@ class SecondOrder:
         W: [N/m^2] the same map from products of the members' du: R_2 = P W, shape
             (6 n_el + 4 n_s, n_r) (:func:`reaction_form`).
         ins_nodes: global node of every suspension attachment, (n_s,).
+        ins_frame: [-] rows (e, t1, t2) of every insulator's orthonormal frame, (n_s, 3, 3).
     """
 
     e: np.ndarray
@@ -70,6 +71,7 @@ class SecondOrder:
     A: np.ndarray
     W: np.ndarray
     ins_nodes: np.ndarray
+    ins_frame: np.ndarray
 
 
 def second_order_operator(model: LinearModel, state: StaticState) -> SecondOrder:
@@ -122,26 +124,32 @@ def second_order_operator(model: LinearModel, state: StaticState) -> SecondOrder
     pinned = np.setdiff1d(np.arange(n_nodes), free)
     e = np.concatenate([e_el, model.axes])
     c = np.concatenate([c_el, c_in])
+    W, frame = reaction_form(e, c, A, n_el)
     return SecondOrder(e.ravel(), c, n_nodes, pinned, runs, model.dofs.node_dof[system.tower_nodes[sus]] // 3,
-                       np.ascontiguousarray(A), reaction_form(e, c, A, n_el), system.tower_nodes[sus].copy())
+                       np.ascontiguousarray(A), W, system.tower_nodes[sus].copy(), frame)
 
 
 _PAIRS = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2))  # products of du's components in P
 
 
-def reaction_form(e: np.ndarray, c: np.ndarray, A: np.ndarray, n_el: int) -> np.ndarray:
-    """[N/m^2] W (6 n_el + 4 n_s, n_r): R_2 = P W with P per row the six products (xx, yy, zz,
-    xy, yz, xz; member-major) of the cable elements' du components then, for the insulators,
-    (a du_x, a du_y, a du_z, q; slot-major) of f2 = c [a du + q e], a = e.du,
-    q = |du|^2/2 - 3 a^2/2 (module docstring).
+def reaction_form(e: np.ndarray, c: np.ndarray, A: np.ndarray, n_el: int) -> tuple[np.ndarray, np.ndarray]:
+    """[N/m^2] W (6 n_el + 3 n_s, n_r) such that R_2 = P W, and the insulators' frames.
 
-    With g_r a member's 3 rows of A (component-major, (3 n_m, n_r)) and h_r = e.g_r,
-    f2.g_r = c [a (g_r.du) + q h_r].  A cable element's is the quadratic form du^T Q_r du,
-    Q_r = c [(e g_r^T + g_r e^T)/2 + h_r I/2 - 3 h_r e e^T/2] (Q_kk for the squares, 2 Q_kl for
-    the cross products): 6 products instead of the ~20 passes of building f2.  An insulator
-    keeps a and q explicitly: its c is ~10^4 times a cable element's (rigid insulator) while a
-    stays ~10^-5 |du| (it swings about its fixed point), and the expanded quadratic form would
-    lose that cancellation to rounding (~3x the rounding error of f2 A on R_2).
+    P holds per row, member-major: for every cable element the six products (xx, yy, zz, xy,
+    yz, xz; _PAIRS) of its du's components; for every insulator (a s, a w, s^2 + w^2), with
+    (a, s, w) = F du its components in its frame F = (e, t1, t2) (rows; returned, (n_s, 3, 3)).
+
+    With g_r a member's 3 rows of A (component-major, (3 n_m, n_r)) and h_r = e.g_r, the
+    module docstring's f2 = c [a du + q e], a = e.du, q = |du|^2/2 - 3 a^2/2, gives
+    f2.g_r = c [a (g_r.du) + q h_r]:
+    * a cable element: the quadratic form du^T Q_r du, Q_r = c [(e g_r^T + g_r e^T)/2
+      + h_r I/2 - 3 h_r e e^T/2] (W: Q_kk for the squares, 2 Q_kl for the cross products);
+    * an insulator: with du = a e + s t1 + w t2, g_r.du = h_r a + (g_r.t1) s + (g_r.t2) w and
+      q = (s^2 + w^2)/2 - a^2, so the a^2 terms cancel exactly:
+      f2.g_r = c [(g_r.t1) a s + (g_r.t2) a w + h_r (s^2 + w^2)/2].  Its c is ~10^4 times a
+      cable element's (rigid insulator) and a stays ~10^-5 |du| (it swings about its fixed
+      point): the expanded quadratic form in x, y, z would lose that to rounding (~3 times the
+      rounding error of f2 A), the frame keeps a computed first, as f2 A does.
     e: unit chords (n_m, 3); c: (n_m,); the first n_el members are the cable elements.
     """
     n_m = c.size
@@ -156,13 +164,22 @@ def reaction_form(e: np.ndarray, c: np.ndarray, A: np.ndarray, n_el: int) -> np.
         else:
             Wq[s] = ek * g[l, el] + el_ * g[k, el] - 3.0 * h[el] * (ek * el_)
         Wq[s] *= c[el, None]
-    ins = slice(n_el, n_m)
-    Wi = np.stack([g[0, ins], g[1, ins], g[2, ins], h[ins]]) * c[None, ins, None]
-    return np.concatenate([Wq.transpose(1, 0, 2).reshape(6 * n_el, -1), Wi.reshape(-1, A.shape[1])])
+    ei = e[n_el:]
+    helper = np.where(np.abs(ei[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+    t1 = np.cross(ei, helper)
+    t1 /= np.linalg.norm(t1, axis=1)[:, None]
+    t2 = np.cross(ei, t1)
+    frame = np.stack([ei, t1, t2], axis=1)  # (n_s, 3, 3), rows e, t1, t2
+    gi = g[:, n_el:]  # (3, n_s, n_r)
+    ci = c[n_el:, None]
+    Wi = np.stack([ci * np.einsum("sk,ksr->sr", t1, gi), ci * np.einsum("sk,ksr->sr", t2, gi), 0.5 * ci * h[n_el:]],
+                  axis=1)  # (n_s, 3, n_r)
+    W = np.concatenate([Wq.transpose(1, 0, 2).reshape(6 * n_el, -1), Wi.reshape(3 * (n_m - n_el), A.shape[1])])
+    return W, frame
 
 
-SINGLE_THREAD_WORK = 200_000  # rows x W.size below OpenBLAS' multithreading threshold (4 x 65536)
-BLOCK_ROWS = 256  # rows of one block of elementwise passes (their arrays stay in cache)
+SINGLE_THREAD_WORK = 4 * 65536  # rows x W.size up to OpenBLAS' multithreading threshold (m n k <= 4 x 65536)
+BLOCK_ROWS = 128  # rows of one block of elementwise passes (their arrays stay in cache)
 
 
 def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None = None) -> np.ndarray:
@@ -174,8 +191,9 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
     R_2 = P W (:func:`reaction_form`), block by block of rows: the displacements go node-major
     into a preallocated (n_nodes, 3, rows) array (rotated by one batched 3x3 product per node),
     the members' du by one slice difference, their products into P (transposed, (6 n_el +
-    4 n_s, rows)), and P W by BLAS.  ~15 elementwise passes with ``out=`` instead of the ~45 of
-    building f2 and multiplying by A; results equal the latter to rounding (tests).
+    3 n_s, rows)), and P W by BLAS: a dozen numpy calls per block with ``out=`` instead of the
+    ~45 elementwise passes of building f2 and multiplying by A; results equal the latter to
+    rounding (tests).
 
     Rows are processed in blocks of a fixed size that depends on the operator only (the last
     block padded with zeros), so every BLAS product always has the same shape: a row's result
@@ -188,16 +206,16 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
     n_el = op.n_nodes - 1
     n_s = op.c.size - n_el
     n_f = U.shape[1] // 3
-    e_in = op.e.reshape(-1, 3)[n_el:, :, None]
     chunk = max(16, SINGLE_THREAD_WORK // W.size // 16 * 16)  # whole micro-kernel tiles (dynamics._fixed_matmul)
     nb = max(1, BLOCK_ROWS // chunk) * chunk  # rows of one elementwise pass: arrays stay in cache
     u = np.zeros((op.n_nodes, 3, nb))  # pinned nodes stay zero
     d = np.empty((n_el, 3, nb))
     P = np.zeros((W.shape[0], nb))  # padding columns stay zero
     Pq = P[:6 * n_el].reshape(n_el, 6, nb)  # cable elements: the six products
-    Pi = P[6 * n_el:].reshape(4, n_s, nb)  # insulators: a du, q
+    Pi = P[6 * n_el:].reshape(n_s, 3, nb)  # insulators: a s, a w, s^2 + w^2
     di = np.empty((n_s, 3, nb))
-    a, t2 = np.empty((n_s, nb)), np.empty((n_s, nb))
+    li = np.empty((n_s, 3, nb))
+    sq = np.empty((n_s, 2, nb))
     pad = np.zeros((nb, U.shape[1])) if T is not None and m % nb else None
     out = np.empty((m, W.shape[1]))
     for i0 in range(0, m, nb):
@@ -217,25 +235,14 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
         if T is None and r < nb:
             u[:, :, r:] = 0.0
         np.subtract(u[1:], u[:-1], out=d)  # cable elements: u_b - u_a
-        np.take(u, op.ins_nodes, axis=0, out=di)  # insulators: the fixed point does not move
         np.multiply(d, d, out=Pq[:, :3])  # cable elements: products of du's components (_PAIRS)
         np.multiply(d[:, :2], d[:, 1:], out=Pq[:, 3:5])
         np.multiply(d[:, 0], d[:, 2], out=Pq[:, 5])
-        q = Pi[3]
-        np.multiply(di[:, 0], e_in[:, 0], out=a)  # insulators: a = e.du
-        for k in (1, 2):
-            np.multiply(di[:, k], e_in[:, k], out=t2)
-            a += t2
-        for k in range(3):
-            np.multiply(a, di[:, k], out=Pi[k])  # a du
-        np.multiply(di[:, 0], di[:, 0], out=q)  # q = |du|^2/2 - 3 a^2/2
-        for k in (1, 2):
-            np.multiply(di[:, k], di[:, k], out=t2)
-            q += t2
-        q *= 0.5
-        np.multiply(a, a, out=t2)
-        t2 *= 1.5
-        q -= t2
+        np.take(u, op.ins_nodes, axis=0, out=di)  # insulators: the fixed point does not move
+        np.matmul(op.ins_frame, di, out=li)  # (a, s, w) in the insulator's frame
+        np.multiply(li[:, :1], li[:, 1:], out=Pi[:, :2])  # a s, a w
+        np.multiply(li[:, 1:], li[:, 1:], out=sq)
+        np.add(sq[:, 0], sq[:, 1], out=Pi[:, 2])  # s^2 + w^2
         for j0 in range(0, r, chunk):
             j1 = j0 + chunk
             if j1 <= r:

@@ -12,7 +12,7 @@ from scipy.linalg import solve
 from linecheck import service
 from linecheck.core.case import load_case
 from linecheck.core.model import build_model
-from linecheck.core.second_order import second_order_operator, second_order_reactions
+from linecheck.core.second_order import second_order_of_loads, second_order_operator, second_order_reactions
 from linecheck.core.static import solve_static, span_loads_uniform
 from linecheck.core.system import LineSystem
 
@@ -198,6 +198,13 @@ def test_second_order_fast_form_equals_member_forces(rotated):
     # and block by block: a row's result does not depend on the other rows
     assert np.array_equal(second_order_reactions(op, U[37:38], T), fast[37:38])
     assert np.array_equal(second_order_reactions(op, U[5:300:3], T), fast[5:300:3])
+    if not rotated:  # the quasi-static entry: displacements X l of loads l, X = K^-1 F
+        X = solve(model.K_dense, F)
+        L = rng.standard_normal((300, F.shape[1]))
+        of_loads = second_order_of_loads(op, L, X)
+        direct = second_order_reactions(op, L @ X.T)
+        assert np.abs(of_loads - direct).max() <= 1e-12 * np.abs(direct).max()
+        assert np.array_equal(second_order_of_loads(op, L[7:200:4], X), of_loads[7:200:4])
 
 
 def test_second_order_raises_strain_tower_tension():

@@ -201,28 +201,16 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
     bit-identical whatever the batch chunking.  The products are small enough for OpenBLAS to
     run on one thread (no thread start-up on a shared machine).
     """
-    m = U.shape[0]
-    W = op.W
-    n_el = op.n_nodes - 1
-    n_s = op.c.size - n_el
     n_f = U.shape[1] // 3
-    chunk = max(16, SINGLE_THREAD_WORK // W.size // 16 * 16)  # whole micro-kernel tiles (dynamics._fixed_matmul)
-    nb = max(1, BLOCK_ROWS // chunk) * chunk  # rows of one elementwise pass: arrays stay in cache
-    u = np.zeros((op.n_nodes, 3, nb))  # pinned nodes stay zero
-    d = np.empty((n_el, 3, nb))
-    P = np.zeros((W.shape[0], nb))  # padding columns stay zero
-    Pq = P[:6 * n_el].reshape(n_el, 6, nb)  # cable elements: the six products
-    Pi = P[6 * n_el:].reshape(n_s, 3, nb)  # insulators: a s, a w, s^2 + w^2
-    di = np.empty((n_s, 3, nb))
-    li = np.empty((n_s, 3, nb))
-    sq = np.empty((n_s, 2, nb))
-    pad = np.zeros((nb, U.shape[1])) if T is not None and m % nb else None
-    out = np.empty((m, W.shape[1]))
-    for i0 in range(0, m, nb):
-        i1 = min(i0 + nb, m)
-        r = i1 - i0
-        Ub = U[i0:i1]
+    pad = None
+
+    def fill(u: np.ndarray, i0: int, r: int) -> None:
+        nonlocal pad
+        nb = u.shape[2]
+        Ub = U[i0:i0 + r]
         if T is not None and r < nb:  # the batched product keeps its shape
+            if pad is None:
+                pad = np.zeros((nb, U.shape[1]))
             pad[:r] = Ub
             pad[r:] = 0.0
             Ub = pad
@@ -234,6 +222,60 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
                 np.matmul(T[f0:f0 + hi - lo], Un[f0:f0 + hi - lo], out=u[lo:hi])
         if T is None and r < nb:
             u[:, :, r:] = 0.0
+
+    return _reactions(op, U.shape[0], fill)
+
+
+def second_order_of_loads(op: SecondOrder, L: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """[N] R_2 of the quasi-static displacements u = X l of loads L [N], shape (m, n_l) ->
+    (m, n_r); X [m/N] (n_dof, n_l) maps the loads to the free displacements (x, y, z per free
+    node).  As :func:`second_order_reactions` of L X^T, without that history: each block's
+    displacements are computed node-major, X L_block^T, straight into the work array, by BLAS
+    products of a fixed shape (16 loads rows, whole micro-kernel tiles, one thread)."""
+    ch = max(16, SINGLE_THREAD_WORK // X.size // 16 * 16)
+    zero = np.zeros((ch, L.shape[1]))
+
+    def fill(u: np.ndarray, i0: int, r: int) -> None:
+        nb = u.shape[2]
+        for j0 in range(0, nb, ch):
+            j1 = j0 + ch
+            if j0 >= r:
+                u[:, :, j0:] = 0.0
+                break
+            Lc = L[i0 + j0:i0 + j1]
+            if j1 > r:  # padded: the product keeps its shape
+                zero[: r - j0] = Lc
+                zero[r - j0:] = 0.0
+                Lc = zero
+            for lo, hi, f0 in op.runs:
+                np.matmul(X[3 * f0:3 * (f0 + hi - lo)], Lc.T, out=u[lo:hi].reshape(3 * (hi - lo), nb)[:, j0:j1])
+
+    return _reactions(op, L.shape[0], fill, multiple=ch)
+
+
+def _reactions(op: SecondOrder, m: int, fill, multiple: int = 1) -> np.ndarray:
+    """R_2 (m, n_r) of m rows of displacements that ``fill(u, i0, r)`` writes node-major into
+    u[:, :, :r] (global x, y, z; (n_nodes, 3, nb)), zeroing u[:, :, r:] (docstrings above)."""
+    W = op.W
+    n_el = op.n_nodes - 1
+    n_s = op.c.size - n_el
+    # whole micro-kernel tiles: with 23-row blocks the edge rows' kernel rounded a column differently
+    chunk = max(16, SINGLE_THREAD_WORK // W.size // 16 * 16)
+    nb = max(1, BLOCK_ROWS // chunk) * chunk  # rows of one elementwise pass: arrays stay in cache
+    nb = -(-nb // multiple) * multiple
+    u = np.zeros((op.n_nodes, 3, nb))  # pinned nodes stay zero
+    d = np.empty((n_el, 3, nb))
+    P = np.zeros((W.shape[0], nb))  # padding columns stay zero
+    Pq = P[:6 * n_el].reshape(n_el, 6, nb)  # cable elements: the six products
+    Pi = P[6 * n_el:].reshape(n_s, 3, nb)  # insulators: a s, a w, s^2 + w^2
+    di = np.empty((n_s, 3, nb))
+    li = np.empty((n_s, 3, nb))
+    sq = np.empty((n_s, 2, nb))
+    out = np.empty((m, W.shape[1]))
+    for i0 in range(0, m, nb):
+        i1 = min(i0 + nb, m)
+        r = i1 - i0
+        fill(u, i0, r)
         np.subtract(u[1:], u[:-1], out=d)  # cable elements: u_b - u_a
         np.multiply(d, d, out=Pq[:, :3])  # cable elements: products of du's components (_PAIRS)
         np.multiply(d[:, :2], d[:, 1:], out=Pq[:, 3:5])

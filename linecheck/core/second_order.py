@@ -57,7 +57,7 @@ class SecondOrder:
         A: [-] member second-order forces -> reactions: the support terms S f2 minus the
             p_2 -> G K^-1 p_2 transfer (Z = K^-1 G^T, module docstring), shape (3 n_m, n_r).
         W: [N/m^2] the same map from products of the members' du: R_2 = P W, shape
-            (6 n_el + 4 n_s, n_r) (:func:`reaction_form`).
+            (6 n_el + 3 n_s, n_r) (:func:`reaction_form`).
         ins_nodes: global node of every suspension attachment, (n_s,).
         ins_frame: [-] rows (e, t1, t2) of every insulator's orthonormal frame, (n_s, 3, 3).
     """

@@ -12,7 +12,7 @@ from scipy.linalg import solve
 from linecheck import service
 from linecheck.core.case import load_case
 from linecheck.core.model import build_model
-from linecheck.core.second_order import second_order_operator, second_order_reactions
+from linecheck.core.second_order import second_order_of_loads, second_order_operator, second_order_reactions
 from linecheck.core.static import solve_static, span_loads_uniform
 from linecheck.core.system import LineSystem
 
@@ -130,6 +130,81 @@ def test_second_order_bit_identical_whatever_else_runs():
     alone = service.run_case(case, realizations=[2], spectral_check=False)
     assert np.array_equal(both.background[1], alone.background[0])
     assert np.array_equal(both.resonant[1], alone.resonant[0])
+
+
+def _reference_second_order(op, U, T=None, dtype=np.float64):
+    """R_2 = f2 A as first built (issue 16): the member forces f2 (module docstring of
+    linecheck.core.second_order) assembled component by component, then the product with A.
+    Kept here as the reference of the faster P W form (same operator, other arithmetic);
+    ``dtype`` np.longdouble evaluates it in extended precision (x86: 64-bit mantissa)."""
+    m, n_el = U.shape[0], op.n_nodes - 1
+    n_m = op.c.size
+    Un = U.astype(dtype).reshape(m, -1, 3)
+    if T is not None:  # u = T u~ node by node
+        Un = np.einsum("nkj,mnj->mnk", T.astype(dtype), Un)
+    u = np.zeros((m, op.n_nodes, 3), dtype)
+    u[:, np.setdiff1d(np.arange(op.n_nodes), op.pinned)] = Un
+    d = np.concatenate([u[:, 1:] - u[:, :-1], u[:, op.ins_nodes]], axis=1)  # (m, n_m, 3)
+    e = op.e.reshape(-1, 3).astype(dtype)
+    a = np.einsum("mik,ik->mi", d, e)
+    q = 0.5 * np.einsum("mik,mik->mi", d, d) - 1.5 * a * a
+    f = op.c.astype(dtype)[:, None] * (a[..., None] * d + q[..., None] * e)  # force on end a, (m, n_m, 3)
+    assert n_m == n_el + op.ins_nodes.size
+    return f.transpose(0, 2, 1).reshape(m, 3 * n_m) @ op.A.astype(dtype)
+
+
+@pytest.mark.parametrize("rotated", [False, True])
+def test_second_order_fast_form_equals_member_forces(rotated):
+    """The P W form of R_2 (products of du, insulators' a and q) equals f2 A to rounding, and
+    is no less accurate.  Displacements: linear responses K^-1 F to random combinations of
+    10 % transverse and vertical load increments per span and random nodal loads (so the
+    insulators swing, e.du ~ 0: the ill-conditioned case, the rigid insulators' c ~ 10^4 times
+    a cable element's times their small e.du), 600 rows (several blocks, the last one padded);
+    rotated into random per-node bases for the Newmark form.
+
+    Tolerances: against an extended-precision evaluation of f2 A, f2 A in float64 is off by
+    0.9e-12 (global) and 2.3e-12 (rotated) of max |R_2|, the P W form by 0.9e-12 and 1.5e-12:
+    1e-12 between two float64 evaluations is below this problem's rounding floor, so the
+    float64 forms are compared within 5e-12 and the P W form's error must not exceed 1.5 times
+    f2 A's (plus 1e-13 of max |R_2|)."""
+    case = load_case(CASES / "paper" / "case09-six.toml")
+    sy = LineSystem(case.line)
+    s0 = solve_static(sy, span_loads_uniform(sy, case.g_yp), tol=1e-13)
+    model = build_model(sy, s0)
+    op = second_order_operator(model, s0)
+    rng = np.random.default_rng(16)
+    n_dof = model.mass.size
+    g = 0.1 * case.g_yp * sy.unstretched_length / sy.ne  # [N] 10 % of a node's transverse load
+    span = np.repeat(np.arange(sy.n_spans), sy.ne)[np.minimum(model.dofs.free_nodes, sy.n_spans * sy.ne - 1)]
+    F = np.zeros((n_dof, 2 * sy.n_spans + 4))
+    for s in range(sy.n_spans):
+        F[1::3, s] = g * (span == s)  # transverse, span by span
+        F[2::3, sy.n_spans + s] = -g * (span == s)  # vertical
+    F[:, 2 * sy.n_spans:] = 0.2 * g * rng.standard_normal((n_dof, 4))  # random nodal loads
+    U = rng.standard_normal((600, F.shape[1])) @ solve(model.K_dense, F).T
+    T = None
+    if rotated:
+        T, _ = np.linalg.qr(rng.standard_normal((n_dof // 3, 3, 3)))
+        U = np.einsum("njk,mnj->mnk", T, U.reshape(600, -1, 3)).reshape(600, -1)  # u~ = T^T u
+    ref = _reference_second_order(op, U, T)
+    fast = second_order_reactions(op, U, T)
+    scale = np.abs(ref).max()
+    assert scale > 100.0  # [N] the test has something to compare (249 N)
+    assert np.abs(fast - ref).max() <= 5e-12 * scale, np.abs(fast - ref).max() / scale
+    if np.finfo(np.longdouble).eps < 1e-18:  # extended precision available (x86)
+        exact = _reference_second_order(op, U, T, dtype=np.longdouble)
+        err_fast, err_ref = (float(np.abs(x - exact).max()) for x in (fast, ref))
+        assert err_fast <= 1.5 * err_ref + 1e-13 * scale, (err_fast / scale, err_ref / scale)
+    # and block by block: a row's result does not depend on the other rows
+    assert np.array_equal(second_order_reactions(op, U[37:38], T), fast[37:38])
+    assert np.array_equal(second_order_reactions(op, U[5:300:3], T), fast[5:300:3])
+    if not rotated:  # the quasi-static entry: displacements X l of loads l, X = K^-1 F
+        X = solve(model.K_dense, F)
+        L = rng.standard_normal((300, F.shape[1]))
+        of_loads = second_order_of_loads(op, L, X)
+        direct = second_order_reactions(op, L @ X.T)
+        assert np.abs(of_loads - direct).max() <= 1e-12 * np.abs(direct).max()
+        assert np.array_equal(second_order_of_loads(op, L[7:200:4], X), of_loads[7:200:4])
 
 
 def test_second_order_raises_strain_tower_tension():

@@ -159,7 +159,7 @@ def integrate(
     R_B = np.empty((n_steps, n_real, n_r))
     chunk = max(1, 8192 // max(n_real, 1))
     if second_order is not None:
-        from .second_order import second_order_from_components, second_order_reactions
+        from .second_order import second_order_of_loads, second_order_reactions
 
         def so(n: int, U: np.ndarray) -> np.ndarray:
             """Second-order reactions of global displacements U (..., n_dof) under the state of step n."""
@@ -173,15 +173,15 @@ def integrate(
             if second_order is not None:  # (K^-1 P)^T: the y-loads to the quasi-static displacements
                 E = np.zeros((n_dof, n_free), order="F")
                 E[ydof, np.arange(n_free)] = 1.0
-                XT = np.ascontiguousarray(_solve(c, E).T)  # (n_free, n_dof)
+                X = np.ascontiguousarray(_solve(c, E))  # (n_dof, n_free)
             all_steps = np.flatnonzero(state_of_step == k)
             for i0 in range(0, all_steps.size, chunk):
                 steps = all_steps[i0:i0 + chunk]
                 R_B[steps] = _rowdot(loads[steps].reshape(-1, n_free), TB).reshape(steps.size, n_real, n_r)
                 sk = steps[steps >= second_order_start]
                 if second_order is not None and sk.size:  # the quasi-static displacements themselves
-                    UB = _fixed_matmul(loads[sk].reshape(-1, n_free), XT)
-                    R_B[sk] += so(int(sk[0]), UB).reshape(sk.size, n_real, n_r)
+                    R_B[sk] += second_order_of_loads(second_order[k], loads[sk].reshape(-1, n_free), X).reshape(
+                        sk.size, n_real, n_r)
     else:
         for n in range(n_steps):
             m, _ = model_of(n)
@@ -265,11 +265,10 @@ def integrate(
                 buf[k] = U
             R_F[b0:b1] = st.reactions(buf[: b1 - b0])
             c0 = max(b0, second_order_start)
-            if second_order is not None and c0 < b1:  # back to global coordinates, u = T u~ node by node
-                ut = buf[c0 - b0: b1 - b0].reshape(-1, n_dof)
-                R_F[c0:b1] += second_order_from_components(
-                    second_order[int(state_of_step[c0])], ut[:, 0::3], ut[:, 1::3], ut[:, 2::3],
-                    T=st.T).reshape(b1 - c0, n_real, n_r)
+            if second_order is not None and c0 < b1:  # from the node bases, u = T u~ node by node
+                R_F[c0:b1] += second_order_reactions(second_order[int(state_of_step[c0])],
+                                                     buf[c0 - b0: b1 - b0].reshape(-1, n_dof),
+                                                     T=st.T).reshape(b1 - c0, n_real, n_r)
             if progress is not None and b1 // report != b0 // report:
                 progress(b1, n_steps)
             if cancel is not None and cancel.is_set():
@@ -286,25 +285,6 @@ def integrate(
         fluctuating=np.ascontiguousarray(R_F.reshape(shape).transpose(1, 0, 2, 3)),
         background=np.ascontiguousarray(R_B.reshape(shape).transpose(1, 0, 2, 3)),
     )
-
-
-def _fixed_matmul(X: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """X @ B by BLAS on blocks of a fixed number of rows (the last one padded with zeros) that
-    depends on B only: every row is computed by the same call shape whatever the number of rows
-    (realizations) in X, so results are bit-identical across batch chunking; the blocks are small
-    enough for OpenBLAS to stay on one thread (below its 4 x 65536 multiply-add threshold)."""
-    m = X.shape[0]
-    chunk = max(8, 250_000 // B.size)
-    out = np.empty((m, B.shape[1]))
-    for i0 in range(0, m, chunk):
-        i1 = min(i0 + chunk, m)
-        if i1 - i0 == chunk:
-            np.matmul(X[i0:i1], B, out=out[i0:i1])
-        else:
-            pad = np.zeros((chunk, X.shape[1]))
-            pad[: i1 - i0] = X[i0:i1]
-            out[i0:i1] = (pad @ B)[: i1 - i0]
-    return out
 
 
 def _rowdot(X: np.ndarray, BT: np.ndarray) -> np.ndarray:

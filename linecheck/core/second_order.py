@@ -56,6 +56,10 @@ class SecondOrder:
         ins_free: index among the free nodes of every suspension attachment, (n_s,).
         A: [-] member second-order forces -> reactions: the support terms S f2 minus the
             p_2 -> G K^-1 p_2 transfer (Z = K^-1 G^T, module docstring), shape (3 n_m, n_r).
+        W: [N/m^2] the same map from products of the members' du: R_2 = P W, shape
+            (6 n_el + 3 n_s, n_r) (:func:`reaction_form`).
+        ins_nodes: global node of every suspension attachment, (n_s,).
+        ins_frame: [-] rows (e, t1, t2) of every insulator's orthonormal frame, (n_s, 3, 3).
     """
 
     e: np.ndarray
@@ -65,6 +69,9 @@ class SecondOrder:
     runs: tuple[tuple[int, int, int], ...]
     ins_free: np.ndarray
     A: np.ndarray
+    W: np.ndarray
+    ins_nodes: np.ndarray
+    ins_frame: np.ndarray
 
 
 def second_order_operator(model: LinearModel, state: StaticState) -> SecondOrder:
@@ -113,81 +120,175 @@ def second_order_operator(model: LinearModel, state: StaticState) -> SecondOrder
     free = model.dofs.free_nodes
     cuts = np.flatnonzero(np.diff(free) != 1) + 1
     runs = tuple((int(r[0]), int(r[-1]) + 1, int(np.searchsorted(free, r[0]))) for r in np.split(free, cuts) if r.size)
-    A = A.transpose(1, 0, 2).reshape(3 * n_m, n_r)  # component-major rows, as _member_forces
+    A = A.transpose(1, 0, 2).reshape(3 * n_m, n_r)  # component-major rows
     pinned = np.setdiff1d(np.arange(n_nodes), free)
-    return SecondOrder(np.concatenate([e_el, model.axes]).ravel(), np.concatenate([c_el, c_in]), n_nodes, pinned, runs,
-                       model.dofs.node_dof[system.tower_nodes[sus]] // 3, np.ascontiguousarray(A))
+    e = np.concatenate([e_el, model.axes])
+    c = np.concatenate([c_el, c_in])
+    W, frame = reaction_form(e, c, A, n_el)
+    return SecondOrder(e.ravel(), c, n_nodes, pinned, runs, model.dofs.node_dof[system.tower_nodes[sus]] // 3,
+                       np.ascontiguousarray(A), W, system.tower_nodes[sus].copy(), frame)
 
 
-SINGLE_THREAD_WORK = 200_000  # rows x A.size below OpenBLAS' multithreading threshold (4 x 65536)
+_PAIRS = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2))  # products of du's components in P
 
 
-def second_order_reactions(op: SecondOrder, U: np.ndarray) -> np.ndarray:
-    """[N] R_2 at every tower for free displacements U [m], shape (m, n_dof) -> (m, n_r)."""
-    m = U.shape[0]
-    U3 = U.reshape(m, -1, 3)
-    return second_order_from_components(op, U3[:, :, 0], U3[:, :, 1], U3[:, :, 2])
+def reaction_form(e: np.ndarray, c: np.ndarray, A: np.ndarray, n_el: int) -> tuple[np.ndarray, np.ndarray]:
+    """[N/m^2] W (6 n_el + 3 n_s, n_r) such that R_2 = P W, and the insulators' frames.
+
+    P holds per row, member-major: for every cable element the six products (xx, yy, zz, xy,
+    yz, xz; _PAIRS) of its du's components; for every insulator (a s, a w, s^2 + w^2), with
+    (a, s, w) = F du its components in its frame F = (e, t1, t2) (rows; returned, (n_s, 3, 3)).
+
+    With g_r a member's 3 rows of A (component-major, (3 n_m, n_r)) and h_r = e.g_r, the
+    module docstring's f2 = c [a du + q e], a = e.du, q = |du|^2/2 - 3 a^2/2, gives
+    f2.g_r = c [a (g_r.du) + q h_r]:
+    * a cable element: the quadratic form du^T Q_r du, Q_r = c [(e g_r^T + g_r e^T)/2
+      + h_r I/2 - 3 h_r e e^T/2] (W: Q_kk for the squares, 2 Q_kl for the cross products);
+    * an insulator: with du = a e + s t1 + w t2, g_r.du = h_r a + (g_r.t1) s + (g_r.t2) w and
+      q = (s^2 + w^2)/2 - a^2, so the a^2 terms cancel exactly:
+      f2.g_r = c [(g_r.t1) a s + (g_r.t2) a w + h_r (s^2 + w^2)/2].  Its c is ~10^4 times a
+      cable element's (rigid insulator) and a stays ~10^-5 |du| (it swings about its fixed
+      point): the expanded quadratic form in x, y, z would lose that to rounding (~3 times the
+      rounding error of f2 A), the frame keeps a computed first, as f2 A does.
+    e: unit chords (n_m, 3); c: (n_m,); the first n_el members are the cable elements.
+    """
+    n_m = c.size
+    g = A.reshape(3, n_m, -1)  # (component, member, reaction)
+    h = np.einsum("mk,kmr->mr", e, g)
+    el = slice(0, n_el)
+    Wq = np.empty((6, n_el, A.shape[1]))
+    for s, (k, l) in enumerate(_PAIRS):
+        ek, el_ = e[el, k, None], e[el, l, None]
+        if k == l:
+            Wq[s] = ek * g[k, el] + h[el] * (0.5 - 1.5 * ek**2)
+        else:
+            Wq[s] = ek * g[l, el] + el_ * g[k, el] - 3.0 * h[el] * (ek * el_)
+        Wq[s] *= c[el, None]
+    ei = e[n_el:]
+    helper = np.where(np.abs(ei[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+    t1 = np.cross(ei, helper)
+    t1 /= np.linalg.norm(t1, axis=1)[:, None]
+    t2 = np.cross(ei, t1)
+    frame = np.stack([ei, t1, t2], axis=1)  # (n_s, 3, 3), rows e, t1, t2
+    gi = g[:, n_el:]  # (3, n_s, n_r)
+    ci = c[n_el:, None]
+    Wi = np.stack([ci * np.einsum("sk,ksr->sr", t1, gi), ci * np.einsum("sk,ksr->sr", t2, gi), 0.5 * ci * h[n_el:]],
+                  axis=1)  # (n_s, 3, n_r)
+    W = np.concatenate([Wq.transpose(1, 0, 2).reshape(6 * n_el, -1), Wi.reshape(3 * (n_m - n_el), A.shape[1])])
+    return W, frame
 
 
-def second_order_from_components(op: SecondOrder, ux: np.ndarray, uy: np.ndarray, uz: np.ndarray,
-                                  T: np.ndarray | None = None) -> np.ndarray:
-    """[N] R_2 at every tower from the x, y, z displacements [m] of the free nodes, each
-    shape (m, n_free_nodes) -> (m, n_r).  With ``T`` (per-node bases, (n_free_nodes, 3, 3)) the
-    components are those of u~ in the node bases, u = T u~ (rotated block by block).
+SINGLE_THREAD_WORK = 4 * 65536  # rows x W.size up to OpenBLAS' multithreading threshold (m n k <= 4 x 65536)
+BLOCK_ROWS = 128  # rows of one block of elementwise passes (their arrays stay in cache)
+
+
+def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None = None) -> np.ndarray:
+    """[N] R_2 at every tower for free displacements U [m], shape (m, n_dof) -> (m, n_r).
+
+    With ``T`` (per-node bases as columns, (n_free_nodes, 3, 3)) U holds the components u~ in
+    the node bases, u = T u~ node by node (the Newmark history of :mod:`.dynamics`).
+
+    R_2 = P W (:func:`reaction_form`), block by block of rows: the displacements go node-major
+    into a preallocated (n_nodes, 3, rows) array (rotated by one batched 3x3 product per node),
+    the members' du by one slice difference, their products into P (transposed, (6 n_el +
+    3 n_s, rows)), and P W by BLAS: a dozen numpy calls per block with ``out=`` instead of the
+    ~45 elementwise passes of building f2 and multiplying by A; results equal the latter to
+    rounding (tests).
 
     Rows are processed in blocks of a fixed size that depends on the operator only (the last
-    block padded with zeros), so the BLAS product always has the same shape: a row's result
+    block padded with zeros), so every BLAS product always has the same shape: a row's result
     does not depend on how many other rows (realizations) share the call, and results stay
-    bit-identical whatever the batch chunking.  The blocks are small enough for OpenBLAS to
-    run the product on one thread (no thread start-up on a shared machine).
+    bit-identical whatever the batch chunking.  The products are small enough for OpenBLAS to
+    run on one thread (no thread start-up on a shared machine).
     """
-    m = ux.shape[0]
-    chunk = max(8, SINGLE_THREAD_WORK // op.A.size)
-    n_blk = max(1, 512 // chunk) * chunk  # rows of one elementwise pass: arrays stay in cache
-    out = np.empty((m, op.A.shape[1]))
-    for i0 in range(0, m, n_blk):
-        i1 = min(i0 + n_blk, m)
-        comps = (ux[i0:i1], uy[i0:i1], uz[i0:i1])
-        if T is not None:  # u = T u~ node by node
-            comps = tuple(comps[0] * T[:, c, 0] + comps[1] * T[:, c, 1] + comps[2] * T[:, c, 2] for c in range(3))
-        f = _member_forces(op, *comps)
-        for j0 in range(0, i1 - i0, chunk):
-            j1 = min(j0 + chunk, i1 - i0)
-            if j1 - j0 == chunk:
-                np.matmul(f[j0:j1], op.A, out=out[i0 + j0:i0 + j1])
-            else:
-                pad = np.zeros((chunk, f.shape[1]))
-                pad[: j1 - j0] = f[j0:j1]
-                out[i0 + j0:i0 + j1] = (pad @ op.A)[: j1 - j0]
-    return out
+    n_f = U.shape[1] // 3
+    pad = None
 
-
-def _member_forces(op: SecondOrder, *comps: np.ndarray) -> np.ndarray:
-    """f2 of every member (force on its end a) [N], component-major, shape (m, 3 n_m), from the
-    free-node displacement components (m, n_free_nodes) each (module docstring for f2)."""
-    m = comps[0].shape[0]
-    n_m, n_el = op.c.size, op.n_nodes - 1
-    d = np.empty((3, m, n_m))
-    u = np.empty((m, op.n_nodes))
-    u[:, op.pinned] = 0.0
-    for k, uk in enumerate(comps):
+    def fill(u: np.ndarray, i0: int, r: int) -> None:
+        nonlocal pad
+        nb = u.shape[2]
+        Ub = U[i0:i0 + r]
+        if T is not None and r < nb:  # the batched product keeps its shape
+            if pad is None:
+                pad = np.zeros((nb, U.shape[1]))
+            pad[:r] = Ub
+            pad[r:] = 0.0
+            Ub = pad
+        Un = Ub.reshape(-1, n_f, 3).transpose(1, 2, 0)  # (n_free_nodes, 3, rows)
         for lo, hi, f0 in op.runs:  # free nodes in contiguous runs (slices, no fancy indexing)
-            u[:, lo:hi] = uk[:, f0:f0 + hi - lo]
-        np.subtract(u[:, 1:], u[:, :-1], out=d[k, :, :n_el])  # cable elements: u_b - u_a
-        d[k, :, n_el:] = uk[:, op.ins_free]  # insulators: the fixed point does not move
-    e = op.e.reshape(-1, 3)
-    a = d[0] * e[:, 0]
-    a += d[1] * e[:, 1]
-    a += d[2] * e[:, 2]  # e.du
-    q = np.einsum("kmi,kmi->mi", d, d)
-    q *= 0.5
-    q -= 1.5 * a * a
-    # f2 = c [a du + (|du|^2/2 - 3 a^2/2) e]: force of the member on its end a
-    a *= op.c
-    q *= op.c
-    d *= a
-    f = np.empty((m, 3, n_m))
-    for k in range(3):
-        np.multiply(q, e[:, k], out=f[:, k])
-        f[:, k] += d[k]
-    return f.reshape(m, 3 * n_m)
+            if T is None:
+                u[lo:hi, :, :r] = Un[f0:f0 + hi - lo]
+            else:  # u = T u~ node by node
+                np.matmul(T[f0:f0 + hi - lo], Un[f0:f0 + hi - lo], out=u[lo:hi])
+        if T is None and r < nb:
+            u[:, :, r:] = 0.0
+
+    return _reactions(op, U.shape[0], fill)
+
+
+def second_order_of_loads(op: SecondOrder, L: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """[N] R_2 of the quasi-static displacements u = X l of loads L [N], shape (m, n_l) ->
+    (m, n_r); X [m/N] (n_dof, n_l) maps the loads to the free displacements (x, y, z per free
+    node).  As :func:`second_order_reactions` of L X^T, without that history: each block's
+    displacements are computed node-major, X L_block^T, straight into the work array, by BLAS
+    products of a fixed shape (16 loads rows, whole micro-kernel tiles, one thread)."""
+    ch = max(16, SINGLE_THREAD_WORK // X.size // 16 * 16)
+    zero = np.zeros((ch, L.shape[1]))
+
+    def fill(u: np.ndarray, i0: int, r: int) -> None:
+        nb = u.shape[2]
+        for j0 in range(0, nb, ch):
+            j1 = j0 + ch
+            if j0 >= r:
+                u[:, :, j0:] = 0.0
+                break
+            Lc = L[i0 + j0:i0 + j1]
+            if j1 > r:  # padded: the product keeps its shape
+                zero[: r - j0] = Lc
+                zero[r - j0:] = 0.0
+                Lc = zero
+            for lo, hi, f0 in op.runs:
+                np.matmul(X[3 * f0:3 * (f0 + hi - lo)], Lc.T, out=u[lo:hi].reshape(3 * (hi - lo), nb)[:, j0:j1])
+
+    return _reactions(op, L.shape[0], fill, multiple=ch)
+
+
+def _reactions(op: SecondOrder, m: int, fill, multiple: int = 1) -> np.ndarray:
+    """R_2 (m, n_r) of m rows of displacements that ``fill(u, i0, r)`` writes node-major into
+    u[:, :, :r] (global x, y, z; (n_nodes, 3, nb)), zeroing u[:, :, r:] (docstrings above)."""
+    W = op.W
+    n_el = op.n_nodes - 1
+    n_s = op.c.size - n_el
+    # whole micro-kernel tiles: with 23-row blocks the edge rows' kernel rounded a column differently
+    chunk = max(16, SINGLE_THREAD_WORK // W.size // 16 * 16)
+    nb = max(1, BLOCK_ROWS // chunk) * chunk  # rows of one elementwise pass: arrays stay in cache
+    nb = -(-nb // multiple) * multiple
+    u = np.zeros((op.n_nodes, 3, nb))  # pinned nodes stay zero
+    d = np.empty((n_el, 3, nb))
+    P = np.zeros((W.shape[0], nb))  # padding columns stay zero
+    Pq = P[:6 * n_el].reshape(n_el, 6, nb)  # cable elements: the six products
+    Pi = P[6 * n_el:].reshape(n_s, 3, nb)  # insulators: a s, a w, s^2 + w^2
+    di = np.empty((n_s, 3, nb))
+    li = np.empty((n_s, 3, nb))
+    sq = np.empty((n_s, 2, nb))
+    out = np.empty((m, W.shape[1]))
+    for i0 in range(0, m, nb):
+        i1 = min(i0 + nb, m)
+        r = i1 - i0
+        fill(u, i0, r)
+        np.subtract(u[1:], u[:-1], out=d)  # cable elements: u_b - u_a
+        np.multiply(d, d, out=Pq[:, :3])  # cable elements: products of du's components (_PAIRS)
+        np.multiply(d[:, :2], d[:, 1:], out=Pq[:, 3:5])
+        np.multiply(d[:, 0], d[:, 2], out=Pq[:, 5])
+        np.take(u, op.ins_nodes, axis=0, out=di)  # insulators: the fixed point does not move
+        np.matmul(op.ins_frame, di, out=li)  # (a, s, w) in the insulator's frame
+        np.multiply(li[:, :1], li[:, 1:], out=Pi[:, :2])  # a s, a w
+        np.multiply(li[:, 1:], li[:, 1:], out=sq)
+        np.add(sq[:, 0], sq[:, 1], out=Pi[:, 2])  # s^2 + w^2
+        for j0 in range(0, r, chunk):
+            j1 = j0 + chunk
+            if j1 <= r:
+                np.matmul(P[:, j0:j1].T, W, out=out[i0 + j0:i0 + j1])
+            else:
+                out[i0 + j0:i1] = (P[:, j0:j1].T @ W)[: r - j0]
+    return out

@@ -138,9 +138,9 @@ class _Spans:
     def __init__(self, system: LineSystem, gy: np.ndarray) -> None:
         op = span_operators(system.ne)
         line = system.line
-        self.Lu = system.unstretched_length
+        self.Lu = system.unstretched_lengths  # (n_spans,)
         self.EA = line.ea
-        self.L = line.span_length
+        self.L = system.span_lengths  # (n_spans,)
         W = line.weight
         # beam end reactions per unit L_u (loads per unit unstretched conductor length)
         self.vAy = gy @ op.a_left
@@ -168,7 +168,7 @@ class _Spans:
         Lu, EA = self.Lu, self.EA
         w = self.w_gp
         ay, az = (dy / l)[..., None], (dz / l)[..., None]
-        by, bz = Lu * self.qy_gp, -Lu * self.qz_gp  # (n_spans, n_gp) and (n_gp,)
+        by, bz = Lu[:, None] * self.qy_gp, -Lu[:, None] * self.qz_gp  # both (n_spans, n_gp)
         H = np.array(H0, dtype=float)
         for _ in range(60):
             Hc = H[..., None]
@@ -247,7 +247,7 @@ def solve_static(
     if not np.all(np.isfinite(gy)):
         raise ConvergenceError(f"{label}: non-finite mean-wind load")
     sp = _Spans(system, gy)
-    L = line.span_length
+    L = system.span_lengths
 
     if initial is not None:
         d = initial.displacement.copy()
@@ -259,7 +259,7 @@ def solve_static(
         wres = np.hypot(line.weight, np.abs(gy).mean(axis=1))
         H = np.maximum(H, system.tension_nominal * wres / line.weight)
     idx = np.flatnonzero(sus)
-    Rres = np.full(nt, line.weight * L)
+    Rres = line.weight * system.weight_spans
     if initial is not None:
         Rres = initial.insulator_force.copy()
 
@@ -326,12 +326,12 @@ def solve_static(
     return _final_state(system, sp.Lu, sp.my_hat, sp.mz_hat, d, H, R, Rres, it, residual, label)
 
 
-def _final_state(system: LineSystem, Lu: float, my_hat: np.ndarray, mz_hat: np.ndarray, d: np.ndarray,
+def _final_state(system: LineSystem, Lu: np.ndarray, my_hat: np.ndarray, mz_hat: np.ndarray, d: np.ndarray,
                  H: np.ndarray, R: np.ndarray, Rres: np.ndarray, it: int, residual: float, label: str) -> StaticState:
     """Strain check and deformed shape of one converged equilibrium (shallow cable:
     y = chord + M_y/H, z = chord - M_z/H; element tension T = H ds/dx)."""
     line = system.line
-    L = line.span_length
+    L = system.span_lengths
     strain = H.max() / line.ea
     if strain > MAX_STRAIN or not np.isfinite(strain):
         raise ConvergenceError(
@@ -417,7 +417,7 @@ def solve_static_batch(
     line = system.line
     nt = system.n_towers
     v = line.insulator_length
-    L = line.span_length
+    L = system.span_lengths
     gy = np.asarray(gy, dtype=float)
     n_s = gy.shape[0]
     if gy.shape[1:] != (system.n_spans, system.ne + 1):

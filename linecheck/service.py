@@ -831,9 +831,10 @@ def spectral_analysis(case: Case, *, static: StaticResult | None = None,
     )
     H = float(mean.tension[0].mean())
     mu = line.mass_per_length
-    f1 = np.sqrt(H / mu) / (2 * line.span_length)  # taut-string fundamental (Irvine 1981 Eq. 3.21)
+    span = st.system.common_span_length  # the closed form is for equal spans
+    f1 = np.sqrt(H / mu) / (2 * span)  # taut-string fundamental (Irvine 1981 Eq. 3.21)
     dav = davenport_gust_factor(
-        span=line.span_length, v_mean=wind.v_ref, intensity=wind.turbulence_intensity, length_scale=L_u,
+        span=span, v_mean=wind.v_ref, intensity=wind.turbulence_intensity, length_scale=L_u,
         coherence_decay=wind.coherence_decay, f1=f1, mass_per_length=mu, air_density=wind.air_density,
         drag_coefficient=line.drag_coefficient, diameter=line.diameter, duration=float(t[-1] - t[0]),
         height=line.height,
@@ -972,7 +973,8 @@ def code_loads(case: Case, *, strict: bool = True) -> list:
     src = str(case.source) if case.source else None
     if wind.type == "downburst":
         return [C.downburst_load(code) for code in C.CODES]
-    args = (wind.v_ref, line.height, line.span_length, line.diameter, line.drag_coefficient)
+    # the codes' wind span: the section's common span (equal spans)
+    args = (wind.v_ref, line.height, LineSystem(line).common_span_length, line.diameter, line.drag_coefficient)
     calls = {
         "ASCE74": lambda: C.asce74_wire_load(*args, cc.asce74_exposure or C.TERRAIN_MAP["ASCE74"][cc.terrain],
                                              source=src),
@@ -1009,7 +1011,7 @@ def codes_analysis(case: Case, run: RunResult | None = None, *, strict: bool = T
     n_spans = line.spans
     speeds = np.asarray(wind.span_speeds if wind.span_speeds is not None else [wind.v_ref] * n_spans, dtype=float)
     scale = (speeds / wind.v_ref) ** 2 if wind.v_ref > 0 else np.ones(n_spans)
-    half = 0.5 * line.span_length * scale  # [m] equivalent half spans at v_ref
+    half = 0.5 * LineSystem(line).span_lengths * scale  # [m] equivalent half spans at v_ref
     eq_span = np.zeros(n_spans + 1)
     eq_span[:-1] += half
     eq_span[1:] += half

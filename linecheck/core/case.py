@@ -296,7 +296,12 @@ class Case:
 
     @property
     def g_yp_L(self) -> float:
-        """Normalising force g*_yp * L_x [N] (paper Eq. 17, Fig. 13)."""
+        """Normalising force g*_yp * L_x [N] (paper Eq. 17, Fig. 13).
+
+        L_x is the case's (equal) span length.  On a section of unequal spans (issue 17)
+        L_x becomes the mean of the two spans adjacent to the tower of interest, which for
+        equal spans is this same value.
+        """
         return self.g_yp * self.line.span_length
 
 

@@ -186,7 +186,8 @@ def build_model(system: LineSystem, state: StaticState) -> LinearModel:
 
     # insulators (issue 4): axially stiff, geometric stiffness R_res/v transversely
     v = line.insulator_length
-    ea_cable_el = line.ea / (system.unstretched_length / system.ne)
+    # stiffest cable element of the section (equal spans: every element, L_u / ne)
+    ea_cable_el = line.ea / float(system.element_unstretched_lengths.min())
     k_ax = INSULATOR_AXIAL_FACTOR * ea_cable_el
     ins_blocks = {}
     axes, axial_dof = [], []
@@ -207,7 +208,7 @@ def build_model(system: LineSystem, state: StaticState) -> LinearModel:
         axial_dof.append(r)
 
     # lumped mass (paper Eq. 8) by tributary unstretched length
-    Le_u = system.unstretched_length / system.ne
+    Le_u = system.element_unstretched_lengths  # (n_elements,)
     trib = np.zeros(system.n_nodes)
     trib[:-1] += 0.5 * Le_u
     trib[1:] += 0.5 * Le_u

@@ -543,7 +543,7 @@ def random_vibration(
                                  v_mean=v_mean, coherence_decay=coherence_decay, max_hz=np.inf)
         refine = mc.significant(GRID_SIGNIFICANCE)
     f = frequency_grid(band[0], band[1], modes, refine=refine)
-    dx = system.line.span_length / system.ne
+    dx = system.uniform_element_length  # KMS coherence: equally spaced nodes
     # the synthesis scales the spectrum to unit variance below its top frequency
     # (linecheck.core.wind.turbulence.spectral_grid); do the same here
     Sv = von_karman(f, sigma, length_scale, v_mean) / float(von_karman_cumulative(band[1], length_scale, v_mean))
@@ -741,7 +741,7 @@ def modal_contributions(
     L = S[ydof].T / modes.mass[:, None]  # M*^-1 S^T maps a y-load at free node i to b
     cvec = np.zeros((lam.size, system.n_nodes), dtype=complex)
     cvec[:, free] = (vl.conj().T @ L) * load_per_v[free][None, :]
-    dx = system.line.span_length / system.ne
+    dx = system.uniform_element_length  # KMS coherence: equally spaced nodes
     rho = np.exp(-coherence_decay * f * dx / v_mean)
     SQ = von_karman(f, sigma, length_scale, v_mean) * _quad_kms(cvec, rho)
     rate = -lam.real

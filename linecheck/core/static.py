@@ -138,9 +138,9 @@ class _Spans:
     def __init__(self, system: LineSystem, gy: np.ndarray) -> None:
         op = span_operators(system.ne)
         line = system.line
-        self.Lu = system.unstretched_length
+        self.Lu = system.unstretched_lengths  # (n_spans,)
         self.EA = line.ea
-        self.L = line.span_length
+        self.L = system.span_lengths  # (n_spans,)
         W = line.weight
         # beam end reactions per unit L_u (loads per unit unstretched conductor length)
         self.vAy = gy @ op.a_left
@@ -168,7 +168,7 @@ class _Spans:
         Lu, EA = self.Lu, self.EA
         w = self.w_gp
         ay, az = (dy / l)[..., None], (dz / l)[..., None]
-        by, bz = Lu * self.qy_gp, -Lu * self.qz_gp  # (n_spans, n_gp) and (n_gp,)
+        by, bz = Lu[:, None] * self.qy_gp, -Lu[:, None] * self.qz_gp  # both (n_spans, n_gp)
         H = np.array(H0, dtype=float)
         for _ in range(60):
             Hc = H[..., None]
@@ -225,6 +225,8 @@ def solve_static(
 ) -> StaticState:
     """Non-linear static equilibrium under weight and the transverse mean-wind load.
 
+    One state of :func:`_fig6_iteration` (a leading state axis of 1).
+
     Args:
         system: the line section.
         gy: [N/m] transverse load per unit conductor length at each span's FE nodes,
@@ -239,99 +241,159 @@ def solve_static(
     """
     line = system.line
     nt = system.n_towers
-    sus = system.suspension
-    v = line.insulator_length
     gy = np.asarray(gy, dtype=float)
     if gy.shape != (system.n_spans, system.ne + 1):
         raise ValueError(f"gy must have shape {(system.n_spans, system.ne + 1)}, got {gy.shape}")
     if not np.all(np.isfinite(gy)):
         raise ConvergenceError(f"{label}: non-finite mean-wind load")
-    sp = _Spans(system, gy)
-    L = line.span_length
-
     if initial is not None:
         d = initial.displacement.copy()
         H = initial.tension.copy()
+        Rres = initial.insulator_force.copy()
     else:
         d = np.zeros((nt, 3))
         H = np.full(system.n_spans, system.tension_nominal)
         # a better start for H: the resultant-load parabola
         wres = np.hypot(line.weight, np.abs(gy).mean(axis=1))
         H = np.maximum(H, system.tension_nominal * wres / line.weight)
-    idx = np.flatnonzero(sus)
-    Rres = np.full(nt, line.weight * L)
-    if initial is not None:
-        Rres = initial.insulator_force.copy()
+        Rres = line.weight * system.weight_spans  # tributary weight (start only)
+    return _fig6_iteration(system, gy[None], d[None], H[None], Rres[None], labels=[label], tol=tol,
+                           max_iter=max_iter)[0]
 
+
+def _fig6_iteration(
+    system: LineSystem,
+    gy: np.ndarray,
+    d: np.ndarray,
+    H: np.ndarray,
+    Rres: np.ndarray,
+    *,
+    labels: list[str],
+    tol: float,
+    max_iter: int,
+    progress: Callable[[int, int], None] | None = None,
+    cancel: threading.Event | None = None,
+) -> list[StaticState]:
+    """The paper's Fig. 6 iteration, written once, on a leading axis of n_states load cases.
+
+    Inner Newton on d_x (Eq. 3) with R_res fixed, then the reactions (Eq. 2) and the
+    insulator update (Eq. 4), repeated until the attachment displacements stop changing;
+    each state is frozen at its own convergence, so a state's result does not depend on
+    the others.  The longitudinal tangent is solved by LAPACK dgtsv for one state and by
+    the vectorised Thomas algorithm for several (same system, both direct).
+
+    Args:
+        gy: [N/m] transverse loads, shape (n_states, n_spans, ne+1) (checked finite).
+        d: [m] start displacements (n_states, n_towers, 3); H: [N] start tensions
+            (n_states, n_spans); Rres: [N] start insulator forces (n_states, n_towers).
+        labels: names of the states for error messages, length n_states.
+        progress: ``progress(converged, n_states)`` once per outer iteration.
+        cancel: set it to stop; raises :class:`Cancelled`.
+    """
+    line = system.line
+    nt = system.n_towers
+    v = line.insulator_length
+    L = system.span_lengths
+    n_s = gy.shape[0]
+    sp = _Spans(system, gy)
+    d, H, Rres = d.copy(), H.copy(), Rres.copy()
+    idx = np.flatnonzero(system.suspension)
+    k = idx.size
+    adj = np.flatnonzero(np.diff(idx) == 1)
     tol_d = tol * max(v, 1.0)
-    change = np.inf
-    residual = np.inf
+    active = np.ones(n_s, dtype=bool)
+    out_d, out_H, out_R = np.empty_like(d), np.empty_like(H), np.empty((n_s, nt, 3))
+    out_Rres, out_res = np.empty_like(Rres), np.zeros(n_s)
+    out_it = np.zeros(n_s, dtype=int)
+    change = np.full(n_s, np.inf)
+    residual = np.full(n_s, np.inf)
     for it in range(1, max_iter + 1):
+        if cancel is not None and cancel.is_set():
+            raise Cancelled("step 1 cancelled")
         d_old = d.copy()
-        # ---- inner Newton on d_x (paper Eq. 3), R_res fixed
+        # ---- inner Newton on d_x (paper Eq. 3), R_res fixed; converged states frozen
+        inner = active.copy()
         for _inner in range(50):
-            l = L + np.diff(d[:, 0])
-            H, C = sp.tension(l, np.diff(d[:, 1]), np.diff(d[:, 2]), H)
-            if idx.size == 0:
+            l = L + np.diff(d[..., 0], axis=-1)
+            H, C = sp.tension(l, np.diff(d[..., 1], axis=-1), np.diff(d[..., 2], axis=-1), H)
+            if k == 0 or not inner.any():
                 break
-            fx = np.zeros(nt)
-            fx[:-1] += H
-            fx[1:] -= H
-            fx = fx - d[:, 0] * Rres / v
-            f = fx[idx]
-            # tangent (paper K_x with the elastic C_n = dH/dl): tridiagonal over all towers
+            fx = np.zeros((n_s, nt))
+            fx[:, :-1] += H
+            fx[:, 1:] -= H
+            fx = fx - d[..., 0] * Rres / v
+            # tangent (paper K_x with the elastic C_n = dH/dl): tridiagonal over all towers,
+            # restricted to the suspension towers (strain towers are fixed); free neighbours
+            # are adjacent towers j, j+1 -> a symmetric tridiagonal system
             diag = -Rres / v
-            diag = diag.copy()
-            diag[:-1] -= C
-            diag[1:] -= C
-            # restrict to suspension nodes (strain nodes are fixed); neighbours that are both
-            # free are adjacent towers j, j+1 -> a symmetric tridiagonal system (LAPACK dgtsv)
-            k = idx.size
-            off = np.zeros(max(k - 1, 0))
-            adj = np.flatnonzero(np.diff(idx) == 1)
-            off[adj] = C[idx[adj]]
-            _, _, _, step, info = _dgtsv(off, diag[idx].copy(), off.copy(), -f)
-            if info != 0:
-                raise ConvergenceError(f"{label}: singular longitudinal tangent (K_x, Eq. 3)")
-            d[idx, 0] += step
-            if np.max(np.abs(step)) <= 1e-3 * tol_d:
+            diag[:, :-1] -= C
+            diag[:, 1:] -= C
+            off = np.zeros((n_s, max(k - 1, 0)))
+            off[:, adj] = C[:, idx[adj]]
+            if n_s == 1:
+                _, _, _, step, info = _dgtsv(off[0], diag[0, idx].copy(), off[0].copy(), -fx[0, idx])
+                if info != 0:
+                    raise ConvergenceError(f"{labels[0]}: singular longitudinal tangent (K_x, Eq. 3)")
+                step = step[None]
+            else:
+                step = _tridiag_solve(off, diag[:, idx], off, -fx[:, idx])
+            step[~inner] = 0.0
+            d[:, idx, 0] += step
+            inner &= ~(np.max(np.abs(step), axis=1) <= 1e-3 * tol_d)
+            if n_s == 1 and not inner[0]:
+                # one state stops right after its last Newton step (its H is recomputed below);
+                # several states take one more pass (H of all states at the final d_x) and stop
+                # at the check above.  Unifying the two moves the paper cases' results by the
+                # round-off of the span-tension Newton (up to 8e-6 relative on near-zero
+                # wind-induced Rx histories), so both keep their bit-identical results.
                 break
-        l = L + np.diff(d[:, 0])
-        H, _ = sp.tension(l, np.diff(d[:, 1]), np.diff(d[:, 2]), H)
-        R = _reactions(sp, H, l, d[:, 1], d[:, 2], nt)
-        Rres = np.linalg.norm(R, axis=1)
-        if not (np.all(np.isfinite(R)) and np.all(np.isfinite(d))):
-            raise ConvergenceError(f"{label}: non-finite values after {it} iterations")
+        l = L + np.diff(d[..., 0], axis=-1)
+        H, _ = sp.tension(l, np.diff(d[..., 1], axis=-1), np.diff(d[..., 2], axis=-1), H)
+        R = _reactions(sp, H, l, d[..., 1], d[..., 2], nt)
+        Rn = np.linalg.norm(R, axis=-1)
+        Rres = np.where(active[:, None], Rn, Rres)
+        finite = np.all(np.isfinite(R.reshape(n_s, -1)), axis=1) & np.all(np.isfinite(d.reshape(n_s, -1)), axis=1)
+        if not np.all(finite | ~active):
+            j = int(np.flatnonzero(~finite & active)[0])
+            raise ConvergenceError(f"{labels[j]}: non-finite values after {it} iterations")
         # ---- insulator equilibrium (paper Eq. 4)
-        if idx.size:
-            d[idx, 0] = v * R[idx, 0] / Rres[idx]
-            d[idx, 1] = v * R[idx, 1] / Rres[idx]
-            d[idx, 2] = v - v * R[idx, 2] / Rres[idx]
-        change = float(np.max(np.abs(d - d_old))) if idx.size else 0.0
-        # out-of-balance: conductor force minus insulator force along its axis
-        if idx.size:
-            axis = np.column_stack([d_old[idx, 0], d_old[idx, 1], v - d_old[idx, 2]]) / v
-            F = np.column_stack([R[idx, 0], R[idx, 1], R[idx, 2]])
-            residual = float(np.max(np.linalg.norm(F - Rres[idx, None] * axis, axis=1)))
+        if k:
+            a = active
+            dn = np.stack([v * R[:, idx, 0] / Rres[:, idx], v * R[:, idx, 1] / Rres[:, idx],
+                           v - v * R[:, idx, 2] / Rres[:, idx]], axis=-1)
+            d[:, idx] = np.where(a[:, None, None], dn, d[:, idx])
+            change = np.where(a, np.max(np.abs(d - d_old).reshape(n_s, -1), axis=1), change)
+            # out-of-balance: conductor force minus insulator force along its axis
+            axis = np.stack([d_old[:, idx, 0], d_old[:, idx, 1], v - d_old[:, idx, 2]], axis=-1) / v
+            res = np.max(np.linalg.norm(R[:, idx] - Rn[:, idx, None] * axis, axis=-1), axis=1)
+            residual = np.where(a, res, residual)
         else:
-            residual = 0.0
-        if change <= tol_d:
+            change = np.where(active, 0.0, change)
+            residual = np.where(active, 0.0, residual)
+        done = active & (change <= tol_d)
+        out_d[done], out_H[done], out_R[done] = d[done], H[done], R[done]
+        out_Rres[done], out_res[done], out_it[done] = Rres[done], residual[done], it
+        active &= ~done
+        if progress is not None:
+            progress(int(n_s - active.sum()), n_s)
+        if not active.any():
             break
     else:
+        j = int(np.flatnonzero(active)[0])
         raise ConvergenceError(
-            f"{label}: step-1 static solver did not converge in {max_iter} iterations "
-            f"(last displacement change {change:.3g} m, out-of-balance force {residual:.3g} N)"
+            f"{labels[j]}: step-1 static solver did not converge in {max_iter} iterations "
+            f"(last displacement change {change[j]:.3g} m, out-of-balance force {residual[j]:.3g} N)"
         )
+    return [_final_state(system, sp.Lu, sp.my_hat[j], sp.mz_hat, out_d[j], out_H[j], out_R[j], out_Rres[j],
+                         int(out_it[j]), float(out_res[j]), labels[j]) for j in range(n_s)]
 
-    return _final_state(system, sp.Lu, sp.my_hat, sp.mz_hat, d, H, R, Rres, it, residual, label)
 
-
-def _final_state(system: LineSystem, Lu: float, my_hat: np.ndarray, mz_hat: np.ndarray, d: np.ndarray,
+def _final_state(system: LineSystem, Lu: np.ndarray, my_hat: np.ndarray, mz_hat: np.ndarray, d: np.ndarray,
                  H: np.ndarray, R: np.ndarray, Rres: np.ndarray, it: int, residual: float, label: str) -> StaticState:
     """Strain check and deformed shape of one converged equilibrium (shallow cable:
     y = chord + M_y/H, z = chord - M_z/H; element tension T = H ds/dx)."""
     line = system.line
-    L = line.span_length
+    L = system.span_lengths
     strain = H.max() / line.ea
     if strain > MAX_STRAIN or not np.isfinite(strain):
         raise ConvergenceError(
@@ -403,21 +465,17 @@ def solve_static_batch(
 ) -> list[StaticState]:
     """:func:`solve_static` for many load cases at once (the downburst's mean states).
 
-    The same Fig. 6 iteration -- inner Newton on d_x (Eq. 3) with R_res fixed, then the
-    insulator update (Eq. 4) -- run on all states together, every array with a leading state
-    axis, each state frozen at its own convergence.  Every state starts from the still-air
-    equilibrium (no warm start from its neighbour in time), so a state's result does not
-    depend on the others; it agrees with the sequential solver to the tolerance ``tol``.
+    The same Fig. 6 iteration (:func:`_fig6_iteration`) on all states together, each state
+    frozen at its own convergence.  Every state starts from the still-air equilibrium (no
+    warm start from its neighbour in time), so a state's result does not depend on the
+    others; it agrees with the sequential solver to the tolerance ``tol``.
 
     Args:
         gy: [N/m] transverse loads, shape (n_states, n_spans, ne+1).
         labels: names of the states for error messages, length n_states.
         progress: ``progress(converged, n_states)`` once per outer iteration.
     """
-    line = system.line
     nt = system.n_towers
-    v = line.insulator_length
-    L = line.span_length
     gy = np.asarray(gy, dtype=float)
     n_s = gy.shape[0]
     if gy.shape[1:] != (system.n_spans, system.ne + 1):
@@ -426,82 +484,11 @@ def solve_static_batch(
     if bad.size:
         raise ConvergenceError(f"{labels[bad[0]]}: non-finite mean-wind load")
     still = still_air_state(system)
-    sp = _Spans(system, gy)
-    d = np.broadcast_to(still.displacement, (n_s, nt, 3)).copy()
-    H = np.broadcast_to(still.tension, (n_s, system.n_spans)).copy()
-    Rres = np.broadcast_to(still.insulator_force, (n_s, nt)).copy()
-    idx = np.flatnonzero(system.suspension)
-    k = idx.size
-    adj = np.flatnonzero(np.diff(idx) == 1)
-    tol_d = tol * max(v, 1.0)
-    active = np.ones(n_s, dtype=bool)
-    out_d, out_H, out_R = np.empty_like(d), np.empty_like(H), np.empty((n_s, nt, 3))
-    out_Rres, out_res = np.empty_like(Rres), np.zeros(n_s)
-    out_it = np.zeros(n_s, dtype=int)
-    change = np.full(n_s, np.inf)
-    residual = np.full(n_s, np.inf)
-    for it in range(1, max_iter + 1):
-        if cancel is not None and cancel.is_set():
-            raise Cancelled("step 1 cancelled")
-        d_old = d.copy()
-        # ---- inner Newton on d_x (paper Eq. 3), R_res fixed; converged states frozen
-        inner = active.copy()
-        for _inner in range(50):
-            l = L + np.diff(d[..., 0], axis=-1)
-            H, C = sp.tension(l, np.diff(d[..., 1], axis=-1), np.diff(d[..., 2], axis=-1), H)
-            if k == 0 or not inner.any():
-                break
-            fx = np.zeros((n_s, nt))
-            fx[:, :-1] += H
-            fx[:, 1:] -= H
-            fx = fx - d[..., 0] * Rres / v
-            diag = -Rres / v
-            diag[:, :-1] -= C
-            diag[:, 1:] -= C
-            off = np.zeros((n_s, max(k - 1, 0)))
-            off[:, adj] = C[:, idx[adj]]
-            step = _tridiag_solve(off, diag[:, idx], off, -fx[:, idx])
-            step[~inner] = 0.0
-            d[:, idx, 0] += step
-            inner &= ~(np.max(np.abs(step), axis=1) <= 1e-3 * tol_d)
-        l = L + np.diff(d[..., 0], axis=-1)
-        H, _ = sp.tension(l, np.diff(d[..., 1], axis=-1), np.diff(d[..., 2], axis=-1), H)
-        R = _reactions(sp, H, l, d[..., 1], d[..., 2], nt)
-        Rn = np.linalg.norm(R, axis=-1)
-        Rres = np.where(active[:, None], Rn, Rres)
-        finite = np.all(np.isfinite(R.reshape(n_s, -1)), axis=1) & np.all(np.isfinite(d.reshape(n_s, -1)), axis=1)
-        if not np.all(finite | ~active):
-            j = int(np.flatnonzero(~finite & active)[0])
-            raise ConvergenceError(f"{labels[j]}: non-finite values after {it} iterations")
-        # ---- insulator equilibrium (paper Eq. 4)
-        if k:
-            a = active
-            dn = np.stack([v * R[:, idx, 0] / Rres[:, idx], v * R[:, idx, 1] / Rres[:, idx],
-                           v - v * R[:, idx, 2] / Rres[:, idx]], axis=-1)
-            d[:, idx] = np.where(a[:, None, None], dn, d[:, idx])
-            change = np.where(a, np.max(np.abs(d - d_old).reshape(n_s, -1), axis=1), change)
-            axis = np.stack([d_old[:, idx, 0], d_old[:, idx, 1], v - d_old[:, idx, 2]], axis=-1) / v
-            res = np.max(np.linalg.norm(R[:, idx] - Rn[:, idx, None] * axis, axis=-1), axis=1)
-            residual = np.where(a, res, residual)
-        else:
-            change = np.where(active, 0.0, change)
-            residual = np.where(active, 0.0, residual)
-        done = active & (change <= tol_d)
-        out_d[done], out_H[done], out_R[done] = d[done], H[done], R[done]
-        out_Rres[done], out_res[done], out_it[done] = Rres[done], residual[done], it
-        active &= ~done
-        if progress is not None:
-            progress(int(n_s - active.sum()), n_s)
-        if not active.any():
-            break
-    else:
-        j = int(np.flatnonzero(active)[0])
-        raise ConvergenceError(
-            f"{labels[j]}: step-1 static solver did not converge in {max_iter} iterations "
-            f"(last displacement change {change[j]:.3g} m, out-of-balance force {residual[j]:.3g} N)"
-        )
-    return [_final_state(system, sp.Lu, sp.my_hat[j], sp.mz_hat, out_d[j], out_H[j], out_R[j], out_Rres[j],
-                         int(out_it[j]), float(out_res[j]), labels[j]) for j in range(n_s)]
+    d = np.broadcast_to(still.displacement, (n_s, nt, 3))
+    H = np.broadcast_to(still.tension, (n_s, system.n_spans))
+    Rres = np.broadcast_to(still.insulator_force, (n_s, nt))
+    return _fig6_iteration(system, gy, d, H, Rres, labels=labels, tol=tol, max_iter=max_iter,
+                           progress=progress, cancel=cancel)
 
 
 @dataclass(frozen=True)

@@ -625,7 +625,7 @@ def _downburst_field_cached(case: Case, stamp: tuple[int, int] | None) -> Downbu
     src = str(case.source) if case.source else None
     dj = db.jet_diameter
     h = line.height
-    x_toi = (case.line.tower_of_interest - 1) * line.span_length
+    x_toi = float(LineSystem(line).tower_x[case.line.tower_of_interest - 1])
     theta = math.radians(db.angle)
     # paper Fig. 2: centre at distance R, angle Theta from the perpendicular through the tower, upwind (-y)
     sin_t, cos_t = math.sin(theta), math.cos(theta)
@@ -717,8 +717,7 @@ def _downburst_field_cached(case: Case, stamp: tuple[int, int] | None) -> Downbu
 # ------------------------------------------------------------------------- public evaluators
 def span_node_x(system: LineSystem) -> np.ndarray:
     """Still-air x [m] of each span's FE nodes, shape (n_spans, ne+1)."""
-    L = system.line.span_length
-    return system.tower_x[:-1, None] + system.node_s[None, :] * L
+    return system.span_node_x0
 
 
 def mean_velocity_at(case: Case, x: np.ndarray, time: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -738,7 +737,7 @@ def mean_velocity_at(case: Case, x: np.ndarray, time: np.ndarray) -> tuple[np.nd
 def point_p(case: Case) -> float:
     """x [m] of point p: the line point nearest the downburst centre (synoptic: tower of interest)."""
     if case.wind.type == "synoptic":
-        return (case.line.tower_of_interest - 1) * case.line.span_length
+        return float(LineSystem(case.line).tower_x[case.line.tower_of_interest - 1])
     return downburst_field(case).point_p
 
 

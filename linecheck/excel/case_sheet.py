@@ -65,7 +65,7 @@ def write_case(ws: Worksheet, doc: RunDocument, threshold: float, chart_points: 
     contrib_rows = _contributions_table(cur, doc, threshold, flagged)
     _towers_table(cur, doc)
     if doc.spectral is not None:
-        _spectral(cur, doc)
+        _spectral(cur, doc, doc.spectral)
     elif doc.wind == "synoptic":
         cur.row += 1
         cur.note("Spectral check: not in this result (run without --no-check to add it).")
@@ -319,10 +319,8 @@ SPECTRAL_DAVENPORT = {
 }
 
 
-def _spectral(cur: Cursor, doc: RunDocument) -> None:
-    """The frequency-domain check of a synoptic run (the typed ``spectral`` block)."""
-    sp = doc.spectral
-    assert sp is not None
+def _spectral(cur: Cursor, doc: RunDocument, sp) -> None:
+    """The frequency-domain check of a synoptic run: ``sp``, the document's typed ``spectral`` block."""
     cur.section("Spectral check: frequency domain beside the time domain (synoptic)")
     for label, unit, v in (("record duration T (peak factor)", "s", sp.duration),
                            ("frequencies in the band", "", sp.n_frequencies)):

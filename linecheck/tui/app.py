@@ -180,8 +180,7 @@ class LinecheckApp(App[None]):
         With unsaved edits a dialog asks first (unless ``discard``): opening another case
         (browser, palette) never drops them silently.
         """
-        if self.edited and not discard:
-            assert self.case is not None and self.original is not None
+        if self.edited and not discard and self.case is not None and self.original is not None:
             keys = [k for k, _a, _b in case_differences(self.original, self.case)]
             shown = ", ".join(keys[:4]) + (f" and {len(keys) - 4} more" if len(keys) > 4 else "")
 

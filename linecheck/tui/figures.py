@@ -47,7 +47,8 @@ def reaction_history(doc: RunDocument, reaction: str) -> Figure:
     From the document's ``time_histories`` (realization 1, thinned keeping the peaks).
     """
     th = doc.time_histories
-    assert th is not None
+    if th is None:
+        raise ValueError(f"{doc.case}: the result document has no time histories to plot")
     t = np.asarray(th.time, dtype=float)
     blk = th.series[reaction]
 

@@ -153,7 +153,7 @@ class ResultsView(Vertical):
         self.query_one("#summary-notes", Static).update(notes)
 
     def _history(self) -> None:
-        if self.output is not None:
+        if self.output is not None and self.output.doc.time_histories is not None:
             self.query_one("#plot-history", PlotView).show(figures.reaction_history(self.output.doc, self.reaction))
 
     @on(TabbedContent.TabActivated, "#results-tabs")

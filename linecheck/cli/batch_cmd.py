@@ -20,11 +20,21 @@ from rich.progress import BarColumn, Progress, TaskID, TextColumn, TimeElapsedCo
 from rich.table import Table
 
 from ..core.errors import CaseError
+from ..core.extremes import (
+    CONT_R_THRESHOLD as CONT_R_FLAG,  # Cont_R flag, paper Sect. 5 (one definition)
+)
 from ..io.display import STAT_ROWS
 from ..io.document import RunDocument, SanityItem
 from .app import CaseArg, app, console, err_console, handle_errors, read_case
+from .export_cmd import (
+    EngineerOpt,
+    LineOpt,
+    ProjectOpt,
+    RevisionOpt,
+    TitleOpt,
+    title_block,
+)
 from .limits import MaxMemoryOpt, apply_max_memory
-from .export_cmd import EngineerOpt, LineOpt, ProjectOpt, RevisionOpt, TitleOpt, title_block
 from .stats_view import MaxRealOpt, UntilOpt, parse_until
 
 JobsOpt = Annotated[int | None, typer.Option(
@@ -224,9 +234,6 @@ def _kn(doc: RunDocument | None, reaction: str, stat: str, fmt: str = "{:.2f}") 
     return "**" if v is None else fmt.format(v * STAT_ROWS[stat].scale)
 
 
-#: Cont_R above this (a fraction) is flagged "dynamic analysis recommended" (the paper's conclusion;
-#: the same threshold as the Excel summary's default --cont-r-threshold and the TUI)
-CONT_R_FLAG = 0.10
 REACTION_NAMES = ("Rx", "Ry", "Rz")
 QUANTITY_TEXT = {"rms_background": "background r.m.s.", "rms_fluctuating": "fluctuating r.m.s."}
 

@@ -13,6 +13,7 @@ from typing import Annotated
 import typer
 
 from ..core.errors import CaseError
+from ..core.extremes import CONT_R_THRESHOLD
 from .app import app, console, handle_errors
 
 ExcelOpt = Annotated[Path | None, typer.Option(
@@ -84,7 +85,7 @@ def export(
     excel: Annotated[Path, typer.Option("--excel", help="Excel design sheet (.xlsx) to write.", show_default=False)],
     template: TemplateOpt = None,
     force: ForceOpt = False,
-    cont_r_threshold: ThresholdOpt = 0.10,
+    cont_r_threshold: ThresholdOpt = CONT_R_THRESHOLD,
     project: ProjectOpt = None,
     line: LineOpt = None,
     engineer: EngineerOpt = None,

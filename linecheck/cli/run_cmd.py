@@ -8,6 +8,7 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
+from ..core.extremes import CONT_R_THRESHOLD as CONT_R_FLAG  # Cont_R flag, paper Sect. 5 (one definition)
 from .. import service
 from ..core.case import Case
 from ..core.results import REACTIONS
@@ -64,9 +65,6 @@ def console_header(st: StatDef, width: int = 7) -> str:
     return "\n".join(lines)
 
 
-#: Cont_R (fraction) above which the table marks a reaction: "dynamic analysis recommended" (as the
-#: Excel design sheet's default --cont-r-threshold; paper Sect. 5).
-CONT_R_FLAG = 0.10
 #: Reactions whose Cont_R is flagged (the paper's Table 5 reactions, as in the Excel Summary; Rz's
 #: wind-induced part is small beside the conductor weight, its Cont_R is not a design signal).
 FLAGGED_REACTIONS = ("Rx", "Ry")

@@ -37,6 +37,7 @@ from openpyxl import Workbook
 
 from ..core.case import MAX_RESULT_BYTES, read_text_file
 from ..core.errors import CaseError
+from ..core.extremes import CONT_R_THRESHOLD
 from ..io.atomic import atomic_path, check_target
 from ..io.document import FailedRun, RunDocument, load_document
 from . import template as tpl
@@ -81,7 +82,7 @@ def write_workbook(
     *,
     template: Path | None = None,
     force: bool = False,
-    cont_r_threshold: float = 0.10,
+    cont_r_threshold: float = CONT_R_THRESHOLD,
     title: dict | None = None,
     chart_points: int = CHART_POINTS,
     reactions: Sequence[str] = SUMMARY_REACTIONS,

@@ -15,6 +15,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..core.case import SCHEMA, Case, FieldSpec
+from ..core.extremes import (
+    CONT_R_THRESHOLD as CONT_R_FLAG,  # Cont_R flag, paper Sect. 5 (one definition)
+)
 from ..io.display import (  # noqa: F401  (shared with the CLI)
     STAT_ROWS,
     SUMMARY_STATS,
@@ -27,7 +30,6 @@ from ..io.display import (  # noqa: F401  (shared with the CLI)
 from ..io.document import RunDocument, StatDef
 
 REACTIONS = ("Rx", "Ry", "Rz")
-CONT_R_FLAG = 0.10  # Cont_R above this: "dynamic analysis recommended" (paper's conclusion)
 
 
 def summary_rows(doc: RunDocument) -> list[tuple[str, str, str, str, str]]:

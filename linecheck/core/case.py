@@ -917,6 +917,9 @@ def case_hash(path: str | Path) -> str:
 
 
 # --------------------------------------------------------------------------- editing / writing
+_QUIET_DEFAULTS = ("direction", "profile_exponent")
+
+
 def case_to_dict(case: Case) -> dict[str, Any]:
     """The TOML document of a case (only keys that are set), inverse of :func:`case_from_dict`."""
     def pick(obj: Any, section: str) -> dict[str, Any]:
@@ -939,6 +942,9 @@ def case_to_dict(case: Case) -> dict[str, Any]:
             doc["line"]["towers"] = [{k: v for k, v in dataclasses.asdict(t).items() if v is not None}
                                      for t in case.line.towers]
     doc["wind"] = pick(case.wind, "wind")
+    for key in _QUIET_DEFAULTS:  # issue 17 keys at their defaults are not written (older documents unchanged)
+        if doc["wind"].get(key) == field_spec("wind", key).default:
+            doc["wind"].pop(key)
     if case.wind.downburst is not None:
         db = pick(case.wind.downburst, "wind.downburst")
         if db.get("preset"):

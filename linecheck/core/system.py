@@ -328,6 +328,19 @@ class LineSystem:
         T[:, 2, 2] = 1.0
         return T
 
+    @cached_property
+    def node_gaps(self) -> np.ndarray:
+        """[m] plan distance between neighbouring still-air FE nodes, (n_nodes - 1,): the spacing
+        of the Markov (exponential) coherence along the line (equal-span form: the element length)."""
+        if not self.is_section:
+            return np.repeat(self.element_lengths, self.ne)
+        return np.linalg.norm(np.diff(self.node_xyz0[:, :2], axis=0), axis=1)
+
+    @cached_property
+    def eq17_lengths(self) -> np.ndarray:
+        """[m] Eq. 17's L_x at every tower: the mean of its adjacent spans (ends: its span), (n_towers,)."""
+        return np.array([self.span_lengths_at_tower(j) for j in range(self.n_towers)])
+
     def span_lengths_at_tower(self, j: int) -> float:
         """[m] Eq. 17's L_x at tower j (0-based): the mean of its adjacent spans' horizontal lengths."""
         L = self.span_lengths

@@ -132,8 +132,29 @@ def test_cli_scan_table_csv_and_dynamic(tmp_path):
     assert r.exit_code == 0, r.output
     assert "critical downburst configurations" in r.output and "Db_x: R = 1.6 D_j" in r.output
     assert "full analysis at the critical configurations" in r.output
+    assert "by the expected dynamic peak" in r.output and "same position" in r.output
     assert len(out.read_text().splitlines()) == 1 + 4
     assert list((tmp_path / "dyn").glob("*.json"))
+
+
+def test_scan_ranks_by_the_expected_dynamic_peak(tmp_path):
+    """Issue 20: with dynamic_realizations the scan runs steps 1-3 at every position; the value
+    ranked is the realization mean of the dynamic peak |M+B+R| at the tower of interest, equal
+    to run_case's own statistics there (same seeds), never below the point's largest |mean|."""
+    from linecheck.batch.tasks import apply_changes, scan_changes
+    from linecheck.service import run_case
+
+    path = write_short_case(CASES / "paper" / "case01-single.toml", tmp_path, realizations=2, duration=30.0)
+    grid = ScanGrid.from_options(load_case(path), "1.2,1.6Dj", "30", None)
+    res = run_scan(path, grid, hold="vref", dynamic_realizations=2)
+    assert res.dynamic is not None and res.dynamic.shape == (2, 3)
+    assert np.all(res.dynamic >= np.abs(res.peak) * (1 - 1e-12))  # M+B+R peaks include the mean's
+    crit = res.critical("Ry", "peak")
+    r, th, dj = res.points[crit.index]
+    again = run_case(apply_changes(load_case(path), scan_changes(r, th, dj)), realizations=[0, 1], spectral_check=False)
+    assert crit.value == again.stats.peak_dynamic[:, 0, 1].mean()  # bit-identical: same case and seeds
+    assert res.critical("Ry", "mean") is not None
+    assert "Ry_peak_N" in scan_csv_text(res).splitlines()[0]
 
 
 def test_cli_scan_usage_errors(tmp_path):

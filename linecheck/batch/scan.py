@@ -210,39 +210,54 @@ class ScanResult:
     elapsed: float = 0.0
     executor: str = ""
     model: str | None = None  # downburst model scanned (issue 15); None: the case's own
+    dynamic: np.ndarray | None = None  # [N] expected dynamic peak |M+B+R| per point (n, 3) (issue 20)
+    dynamic_realizations: int = 0  # realizations behind ``dynamic``
 
     @property
     def n_failed(self) -> int:
         return sum(e is not None for e in self.errors)
 
-    def critical(self, reaction: str | int) -> Critical | None:
-        """The point with the largest |peak| of ``reaction`` (``"Rx"``/0, ``"Ry"``/1, ``"Rz"``/2)."""
+    def critical(self, reaction: str | int, by: str = "mean") -> Critical | None:
+        """The point with the largest |peak| of ``reaction`` (``"Rx"``/0, ``"Ry"``/1, ``"Rz"``/2).
+
+        ``by="mean"``: the largest wind-induced mean (step 1); ``by="peak"``: the largest expected
+        dynamic peak (a scan with ``dynamic_realizations``; its ``value`` is that peak, its
+        ``time`` the instant of the point's largest mean)."""
         c = REACTIONS.index(reaction) if isinstance(reaction, str) else int(reaction)
-        mag = np.abs(self.peak[:, c])
+        if by == "peak":
+            if self.dynamic is None:
+                return None
+            mag = np.abs(self.dynamic[:, c])
+        else:
+            mag = np.abs(self.peak[:, c])
         if not np.any(np.isfinite(mag)):
             return None
         i = int(np.nanargmax(mag))  # first point on ties (grid order)
         r, th, dj = self.points[i]
-        return Critical(REACTIONS[c], i, float(r), float(th), float(dj), float(self.peak[i, c]), float(self.time[i, c]),
+        value = self.dynamic[i, c] if by == "peak" else self.peak[i, c]
+        return Critical(REACTIONS[c], i, float(r), float(th), float(dj), float(value), float(self.time[i, c]),
                         float(self.v_ref[i]))
 
-    def criticals(self, reactions: Sequence[str] = ("Rx", "Ry")) -> list[Critical]:
-        return [c for c in (self.critical(r) for r in reactions) if c is not None]
+    def criticals(self, reactions: Sequence[str] = ("Rx", "Ry"), by: str = "mean") -> list[Critical]:
+        return [c for c in (self.critical(r, by) for r in reactions) if c is not None]
 
 
 def scan_csv_text(result: ScanResult) -> str:
     """CSV of every scan point (SI units; empty cells where a point failed)."""
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
+    dyn = result.dynamic
+    extra = ["Rx_peak_N", "Ry_peak_N", "Rz_peak_N"] if dyn is not None else []
     w.writerow(["jet_diameter_m", "distance_m", "distance_over_dj", "angle_deg", "v_ref_at_p_m_s",
-                "Rx_N", "Ry_N", "Rz_N", "t_Rx_s", "t_Ry_s", "t_Rz_s", "error"])
+                "Rx_N", "Ry_N", "Rz_N", "t_Rx_s", "t_Ry_s", "t_Rz_s", *extra, "error"])
 
     def f(x: float) -> str:
         return "" if not math.isfinite(x) else repr(float(x))
 
     for i, (r, th, dj) in enumerate(result.points):
+        more = [f(v) for v in dyn[i]] if dyn is not None else []
         w.writerow([repr(float(dj)), repr(float(r)), f(r / dj), repr(float(th)), f(result.v_ref[i]),
-                    *(f(v) for v in result.peak[i]), *(f(v) for v in result.time[i]), result.errors[i] or ""])
+                    *(f(v) for v in result.peak[i]), *(f(v) for v in result.time[i]), *more, result.errors[i] or ""])
     return buf.getvalue()
 
 
@@ -278,10 +293,13 @@ def run_scan(
     progress: Callable[[str, int, int], None] | None = None,
     cancel: threading.Event | None = None,
     model: str | None = None,
+    dynamic_realizations: int = 0,
 ) -> ScanResult:
     """Step 1 at every grid point of ``grid`` for the case in ``case_path``.
 
     ``model``: scan under this downburst running-mean model (issue 15; ``None``: the case's own).
+    ``dynamic_realizations``: k > 0 runs steps 1-3 with realizations 0..k-1 at every point too,
+    so that positions are ranked by the expected dynamic peak (issue 20; ``critical(r, "peak")``).
 
     Args:
         hold: ``"jet"`` (default): one storm, V_max held at its value for the case's own
@@ -322,8 +340,11 @@ def run_scan(
         kwargs = {"cancel": cancel} if executor.in_process and cancel is not None else {}
         if model is not None:
             kwargs["model"] = model
+        if dynamic_realizations > 0:
+            kwargs["dynamic_realizations"] = int(dynamic_realizations)
         handles.append(executor.submit(scan_chunk, str(path), chunk, a, digest, v_max, **kwargs))
     peak = np.full((n, 3), np.nan)
+    dyn = np.full((n, 3), np.nan) if dynamic_realizations > 0 else None
     tt = np.full((n, 3), np.nan)
     vref = np.full(n, np.nan)
     errors: list[str | None] = [None] * n
@@ -347,6 +368,8 @@ def run_scan(
                 peak[value.start:value.start + m] = value.peak
                 tt[value.start:value.start + m] = value.time
                 vref[value.start:value.start + m] = value.v_ref
+                if dyn is not None and value.dynamic is not None:
+                    dyn[value.start:value.start + m] = value.dynamic
                 errors[value.start:value.start + m] = list(value.errors)
                 done += m
                 if progress is not None:
@@ -357,13 +380,15 @@ def run_scan(
         executor.abort([handles[i] for i in pending])
         raise
     return ScanResult(case, path, pts, peak, tt, vref, tuple(errors), hold, v_max,
-                      time.perf_counter() - t0, executor.describe(), model)
+                      time.perf_counter() - t0, executor.describe(), model, dyn, int(dynamic_realizations))
 
 
-def critical_jobs(result: ScanResult, reactions: Sequence[str] = ("Rx", "Ry")) -> list[RunJob]:
-    """One run per distinct critical configuration (reactions sharing one are grouped)."""
+def critical_jobs(result: ScanResult, reactions: Sequence[str] = ("Rx", "Ry"), by: str | None = None) -> list[RunJob]:
+    """One run per distinct critical configuration (reactions sharing one are grouped);
+    ``by``: "mean" or "peak" (default: "peak" when the scan has dynamic peaks, else "mean")."""
+    by = by or ("peak" if result.dynamic is not None else "mean")
     groups: dict[tuple[float, float, float], list[str]] = {}
-    for c in result.criticals(reactions):
+    for c in result.criticals(reactions, by):
         groups.setdefault((c.distance, c.angle, c.jet_diameter), []).append(c.reaction)
     stem = result.case_path.stem
     jobs = []

@@ -144,6 +144,7 @@ class ScanChunk:
     time: np.ndarray
     v_ref: np.ndarray
     errors: tuple[str | None, ...]
+    dynamic: np.ndarray | None = None  # [N] mean over realizations of the dynamic peak |M + B + R|, (n_points, 3)
 
 
 def fixed_jet_case(case: Case, v_max: float, *, iterations: int = 4) -> Case:
@@ -169,25 +170,34 @@ def fixed_jet_case(case: Case, v_max: float, *, iterations: int = 4) -> Case:
 
 
 def scan_point(case: Case, distance: float, angle: float, jet_diameter: float,
-               v_max: float | None = None) -> tuple[np.ndarray, np.ndarray, float]:
-    """Step 1 at one downburst configuration.
+               v_max: float | None = None, dynamic_realizations: int = 0):
+    """Step 1 (and with ``dynamic_realizations`` > 0 steps 1-3) at one downburst configuration.
 
     Returns (signed peak wind-induced mean reaction at the tower of interest [N] (3,),
-    its instant [s] (3,), the V_ref at point p used [m/s]).
+    its instant [s] (3,), the V_ref at point p used [m/s]) and, with ``dynamic_realizations``
+    = k > 0, a fourth item: the expected dynamic peak |M + B + R| of each reaction [N] (3,), the
+    mean over realizations 0..k-1 (issue 20: the scan ranks by the peak the design carries).
 
     ``v_max``: hold the storm's V_max [m/s] fixed (:func:`fixed_jet_case`); ``None``
     keeps the case's V_ref at point p of every configuration.
     """
-    from ..service import static_analysis
+    from ..service import run_case, static_analysis
 
     c = apply_changes(case, scan_changes(distance, angle, jet_diameter))
     if v_max is not None:
         c = fixed_jet_case(c, v_max)
-    st = static_analysis(c)
-    rw = st.mean.reactions_wind[:, c.line.tower_of_interest - 1, :]  # (n_t, 3)
+    j = c.line.tower_of_interest - 1
+    if dynamic_realizations > 0:
+        res = run_case(c, realizations=list(range(dynamic_realizations)), spectral_check=False)
+        st = res.static
+        dyn = res.stats.peak_dynamic[:, j, :].mean(axis=0)
+    else:
+        st = static_analysis(c)
+    rw = st.system.to_tower_frames(st.mean.reactions_wind)[:, j, :]  # (n_t, 3), the tower's own frame
     k = np.argmax(np.abs(rw), axis=0)
     comp = np.arange(rw.shape[1])
-    return rw[k, comp].copy(), st.mean.time[k].copy(), float(c.wind.v_ref)
+    out = (rw[k, comp].copy(), st.mean.time[k].copy(), float(c.wind.v_ref))
+    return out + (dyn,) if dynamic_realizations > 0 else out
 
 
 def scan_chunk(
@@ -199,10 +209,13 @@ def scan_chunk(
     *,
     cancel: threading.Event | None = None,
     model: str | None = None,
+    dynamic_realizations: int = 0,
 ) -> Any:
     """Step 1 at each (distance R [m], angle Theta [deg], jet diameter D_j [m]) of ``points``.
 
     ``model``: the downburst running-mean model to scan under (issue 15; ``None``: the case's own).
+    ``dynamic_realizations``: k > 0 also runs steps 1-3 with realizations 0..k-1 at every point
+    and returns the expected dynamic peaks (issue 20).
 
     ``v_max`` [m/s]: the storm's fixed V_max (see :func:`scan_point`), or ``None``.
 
@@ -223,17 +236,21 @@ def scan_chunk(
     peak = np.full((n, 3), np.nan)
     time = np.full((n, 3), np.nan)
     vref = np.full(n, np.nan)
+    dyn = np.full((n, 3), np.nan) if dynamic_realizations > 0 else None
     errors: list[str | None] = [None] * n
     for i, (r, th, dj) in enumerate(points):
         if cancel is not None and cancel.is_set():
             raise Cancelled("scan cancelled")
         try:
-            peak[i], time[i], vref[i] = scan_point(case, r, th, dj, v_max)
+            got = scan_point(case, r, th, dj, v_max, dynamic_realizations)
+            peak[i], time[i], vref[i] = got[:3]
+            if dyn is not None:
+                dyn[i] = got[3]
         except Cancelled:
             raise
         except LinecheckError as err:
             errors[i] = str(err)
-    return ScanChunk(start, peak, time, vref, tuple(errors))
+    return ScanChunk(start, peak, time, vref, tuple(errors), dyn)
 
 
 def ignore_sigint() -> None:

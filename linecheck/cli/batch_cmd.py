@@ -437,6 +437,25 @@ def scan_table(result: Any) -> Table:
     return t
 
 
+def peak_scan_table(result: Any) -> Table:
+    """Critical configurations by the expected dynamic peak beside those by the mean (issue 20)."""
+    t = Table(title=f"critical configurations by the expected dynamic peak |M + B + R| "
+                    f"(mean of {result.dynamic_realizations} realization(s) per position) and by the mean",
+              title_justify="left")
+    for col in ("reaction", "ranked by", "R m", "R/D_j", "Θ deg", "D_j m", "value kN", "same position"):
+        t.add_column(col, justify="right" if col not in ("reaction", "ranked by", "same position") else "left")
+    for r in ("Rx", "Ry"):
+        cm, cp = result.critical(r, "mean"), result.critical(r, "peak")
+        for by, c in (("peak", cp), ("mean", cm)):
+            if c is None:
+                continue
+            same = "yes" if (cm is not None and cp is not None and cm.index == cp.index) else "no"
+            label = "expected peak" if by == "peak" else "max |mean|"
+            t.add_row(r, label, f"{c.distance:.0f}", f"{c.distance_over_dj:.2f}", f"{c.angle:g}", f"{c.jet_diameter:.0f}",
+                      f"{c.value / 1e3:.3f}", same)
+    return t
+
+
 def dynamic_table(report: Any) -> Table:
     t = Table(title="full analysis at the critical configurations", title_justify="left")
     for col in ("run", "status", "peak Rx kN", "peak Ry kN", "GF_Dy Rx", "GF_Dy Ry", "Cont_R Rx %", "Cont_R Ry %"):
@@ -452,7 +471,7 @@ def dynamic_table(report: Any) -> Table:
 
 def _scan_each_model(case_file: Path, case: Any, grid: Any, names: tuple[str | None, ...], *, hold: str,
                      csv_out: Path | None, dynamic: bool, json_dir: Path | None, jobs: int | None,
-                     scheduler: str | None, connect_timeout: float = 10.0) -> None:
+                     scheduler: str | None, connect_timeout: float = 10.0, dynamic_realizations: int = 3) -> None:
     """The scan under each downburst model of ``names`` (None: the case's own model; ``scan
     --models`` gives several), then the critical position per model."""
     from ..batch import make_executor, run_critical, run_scan, write_scan_csv
@@ -465,11 +484,13 @@ def _scan_each_model(case_file: Path, case: Any, grid: Any, names: tuple[str | N
             try:
                 with progress_bar() as cb:
                     result = run_scan(case_file, grid, executor=executor, hold=hold, progress=cb, cancel=cancel,
-                                      model=model)
+                                      model=model, dynamic_realizations=dynamic_realizations if dynamic else 0)
             except KeyboardInterrupt:
                 cancel.set()
                 raise
             console.print(scan_table(result))
+            if result.dynamic is not None:
+                console.print(peak_scan_table(result))
             strength = (f"one storm, V_max = {result.v_max:.1f} m/s (the case's own configuration)"
                         if result.hold == "jet" else f"V_ref = {case.wind.v_ref:g} m/s at point p everywhere")
             console.print(f"[dim]{grid.size} configurations in {result.elapsed:.1f} s on {escape(result.executor)}; "
@@ -487,8 +508,8 @@ def _scan_each_model(case_file: Path, case: Any, grid: Any, names: tuple[str | N
                 raise CaseError("no scan configuration could be analysed", file=str(case_file))
             summary.append(result)
             if dynamic:
-                console.print(f"[dim]full analysis at the critical configurations with the case's V_ref = "
-                              f"{case.wind.v_ref:g} m/s at point p[/]", highlight=False)
+                console.print(f"[dim]full analysis at the critical configurations of the expected dynamic peak "
+                              f"with the case's V_ref = {case.wind.v_ref:g} m/s at point p[/]", highlight=False)
                 with BatchDisplay() as display:
                     report = run_critical(result, executor=executor, json_dir=json_dir, progress=display, cancel=cancel)
                 console.print(dynamic_table(report))
@@ -518,7 +539,12 @@ def scan(
         "--hold", help="Storm strength over the grid: 'jet' = one storm (V_max of the case's own configuration) "
                        "moved around; 'vref' = the case's V_ref at point p in every configuration.")] = "jet",
     dynamic: Annotated[bool, typer.Option(
-        "--dynamic", help="Then run the full three-step analysis at the critical configurations.")] = False,
+        "--dynamic", help="Rank every position by the expected dynamic peak |M+B+R| (steps 1-3 with "
+                          "--dynamic-realizations realizations each), report the critical positions for the peak "
+                          "and for the mean, then run the full analysis at the peak-critical ones.")] = False,
+    dynamic_realizations: Annotated[int, typer.Option(
+        "--dynamic-realizations", min=1, max=1000,
+        help="With --dynamic: realizations per position for the expected peak (their mean).")] = 3,
     json_dir: Annotated[Path | None, typer.Option(
         "--json-dir", help="With --dynamic: save the critical runs' JSON results in this folder.",
         show_default=False)] = None,
@@ -543,4 +569,5 @@ def scan(
 
     names = service.parse_models(case, models) if models is not None else (None,)  # None: the case's own model
     _scan_each_model(case_file, case, grid, names, hold=hold, csv_out=csv_out, dynamic=dynamic, json_dir=json_dir,
-                     jobs=jobs, scheduler=scheduler, connect_timeout=connect_timeout)
+                     jobs=jobs, scheduler=scheduler, connect_timeout=connect_timeout,
+                     dynamic_realizations=dynamic_realizations)

@@ -161,6 +161,23 @@ def test_asnzs_pressure_and_srf():
     assert not r.verified
 
 
+def test_verified_flags_match_this_document():
+    # docs/codes.md is the record of what was checked against which published value; its case-9
+    # table has a "verified" column.  A code's flag in linecheck/core/codes.py may only be True
+    # where that page says "yes" (a flag flipped without documenting the published value, or a
+    # verification documented without the flag, fails here).
+    import re
+
+    doc = (ROOT / "docs" / "codes.md").read_text(encoding="utf-8")
+    rows = dict(re.findall(r"^\| (ASCE74|IEC60826|EN50341|ASNZS7000) \| (yes|no) \|", doc, flags=re.M))
+    assert set(rows) == set(C.CODES)
+    loads = {"ASCE74": C.asce74_wire_load(40.0, 43.0, 300.0, 0.022),
+             "IEC60826": C.iec60826_conductor_load(40.0, 43.0, 300.0, 0.022),
+             "EN50341": C.en50341_conductor_load(40.0, 43.0, 300.0, 0.022),
+             "ASNZS7000": C.asnzs7000_conductor_load(40.0, 43.0, 300.0, 0.022)}
+    assert {code: r.verified for code, r in loads.items()} == {code: v == "yes" for code, v in rows.items()}
+
+
 # --------------------------------------------------------------------------- validity
 @pytest.mark.parametrize("fn,kw,key", [
     (C.iec60826_conductor_load, dict(height=70.0, span=300.0), "line.height"),

@@ -183,6 +183,10 @@ IEC_TERRAIN = {  # category: (K_R [-], alpha [-])
 # design standard, built on IEC 60826's method with the same K_R and 10-min reference wind),
 # as published in the same public implementation (normaslt/nbr5422.py, fatCombVentoCabo).
 # IEC 60826's own G_c figure could not be obtained from a public source; see docs/codes.md.
+# Open point (docs/codes.md, "Verification"): two other public transcriptions of the same log
+# fits (an anonymous 2019 design spreadsheet and another NBR 5422 implementation, neither a
+# citable publication) print b = 0.9124 for terrain C, not 0.9214 (a digit transposition on one
+# side; G_c differs by 0.009, 0.3-0.4 %).  The cited value is kept; nothing is tuned to either.
 IEC_GC_STANDIN = {  # category: (a [-], b [-])
     "A": (0.2914, 1.0468),
     "B": (0.3733, 0.9762),

@@ -128,14 +128,14 @@ def reference_height(case: Case) -> float:
 def profile_factor(case: Case, z_agl: np.ndarray) -> np.ndarray:
     """V(z)/v_ref [-] = (z_agl / z_ref)^alpha at heights above ground z_agl [m] (any shape).
 
-    Power law (Davenport 1960; Holmes, "Wind loading of structures", 3rd ed. 2015, sec. 3.2.3);
+    Power law (Hellmann 1916; Davenport 1960);
     alpha = ``profile_exponent`` (0: exactly 1 everywhere).  A point at or below the ground
     (possible only for a sagging conductor) gets 0."""
     z_agl = np.asarray(z_agl, dtype=float)
     alpha = float(case.wind.profile_exponent)
     if alpha == 0.0:
         return np.ones_like(z_agl)
-    # Holmes (2015) Eq. 3.3: V(z) = V_ref (z / z_ref)^alpha
+    # power law (Hellmann 1916; Davenport 1960): V(z) = V_ref (z / z_ref)^alpha
     return (np.maximum(z_agl, 0.0) / reference_height(case)) ** alpha
 
 

@@ -137,6 +137,18 @@ def test_markov_factor_is_the_cholesky_factor_of_davenport_coherence_on_unequal_
     np.testing.assert_array_equal(auto, tb.synthesize(X_UNEQUAL, grid, phases, 10.0, 35.0, method="markov"))
 
 
+def test_markov_quadratic_form_is_w_h_coh_w_on_unequal_spacing():
+    """The O(N) quadratic form a frequency-domain check needs (spectral estimate on a section)."""
+    rng = np.random.default_rng(17)
+    f = np.array([0.004, 0.05, 0.6])
+    w = rng.normal(size=(2, X_UNEQUAL.size, f.size)) + 1j * rng.normal(size=(2, X_UNEQUAL.size, f.size))
+    got = tb.markov_quadratic_form(w, tb.gap_coherence(X_UNEQUAL, f, 10.0, 35.0))
+    for k, fk in enumerate(f):
+        coh = np.exp(-10.0 * fk * np.abs(np.subtract.outer(X_UNEQUAL, X_UNEQUAL)) / 35.0)  # dense Davenport
+        ref = np.einsum("ai,ij,aj->a", w[..., k].conj(), coh, w[..., k]).real
+        np.testing.assert_allclose(got[:, k], ref, rtol=1e-13)
+
+
 def test_synthesised_field_reproduces_the_target_coherence_on_unequal_spacing():
     """Empirical check from the time series (fixed seed): at bin k the field's Fourier coefficient
     is (M/2) A_k y_k with E[Re(y_j conj y_m)] = exp(-C f_k |x_j - x_m| / V) exactly, so the mean over

@@ -65,8 +65,10 @@ __all__ = [
     "fluctuating_velocity",
     "general_apply",
     "kms_apply",
+    "gap_coherence",
     "length_scale",
     "markov_apply",
+    "markov_quadratic_form",
     "mean_normal_at_nodes",
     "mean_speed_at_nodes",
     "modulation",
@@ -249,6 +251,33 @@ def markov_apply(x: np.ndarray, freq: np.ndarray, xi: np.ndarray, decay: float, 
         prev = rho * prev + s * xi[j]
         y[j] = prev
     return y
+
+
+def gap_coherence(x: np.ndarray, freq: np.ndarray, decay: float, v_mean: float) -> np.ndarray:
+    """Davenport coherence of neighbouring points rho_j = exp(-C f (x_j - x_(j-1)) / V) [-] for
+    ordered x [m] (n_nodes,) at f [Hz] (n_f,), shape (n_nodes - 1, n_f) (Davenport 1961)."""
+    gaps = np.diff(np.asarray(x, dtype=float))
+    return davenport_coherence(np.asarray(freq, dtype=float)[None, :], gaps[:, None], decay, v_mean)
+
+
+def markov_quadratic_form(w: np.ndarray, rho_gaps: np.ndarray) -> np.ndarray:
+    """w^H Coh w [-] for the Markov coherence Coh_jm = prod of the gap coefficients between j and m
+    (Davenport coherence at separations along ordered points, any spacing), O(N) per frequency.
+
+    w (..., N, n_f) complex (node axis second to last, frequency last); rho_gaps (N - 1, n_f) from
+    :func:`gap_coherence`.  Returns (..., n_f) real.  With h_j = sum_(i<j) Coh_ij w_i the recursion
+    h_j = rho_j (h_(j-1) + w_(j-1)) holds because Coh_ij = Coh_i,j-1 rho_j (Markov property), and
+    w^H Coh w = sum |w_j|^2 + 2 Re sum_j conj(w_j) h_j.  Equal gaps: the KMS form of the spectral
+    check (core/spectral.py ``_quad_kms_nodes``) -- this is its unequal-spacing generalisation.
+    """
+    h = np.zeros(w.shape[:-2] + w.shape[-1:], dtype=complex)
+    total = np.sum(w.real**2 + w.imag**2, axis=-2)
+    cross = np.zeros(total.shape)
+    for j in range(1, w.shape[-2]):
+        h += w[..., j - 1, :]
+        h *= rho_gaps[j - 1]  # h_j = rho_j (h_(j-1) + w_(j-1))
+        cross += w[..., j, :].real * h.real + w[..., j, :].imag * h.imag
+    return total + 2.0 * cross
 
 
 def _factor(c: np.ndarray) -> np.ndarray:

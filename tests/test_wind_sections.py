@@ -343,3 +343,19 @@ def test_equal_span_wind_is_bit_identical_to_before_sections(name):
         ref = gold[f"{k}/{key}"]
         assert value.shape == ref.shape, key
         assert np.array_equal(value, ref) and np.array_equal(np.signbit(value), np.signbit(ref)), key
+
+
+def test_equal_span_downburst_with_a_reference_height_scales_there_and_loads_at_the_conductor():
+    case = load_case(CASES / "paper" / "case05-six.toml")  # Db_y: D_j = 600 m, R = 720 m, Theta = 0; h = 43 m
+    case = replace(case, wind=replace(case.wind, reference_height=10.0))
+    s = LineSystem(case.line)
+    delta = 15.0 / wm.ETA_PEAK  # z_max = 0.025 D_j
+    # V_ref at p at 10 m, so at the conductor (43 m) the peak (t = T1 = 120 s) is V_ref f_z(43)/f_z(10)
+    expect = case.wind.v_ref * float(_wood(43.0, delta) / _wood(10.0, delta))
+    mw = wm.mean_wind(case, s, np.array([120.0]))
+    assert mw.normal[0, 2, 10] == pytest.approx(expect, rel=1e-12)  # span 3's end node: the tower of interest
+    ps = point_series(case, 0)
+    assert ps.mean_speed.max() == pytest.approx(expect, rel=1e-9)
+    # by hand: delta = 81.70 m, f_z(43) = 1.55 * 0.5263^(1/6) * (1 - erf(0.3684)) = 0.8390,
+    # f_z(10) = 1.55 * 0.1224^(1/6) * (1 - erf(0.0857)) = 0.9869: ratio 0.8501 (weaker above the nose)
+    assert expect / case.wind.v_ref == pytest.approx(0.8501, abs=2e-4)

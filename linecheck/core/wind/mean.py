@@ -903,7 +903,7 @@ def mean_velocity_at(case: Case, x: np.ndarray, time: np.ndarray) -> tuple[np.nd
     if case.wind.type == "synoptic":
         shape = (time.size, x.size)
         return np.zeros(shape), np.full(shape, case.wind.v_ref)
-    return downburst_field(case).velocity(x, time)
+    return _equal_span_downburst(case, downburst_field(case), x, time)
 
 
 def point_p(case: Case) -> float:
@@ -971,12 +971,12 @@ def mean_vector_at_nodes(case: Case, system: LineSystem, time: np.ndarray) -> np
     if system.is_section:
         vx, vy = _downburst_nodes(case, system, field, time)
     else:
-        vx, vy = _equal_span_downburst(case, system, field, system.node_x0, time)
+        vx, vy = _equal_span_downburst(case, field, system.node_x0, time)
     out[:, :, 0], out[:, :, 1] = vx, vy
     return out
 
 
-def _equal_span_downburst(case: Case, system: LineSystem, field: DownburstField, x: np.ndarray,
+def _equal_span_downburst(case: Case, field: DownburstField, x: np.ndarray,
                           time: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Equal-span form: the field on y = 0 at the conductor height (the original path; with an
     explicit ``reference_height`` the scaling height differs from the conductor height)."""
@@ -1021,7 +1021,7 @@ def mean_wind(case: Case, system: LineSystem, times: np.ndarray | None = None) -
     shape = (t.size, system.n_spans, system.ne + 1)
     if not system.is_section:
         xs = span_node_x(system)
-        vx, vy = _equal_span_downburst(case, system, field, xs.ravel(), t)
+        vx, vy = _equal_span_downburst(case, field, xs.ravel(), t)
         return MeanWind(t, vy.reshape(shape), vx.reshape(shape), field.point_p)
     # section form: the field at each span node's plan position and height, resolved on the span's
     # horizontal normal n_i and direction e_i (a tower node gets each adjacent span's components)
@@ -1057,7 +1057,7 @@ def mean_components_at_nodes(case: Case, system: LineSystem, time: np.ndarray) -
     """
     time = np.atleast_1d(np.asarray(time, dtype=float))
     if not system.is_section and case.wind.type == "downburst":
-        vx, vy = _equal_span_downburst(case, system, downburst_field(case), system.node_x0, time)
+        vx, vy = _equal_span_downburst(case, downburst_field(case), system.node_x0, time)
         return vy, vx
     if case.wind.type == "synoptic" and _synoptic_plain(case, system):
         return mean_normal_at_nodes(case, system, time), np.zeros((time.size, system.n_nodes))
@@ -1078,7 +1078,7 @@ def mean_normal_at_nodes(case: Case, system: LineSystem, time: np.ndarray) -> np
     if case.wind.type == "synoptic" and _synoptic_plain(case, system):
         return np.broadcast_to(_synoptic_node_speeds(case, system), (time.size, system.n_nodes)).copy()
     if case.wind.type == "downburst" and not system.is_section:
-        return _equal_span_downburst(case, system, downburst_field(case), system.node_x0, time)[1]
+        return _equal_span_downburst(case, downburst_field(case), system.node_x0, time)[1]
     return mean_components_at_nodes(case, system, time)[0]
 
 
@@ -1090,7 +1090,7 @@ def mean_speed_at_nodes(case: Case, system: LineSystem, time: np.ndarray) -> np.
             return np.abs(mean_normal_at_nodes(case, system, time))
         return np.broadcast_to(np.abs(_synoptic_speed_nodes(case, system)), (time.size, system.n_nodes)).copy()
     if not system.is_section:
-        vx, vy = _equal_span_downburst(case, system, downburst_field(case), system.node_x0, time)
+        vx, vy = _equal_span_downburst(case, downburst_field(case), system.node_x0, time)
     else:
         vx, vy = _downburst_nodes(case, system, downburst_field(case), time)
     return np.hypot(vx, vy)

@@ -293,6 +293,8 @@ def test_downburst_point_series_and_table_heights_on_a_section():
     tab = replace(tab, wind=replace(tab.wind, downburst=replace(tab.wind.downburst, model=None)))
     with pytest.raises(CaseError, match=r"conductor heights reach z/D_j from 0\.02"):
         wm.mean_wind(tab, s)
+    with pytest.raises(CaseError, match=r"example-field\.csv: the conductor heights reach z/D_j from 0\.02179 to 0\.065"):
+        service.check_case(tab)  # `linecheck check` reports it before any run
 
 
 def test_wind_field_on_a_section_is_global_vectors_and_loads_use_node_normals():

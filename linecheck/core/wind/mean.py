@@ -837,6 +837,14 @@ def _downburst_field_cached(case: Case, stamp: tuple[int, int] | None) -> Downbu
         special = np.array([t1, *window])
     else:
         z = h / dj
+        if system.is_section and table.z.size > 1:
+            # every conductor node is evaluated at its own height: the table must cover them all
+            # (checked here so that `linecheck check` reports it; same message as the evaluation)
+            zn = system.node_height / dj
+            lo, hi = float(zn.min()), float(zn.max())
+            if lo < table.z[0] - 1e-12 or hi > table.z[-1] + 1e-12:
+                raise _field_error(table.path, f"the conductor heights reach z/D_j from {lo:.4g} to {hi:.4g} but "
+                                   f"the table covers z_over_dj {table.z[0]:g} to {table.z[-1]:g}: extend the table")
         sl = _table_slice(table, z)
         # reference instant: the table's peak radial speed at the conductor height
         t_ref = float(table.t[int(np.argmax(np.max(np.abs(sl.rgi.values), axis=0)))])

@@ -694,7 +694,9 @@ class WindField:
             "t": self.t, "burn_in": np.float64(self.burn_in), "x_node": self.x_node,
             "u_mean": self.u_mean, "u_turb": self.u_turb, "v_along": self.v_along,
             "realization": np.int64(self.realization), "seed": np.int64(self.seed),
-            "case": np.str_(self.case.name), "units": np.str_("SI: s, m, m/s; x along the line, y transverse, z up"),
+            "case": np.str_(self.case.name), "units": np.str_(
+                "SI: s, m, m/s; global frame: x along the first span, y to its left, z up" if self.case.line.is_section
+                else "SI: s, m, m/s; x along the line, y transverse, z up"),
         }
 
 

@@ -310,6 +310,7 @@ def test_wind_field_on_a_section_is_global_vectors_and_loads_use_node_normals():
                                rtol=0, atol=1e-15)
     np.testing.assert_allclose(speed[0], 35.0 * (s.node_height / 10.0) ** 0.16, rtol=1e-14)
     np.testing.assert_allclose(wf.u_turb[..., :2], wf.v_along[..., None] * m, rtol=0, atol=1e-12)
+    assert str(wf.to_npz_dict()["units"]) == "SI: s, m, m/s; global frame: x along the first span, y to its left, z up"
     loads, direct = service.loads_from_field(case, wf.to_npz_dict())
     st = service.static_analysis(case)
     from linecheck.core.model import build_model

@@ -678,8 +678,10 @@ class WindField:
         t: [s] the analysed record's equally spaced instants, burn-in included, shape (n_t,).
         burn_in: [s] the discarded start of ``t`` (0 for downbursts and ``damping = "paper"``).
         x_node: [m] still-air node positions (x along the line, z up), shape (n_nodes, 3);
-            nodes in line order, tower nodes once (n_spans * elements_per_span + 1).
-        u_mean: [m/s] running-mean wind velocity (x, y, z) at each node, (n_t, n_nodes, 3).
+            nodes in line order, tower nodes once (n_spans * elements_per_span + 1).  Section form:
+            ``LineSystem.node_xyz0`` (x along the first span, y to its left, z up, global frame).
+        u_mean: [m/s] running-mean wind velocity (x, y, z) at each node, (n_t, n_nodes, 3)
+            (section form: the full vector in the global frame, synoptic V(z)(sin d, cos d, 0)).
         u_turb: [m/s] turbulent wind velocity (x, y, z): the along-wind fluctuation v along the
             running mean's direction, (n_t, n_nodes, 3).
         v_along: [m/s] the along-wind fluctuation v itself (signed), (n_t, n_nodes).
@@ -702,7 +704,9 @@ class WindField:
             "t": self.t, "burn_in": np.float64(self.burn_in), "x_node": self.x_node,
             "u_mean": self.u_mean, "u_turb": self.u_turb, "v_along": self.v_along,
             "realization": np.int64(self.realization), "seed": np.int64(self.seed),
-            "case": np.str_(self.case.name), "units": np.str_("SI: s, m, m/s; x along the line, y transverse, z up"),
+            "case": np.str_(self.case.name), "units": np.str_(
+                "SI: s, m, m/s; global frame: x along the first span, y to its left, z up" if self.case.line.is_section
+                else "SI: s, m, m/s; x along the line, y transverse, z up"),
         }
 
 
@@ -734,6 +738,20 @@ def wind_field(case: Case, *, realization: int = 0) -> WindField:
     st = static_analysis(case)
     system = st.system
     t, burn = record_grid(case, st)
+    if _wind_vectors(case, system):
+        # issue 17: full vectors in the global frame at the still-air node positions (section form)
+        from .core.wind.mean import mean_vector_at_nodes
+
+        v = fluctuating_velocity(case, system, t, [realization])[0]
+        u_mean = np.broadcast_to(mean_vector_at_nodes(case, system, t[:1] if case.wind.type == "synoptic" else t),
+                                 (t.size, system.n_nodes, 3)).copy()
+        speed = np.hypot(u_mean[..., 0], u_mean[..., 1])
+        normal = system.node_normals[None, :, :]  # direction of the fluctuation where |V| = 0
+        with np.errstate(invalid="ignore", divide="ignore"):
+            unit = np.where(speed[..., None] > 0, u_mean / np.where(speed > 0, speed, 1.0)[..., None], normal)
+        u_turb = v[..., None] * unit
+        x_node = system.node_xyz0.copy()
+        return WindField(case, t, burn, x_node, u_mean, u_turb, v, realization + 1, case.analysis.seed)
     vn, vl = record_mean_wind(case, st, t)
     vl = np.zeros_like(vn) if vl is None else vl
     v = fluctuating_velocity(case, system, t, [realization])[0]
@@ -746,6 +764,14 @@ def wind_field(case: Case, *, realization: int = 0) -> WindField:
     u_turb = np.stack([v * unit_l, v * unit_n, zero], axis=-1)
     x_node = st.mean.still_air.nodes.copy()
     return WindField(case, t, burn, x_node, u_mean, u_turb, v, realization + 1, case.analysis.seed)
+
+
+def _wind_vectors(case: Case, system: LineSystem) -> bool:
+    """True when the wind field is built from full mean-wind vectors (a section, or a synoptic
+    wind with a direction or profile); False keeps the equal-span form's original arrays."""
+    w = case.wind
+    return system.is_section or (w.type == "synoptic" and (w.direction != 0.0 or w.profile_exponent != 0.0
+                                                           or w.reference_height is not None))
 
 
 def read_wind_field(path) -> dict[str, np.ndarray]:
@@ -761,6 +787,13 @@ def loads_from_field(case: Case, field: dict[str, np.ndarray]) -> tuple[np.ndarr
     st = static_analysis(case)
     model = build_model(st.system, st.mean.state(0))
     u = field["u_mean"]
+    if _wind_vectors(case, st.system):
+        # issue 17: normal component along each node's horizontal normal (span normal; tower nodes:
+        # the tower frame's y) and the along-line rest, for cos(phi) = |V_n|/|V|
+        n, e = st.system.node_normals, st.system.node_frames[:, :, 0]
+        vn = u[..., 0] * n[None, :, 0] + u[..., 1] * n[None, :, 1]
+        vl = u[..., 0] * e[None, :, 0] + u[..., 1] * e[None, :, 1]
+        return fluctuating_loads(case, st.system, model, field["t"], field["v_along"][None], vn, vl)
     vl = None if case.wind.type == "synoptic" else u[:, :, 0]
     return fluctuating_loads(case, st.system, model, field["t"], field["v_along"][None], u[:, :, 1], vl)
 

@@ -92,13 +92,21 @@ class MeanWind:
             shape (n_t, n_spans, ne+1) (span-local nodes, so a speed may jump at a tower).
         longitudinal: [m/s] component along the line (toward +x), same shape.
         point_p: [m] x-coordinate of point p (line point nearest the downburst centre;
-            synoptic: the tower of interest).
+            synoptic: the tower of interest).  Section form: p's coordinate along the tower of
+            interest's frame x axis, counted from the first tower like a station.
+        point_xy: [m] plan position (x, y) of p in the global frame (section form; equal-span
+            form: (point_p, 0)).
+
+    Section form (issue 17): ``normal`` is the component along each span's horizontal normal
+    n_i = (-sin h_i, cos h_i, 0) and ``longitudinal`` along its horizontal direction
+    (cos h_i, sin h_i, 0), at the nodes' still-air plan positions and heights above ground.
     """
 
     time: np.ndarray
     normal: np.ndarray
     longitudinal: np.ndarray
     point_p: float
+    point_xy: tuple[float, float] | None = None
 
 
 def synoptic_span_speeds(case: Case) -> np.ndarray:
@@ -106,6 +114,61 @@ def synoptic_span_speeds(case: Case) -> np.ndarray:
     if case.wind.span_speeds is None:
         return np.full(case.line.spans, case.wind.v_ref)
     return np.asarray(case.wind.span_speeds, dtype=float)
+
+
+# ------------------------------------------------------------------------- synoptic direction and profile
+def reference_height(case: Case) -> float:
+    """z_ref [m]: ``wind.reference_height``, else the mean clamp height above ground (``line.height``;
+    the equal-span form's conductor height).  Synoptic: the height of V_ref in the power law;
+    downburst: the height at which the running mean at p peaks at V_ref."""
+    z = case.wind.reference_height
+    return float(case.line.height if z is None else z)
+
+
+def profile_factor(case: Case, z_agl: np.ndarray) -> np.ndarray:
+    """V(z)/v_ref [-] = (z_agl / z_ref)^alpha at heights above ground z_agl [m] (any shape).
+
+    Power law (Hellmann 1916; Davenport 1960);
+    alpha = ``profile_exponent`` (0: exactly 1 everywhere).  A point at or below the ground
+    (possible only for a sagging conductor) gets 0."""
+    z_agl = np.asarray(z_agl, dtype=float)
+    alpha = float(case.wind.profile_exponent)
+    if alpha == 0.0:
+        return np.ones_like(z_agl)
+    # power law (Hellmann 1916; Davenport 1960): V(z) = V_ref (z / z_ref)^alpha
+    return (np.maximum(z_agl, 0.0) / reference_height(case)) ** alpha
+
+
+def wind_direction_vector(case: Case) -> np.ndarray:
+    """Unit mean-wind direction m = (sin d, cos d, 0) [-], shape (3,) (d = ``wind.direction``;
+    d = 0 blows toward +y, normal to the first span; issue 17)."""
+    d = math.radians(case.wind.direction)
+    return np.array([math.sin(d), math.cos(d), 0.0])
+
+
+def _span_node_index(system: LineSystem) -> np.ndarray:
+    """Global node index of every span-local node, shape (n_spans, ne+1)."""
+    return np.arange(system.n_spans)[:, None] * system.ne + np.arange(system.ne + 1)[None, :]
+
+
+def _span_along(system: LineSystem) -> np.ndarray:
+    """Horizontal unit direction (cos h_i, sin h_i, 0) of every span, shape (n_spans, 3)."""
+    h = system.span_headings
+    return np.stack([np.cos(h), np.sin(h), np.zeros_like(h)], axis=1)
+
+
+def _node_along(system: LineSystem) -> np.ndarray:
+    """Horizontal unit along-line direction of every global node, shape (n_nodes, 3): the node
+    normal turned -90 deg in plan (span nodes: the span's direction; tower nodes: the tower frame x)."""
+    n = system.node_normals
+    return np.stack([n[:, 1], -n[:, 0], np.zeros(n.shape[0])], axis=1)
+
+
+def _synoptic_plain(case: Case, system: LineSystem) -> bool:
+    """True for the paper's synoptic wind: equal-span form, d = 0, no profile (the original,
+    bit-identical code path)."""
+    return (not system.is_section and case.wind.direction == 0.0 and case.wind.profile_exponent == 0.0
+            and case.wind.reference_height is None)
 
 
 # ------------------------------------------------------------------------- profiles
@@ -395,6 +458,13 @@ class DownburstField:
         r_max, radial_decay, z_max, delta: [m] analytic profile parameters (NaN for a table).
         t1, t_f: [s] intensity-function times (NaN for a table).
         table: the user :class:`FieldTable`, or None for the analytic model.
+        point_xy: [m] plan position (x, y) of p in the global frame (section form: the foot of
+            the perpendicular from the centre on the tower of interest's frame x axis); None for
+            the equal-span form, where p is (point_p, 0).
+
+    Section form (issue 17): ``centre``, ``translation`` and ``point_xy`` are in the global
+    plan frame; :meth:`velocity_at` evaluates the field at any plan point and height.
+    ``height`` is then the reference height at which the running mean at p peaks at V_ref.
     """
 
     jet_diameter: float
@@ -413,6 +483,7 @@ class DownburstField:
     t_f: float = math.nan
     table: FieldTable | None = None
     ring: ring_model.RingJet | None = None  # model "ring-jet" (issue 15)
+    point_xy: tuple[float, float] | None = None  # [m] plan position of p (section form; None: (point_p, 0))
 
     # -- model pieces
     def centre_at(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -421,8 +492,11 @@ class DownburstField:
         dt = t - self.t_ref
         return self.centre[0] + self.translation[0] * dt, self.centre[1] + self.translation[1] * dt
 
-    def shape(self, r: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """Radial speed per unit V_max [-] at radius r [m] and time t [s] (broadcast shapes)."""
+    def shape(self, r: np.ndarray, t: np.ndarray, z: np.ndarray | None = None) -> np.ndarray:
+        """Radial speed per unit V_max [-] at radius r [m], time t [s] and height above ground
+        z [m] (broadcast shapes; None: ``height`` everywhere)."""
+        if z is not None:
+            return self._shape_z(r, t, z)
         r, t = np.broadcast_arrays(np.asarray(r, dtype=float), np.asarray(t, dtype=float))
         if self.ring is not None:
             # issue 15: non-separable ring vortex + image + wall jet, per unit V_j
@@ -432,6 +506,45 @@ class DownburstField:
             return (radial_profile(r, self.r_max, self.radial_decay)
                     * float(vertical_profile(self.height, self.delta)) * intensity(t, self.t1, self.t_f))
         return _table_slice(self.table, self.height / self.jet_diameter)(r / self.jet_diameter, t, self.table.path)
+
+    def _shape_z(self, r: np.ndarray, t: np.ndarray, z: np.ndarray) -> np.ndarray:
+        """:meth:`shape` with a height per point (section form: each node's own height)."""
+        r, t, z = np.broadcast_arrays(np.asarray(r, dtype=float), np.asarray(t, dtype=float),
+                                      np.asarray(z, dtype=float))
+        if self.ring is not None:
+            # issue 15: the ring-jet field is a function of (r, z, t) (not separable)
+            return self.ring.shape(r, z, t)
+        if self.table is None:
+            # issue 3: V = V_max f_r(r) f_z(z) Pi(t), f_z of Wood et al. (2001) at each point's height
+            return (radial_profile(r, self.r_max, self.radial_decay) * vertical_profile(z, self.delta)
+                    * intensity(t, self.t1, self.t_f))
+        return _table_points(self.table, r / self.jet_diameter, z / self.jet_diameter, t)
+
+    def p_xy(self) -> tuple[float, float]:
+        """Plan position of p [m] in the frame of ``centre``."""
+        return self.point_xy if self.point_xy is not None else (self.point_p, 0.0)
+
+    def velocity_at(self, x: np.ndarray, y: np.ndarray, t: np.ndarray,
+                    z: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Running-mean horizontal velocity (v_x, v_y) [m/s] at plan points (x, y) [m] and heights
+        above ground z [m] (None: ``height``), in the frame of ``centre`` (global for sections).
+
+        x, y, z shape (n_x,), t shape (n_t,) -> two arrays (n_t, n_x).  Radial outflow from the
+        moving centre plus the translation velocity (vector sum, Holmes & Oliver 2000).
+        """
+        x = np.asarray(x, dtype=float)[None, :]
+        y = np.asarray(y, dtype=float)[None, :]
+        t = np.asarray(t, dtype=float)[:, None]
+        cx, cy = self.centre_at(t)
+        dx, dy = x - cx, y - cy
+        r = np.hypot(dx, dy)
+        zz = None if z is None else np.asarray(z, dtype=float)[None, :]
+        speed = self.v_max * self.shape(r, t, zz)
+        safe = np.where(r > 0.0, r, 1.0)
+        # Holmes & Oliver (2000): vector sum of the radial outflow and the translation velocity
+        vx = np.where(r > 0.0, speed * dx / safe, 0.0) + self.translation[0]
+        vy = np.where(r > 0.0, speed * dy / safe, 0.0) + self.translation[1]
+        return vx, vy
 
     def velocity(self, x: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Running-mean velocity (v_x, v_y) [m/s] at line points x [m] (y = 0, z = height).
@@ -474,6 +587,12 @@ class _SliceInterpolator:
 
     def __call__(self, rr: np.ndarray, tt: np.ndarray, path: Path) -> np.ndarray:
         rr, tt = np.broadcast_arrays(rr, tt)
+        self.check(rr, tt, path)
+        pts = np.stack([np.clip(rr, self.r[0], self.r[-1]).ravel(), np.clip(tt, self.t[0], self.t[-1]).ravel()], axis=-1)
+        return self.rgi(pts).reshape(rr.shape)
+
+    def check(self, rr: np.ndarray, tt: np.ndarray, path: Path) -> None:
+        """One-line error when points leave the table's r or t range (round-off tolerated)."""
         tol_r = 1e-9 * max(1.0, abs(self.r[-1]))
         tol_t = 1e-9 * max(1.0, abs(self.t[-1]))
         if rr.size:
@@ -485,8 +604,6 @@ class _SliceInterpolator:
             if lo < self.t[0] - tol_t or hi > self.t[-1] + tol_t:
                 raise _field_error(path, f"times {lo:.6g} to {hi:.6g} s are needed but the table covers t "
                                    f"{self.t[0]:g} to {self.t[-1]:g} s: extend the table or shorten analysis.duration")
-        pts = np.stack([np.clip(rr, self.r[0], self.r[-1]).ravel(), np.clip(tt, self.t[0], self.t[-1]).ravel()], axis=-1)
-        return self.rgi(pts).reshape(rr.shape)
 
 
 @lru_cache(maxsize=32)
@@ -507,6 +624,30 @@ def _table_slice_cached(table: FieldTable, z: float, vertical: bool) -> _SliceIn
 
 def _table_slice(table: FieldTable, z: float, vertical: bool = False) -> _SliceInterpolator:
     return _table_slice_cached(table, float(z), vertical)
+
+
+@lru_cache(maxsize=16)
+def _table_volume(table: FieldTable) -> RegularGridInterpolator:
+    return RegularGridInterpolator((table.r, table.z, table.t), table.radial, method="linear")
+
+
+def _table_points(table: FieldTable, rr: np.ndarray, zz: np.ndarray, tt: np.ndarray) -> np.ndarray:
+    """Radial table speed at (r/D_j, z/D_j, t) per point (broadcast shapes): trilinear
+    interpolation (the same as the per-height slices of :func:`_table_slice`), with the same
+    range checks; a table with one height has no z dependence."""
+    rr, zz, tt = np.broadcast_arrays(rr, zz, tt)
+    if table.z.size == 1:
+        return _table_slice(table, float(table.z[0]))(rr, tt, table.path)
+    if zz.size:
+        lo, hi = float(zz.min()), float(zz.max())
+        if lo < table.z[0] - 1e-12 or hi > table.z[-1] + 1e-12:
+            raise _field_error(table.path, f"the conductor heights reach z/D_j from {lo:.4g} to {hi:.4g} but the "
+                               f"table covers z_over_dj {table.z[0]:g} to {table.z[-1]:g}: extend the table")
+    # r and t checks of the slice interpolator (same messages)
+    _table_slice(table, float(table.z[0])).check(rr, tt, table.path)
+    pts = np.stack([np.clip(rr, table.r[0], table.r[-1]).ravel(), np.clip(zz, table.z[0], table.z[-1]).ravel(),
+                    np.clip(tt, table.t[0], table.t[-1]).ravel()], axis=-1)
+    return _table_volume(table)(pts).reshape(rr.shape)
 
 
 def _downburst(case: Case) -> Downburst:
@@ -565,11 +706,12 @@ def _ring_scale(case: Case) -> ring_model.RingJet:
     if abs(math.cos(math.radians(db.angle))) < 1e-12:
         rho_p = 0.0
     tau = np.linspace(0.0, ring_model.TAU_END, 6001)
-    s = np.abs(ring_model.radial_speed(rho_p, case.line.height / dj, tau))
+    z_ref = reference_height(case)  # the height of V_ref at p (equal-span form: the conductor height)
+    s = np.abs(ring_model.radial_speed(rho_p, z_ref / dj, tau))
     k = int(np.argmax(s))
     peak = float(s[k])
     lo, hi = tau[max(k - 1, 0)], tau[min(k + 1, tau.size - 1)]
-    res = minimize_scalar(lambda tt: -abs(float(ring_model.radial_speed(rho_p, case.line.height / dj, tt))),
+    res = minimize_scalar(lambda tt: -abs(float(ring_model.radial_speed(rho_p, z_ref / dj, tt))),
                           bounds=(lo, hi), method="bounded", options={"xatol": 1e-10})
     peak = max(peak, float(-res.fun))
     if not peak > 0.0:
@@ -582,9 +724,13 @@ def _max_speed_at_p(field: DownburstField, v_max: float, times: np.ndarray) -> t
     """max over t of |V(p, t)| for a trial V_max: grid search then bounded refinement."""
     f = DownburstField(**{**field.__dict__, "v_max": v_max})
     xp = np.array([field.point_p])
+    px, py = field.p_xy()
 
     def speed(t: np.ndarray) -> np.ndarray:
-        vx, vy = f.velocity(xp, np.atleast_1d(t))
+        if field.point_xy is None:
+            vx, vy = f.velocity(xp, np.atleast_1d(t))
+        else:  # section form: p off the line, in the global plan frame, at the reference height
+            vx, vy = f.velocity_at(np.array([px]), np.array([py]), np.atleast_1d(t))
         return np.hypot(vx, vy)[:, 0]
 
     s = speed(times)
@@ -618,23 +764,46 @@ def downburst_field(case: Case) -> DownburstField:
     return _downburst_field_cached(case, stamp)
 
 
+def _distance_to_p(centre: tuple[float, float], point_p: float, point_xy: tuple[float, float] | None) -> float:
+    """Plan distance [m] from the downburst centre to p (equal-span form: |y_c|, as always)."""
+    if point_xy is None:
+        return abs(centre[1])
+    return math.hypot(centre[0] - point_xy[0], centre[1] - point_xy[1])
+
+
 @lru_cache(maxsize=64)
 def _downburst_field_cached(case: Case, stamp: tuple[int, int] | None) -> DownburstField:
     db = _downburst(case)
     line = case.line
     src = str(case.source) if case.source else None
     dj = db.jet_diameter
-    h = line.height
-    x_toi = float(LineSystem(line).tower_x[case.line.tower_of_interest - 1])
+    h = reference_height(case)  # V_ref at p at this height (equal-span form: the conductor height)
+    system = LineSystem(line)
+    toi = case.line.tower_of_interest - 1
+    x_toi = float(system.tower_x[toi])
     theta = math.radians(db.angle)
     # paper Fig. 2: centre at distance R, angle Theta from the perpendicular through the tower, upwind (-y)
     sin_t, cos_t = math.sin(theta), math.cos(theta)
     # snap round-off of sin/cos at multiples of 90 degrees (e.g. cos(pi/2) = 6e-17)
     sin_t, cos_t = (0.0 if abs(sin_t) < 1e-12 else sin_t), (0.0 if abs(cos_t) < 1e-12 else cos_t)
-    # (rounded to 1 nm so that, e.g., R sin 30 deg lands on its FE node: 480.0, not 479.99999999999994)
-    centre = (round(x_toi + db.distance * sin_t, 9), round(-db.distance * cos_t, 9) + 0.0)
-    point_p = centre[0]  # foot of the perpendicular from the centre to the line y = 0
     beta = math.radians(db.translation_direction)
+    point_xy = None
+    if system.is_section:
+        # issue 17: the paper's Fig. 2 geometry in the tower of interest's own frame (x' along its mean
+        # heading psi, y' = x' turned +90 deg): centre = P_T + R sin(Theta) x' - R cos(Theta) y'; p = the
+        # foot of the perpendicular from the centre on the x' axis, P_T + R sin(Theta) x' (docs/wind.md)
+        psi = float(system.tower_headings[toi])
+        cp, sp = math.cos(psi), math.sin(psi)
+        px0, py0 = (float(v) for v in system.clamp_points[toi, :2])
+        a, b = db.distance * sin_t, -db.distance * cos_t  # centre in the tower frame (x', y')
+        centre = (round(px0 + a * cp - b * sp, 9) + 0.0, round(py0 + a * sp + b * cp, 9) + 0.0)
+        point_xy = (px0 + a * cp, py0 + a * sp)
+        point_p = round(x_toi + a, 9)  # p's coordinate along the x' axis, counted like a station
+        beta += psi  # translation_direction is measured from the tower frame's x' axis
+    else:
+        # (rounded to 1 nm so that, e.g., R sin 30 deg lands on its FE node: 480.0, not 479.99999999999994)
+        centre = (round(x_toi + db.distance * sin_t, 9), round(-db.distance * cos_t, 9) + 0.0)
+        point_p = centre[0]  # foot of the perpendicular from the centre to the line y = 0
     translation = (db.translation_speed * math.cos(beta), db.translation_speed * math.sin(beta))
     if abs(translation[0]) < 1e-15:
         translation = (0.0, translation[1])
@@ -646,10 +815,10 @@ def _downburst_field_cached(case: Case, stamp: tuple[int, int] | None) -> Downbu
         rj = _ring_scale(case)
         if db.t1 is not None or db.t_f is not None:  # guarded by the loader too
             raise CaseError("t1/t_f shape the holmes-oliver model only", file=src, key="wind.downburst.t1")
-        field = DownburstField(dj, h, centre, 0.0, translation, 1.0, point_p, window, ring=rj)
+        field = DownburstField(dj, h, centre, 0.0, translation, 1.0, point_p, window, ring=rj, point_xy=point_xy)
         # reference instant of the centre position: when the stationary outflow at p peaks
         times = np.linspace(window[0], window[1], 6001)
-        r_p0 = abs(centre[1])
+        r_p0 = _distance_to_p(centre, point_p, point_xy)
         t_ref = float(times[int(np.argmax(np.abs(field.shape(np.full(times.size, r_p0), times))))])
         field = DownburstField(**{**field.__dict__, "t_ref": t_ref})
         special = times
@@ -663,18 +832,27 @@ def _downburst_field_cached(case: Case, stamp: tuple[int, int] | None) -> Downbu
             raise CaseError(f"value {t_f!r} is not allowed: expected t_f > t1 = {t1!r} (t1 default {T1_DEFAULT:g} s)",
                             file=src, key="wind.downburst.t_f")
         field = DownburstField(dj, h, centre, t1, translation, 1.0, point_p, window, r_max, r_dec, z_max,
-                               wood_delta(z_max), t1, t_f, None)
+                               wood_delta(z_max), t1, t_f, None, point_xy=point_xy)
         # candidate instants where the stationary speed at p peaks: T1 and the window ends
         special = np.array([t1, *window])
     else:
         z = h / dj
+        if system.is_section and table.z.size > 1:
+            # every conductor node is evaluated at its own height: the table must cover them all
+            # (checked here so that `linecheck check` reports it; same message as the evaluation)
+            zn = system.node_height / dj
+            lo, hi = float(zn.min()), float(zn.max())
+            if lo < table.z[0] - 1e-12 or hi > table.z[-1] + 1e-12:
+                raise _field_error(table.path, f"the conductor heights reach z/D_j from {lo:.4g} to {hi:.4g} but "
+                                   f"the table covers z_over_dj {table.z[0]:g} to {table.z[-1]:g}: extend the table")
         sl = _table_slice(table, z)
         # reference instant: the table's peak radial speed at the conductor height
         t_ref = float(table.t[int(np.argmax(np.max(np.abs(sl.rgi.values), axis=0)))])
-        field = DownburstField(dj, h, centre, t_ref, translation, 1.0, point_p, window, table=table)
+        field = DownburstField(dj, h, centre, t_ref, translation, 1.0, point_p, window, table=table,
+                               point_xy=point_xy)
         special = np.concatenate([table.t, np.array(window)])
     special = special[(special >= window[0]) & (special <= window[1])]
-    r_p = abs(centre[1])
+    r_p = _distance_to_p(centre, point_p, point_xy)
     v_ref = case.wind.v_ref
     if translation == (0.0, 0.0) and db.model_name == "ring-jet":
         # stationary ring-jet: |V(p,t)| = V_max |s(r_p, t)|, maximum found by grid + refinement
@@ -725,20 +903,94 @@ def mean_velocity_at(case: Case, x: np.ndarray, time: np.ndarray) -> tuple[np.nd
 
     x shape (n_x,), time shape (n_t,) -> two arrays (n_t, n_x).  Synoptic: (0, V_ref)
     everywhere (``span_speeds`` apply only through :func:`mean_wind` and the node helpers).
+    Equal-span form (points on the straight line y = 0 at the conductor height); sections use
+    :func:`mean_vector_at_nodes`.
     """
     x = np.atleast_1d(np.asarray(x, dtype=float))
     time = np.atleast_1d(np.asarray(time, dtype=float))
     if case.wind.type == "synoptic":
         shape = (time.size, x.size)
         return np.zeros(shape), np.full(shape, case.wind.v_ref)
-    return downburst_field(case).velocity(x, time)
+    return _equal_span_downburst(case, downburst_field(case), x, time)
 
 
 def point_p(case: Case) -> float:
-    """x [m] of point p: the line point nearest the downburst centre (synoptic: tower of interest)."""
+    """x [m] of point p: the line point nearest the downburst centre (synoptic: tower of interest).
+
+    Section form: p's coordinate along the tower of interest's frame x axis, counted like a
+    station (the tower's station + R sin(Theta)); its plan position is :func:`point_p_xy`."""
     if case.wind.type == "synoptic":
         return float(LineSystem(case.line).tower_x[case.line.tower_of_interest - 1])
     return downburst_field(case).point_p
+
+
+def point_p_xy(case: Case) -> tuple[float, float]:
+    """Plan position (x, y) [m] of point p in the global frame (synoptic: the tower of interest's
+    still-air clamp; downburst on a section: the foot of the perpendicular from the centre on the
+    tower of interest's frame x axis; equal-span form: (point_p, 0))."""
+    if case.wind.type == "synoptic":
+        c = LineSystem(case.line).clamp_points[case.line.tower_of_interest - 1]
+        return float(c[0]), float(c[1])
+    return downburst_field(case).p_xy()
+
+
+def nearest_node_to_p(case: Case, system: LineSystem) -> int:
+    """Global FE node nearest point p (0-based): in plan (still-air ``node_xyz0``) on a section,
+    along x (``node_x0``) on the equal-span form."""
+    if not system.is_section:
+        return int(np.argmin(np.abs(system.node_x0 - point_p(case))))
+    px, py = point_p_xy(case)
+    xy = system.node_xyz0[:, :2]
+    return int(np.argmin(np.hypot(xy[:, 0] - px, xy[:, 1] - py)))
+
+
+def _downburst_nodes(case: Case, system: LineSystem, field: DownburstField,
+                     time: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Downburst (v_x, v_y) [m/s] in the global plan frame at every global node's still-air plan
+    position and height above ground (section form), shape (n_t, n_nodes) each."""
+    xyz = system.node_xyz0
+    return field.velocity_at(xyz[:, 0], xyz[:, 1], time, system.node_height)
+
+
+def _synoptic_speed_nodes(case: Case, system: LineSystem) -> np.ndarray:
+    """Synoptic mean speed |V| [m/s] at the global nodes: the span speed (tower nodes: the mean
+    of their two spans) times the power-law profile at the node's height, shape (n_nodes,)."""
+    return _synoptic_node_speeds(case, system) * profile_factor(case, system.node_height)
+
+
+def mean_vector_at_nodes(case: Case, system: LineSystem, time: np.ndarray) -> np.ndarray:
+    """Running-mean wind velocity vector [m/s] at the global FE nodes in the global frame
+    (x along the first span, y to its left, z up; z component 0), shape (n_t, n_nodes, 3).
+
+    Synoptic: V(z_node) (sin d, cos d, 0) (issue 17), V(z) = v (z/z_ref)^alpha with v the node's
+    span speed (``span_speeds``, else V_ref; tower nodes the mean of their two spans).
+    Downburst: the horizontal outflow at the node's still-air plan position and height
+    (equal-span form: on y = 0 at the conductor height, as :func:`mean_velocity_at`).
+    """
+    time = np.atleast_1d(np.asarray(time, dtype=float))
+    out = np.zeros((time.size, system.n_nodes, 3))
+    if case.wind.type == "synoptic":
+        v = _synoptic_speed_nodes(case, system)
+        m = wind_direction_vector(case)
+        out[:, :, 0] = (v * m[0])[None, :]
+        out[:, :, 1] = (v * m[1])[None, :]
+        return out
+    field = downburst_field(case)
+    if system.is_section:
+        vx, vy = _downburst_nodes(case, system, field, time)
+    else:
+        vx, vy = _equal_span_downburst(case, field, system.node_x0, time)
+    out[:, :, 0], out[:, :, 1] = vx, vy
+    return out
+
+
+def _equal_span_downburst(case: Case, field: DownburstField, x: np.ndarray,
+                          time: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Equal-span form: the field on y = 0 at the conductor height (the original path; with an
+    explicit ``reference_height`` the scaling height differs from the conductor height)."""
+    if reference_height(case) == float(case.line.height):
+        return field.velocity(x, time)
+    return field.velocity_at(x, np.zeros_like(x), time, np.full(x.size, float(case.line.height)))
 
 
 def mean_wind(case: Case, system: LineSystem, times: np.ndarray | None = None) -> MeanWind:
@@ -746,23 +998,49 @@ def mean_wind(case: Case, system: LineSystem, times: np.ndarray | None = None) -
 
     Synoptic: constant (``times`` default one instant t = 0).  Downburst: ``times``
     default ``analysis.mean_states`` instants over :func:`event_window`.
+    Components per span node: ``normal`` along the span's horizontal normal n_i, ``longitudinal``
+    along its horizontal direction (equal-span form: +y and +x).
     """
     if case.wind.type == "synoptic":
         t = np.zeros(1) if times is None else np.asarray(times, dtype=float)
-        v = synoptic_span_speeds(case)
-        normal = np.broadcast_to(v[:, None], (t.size, system.n_spans, system.ne + 1)).copy()
         p = float(system.tower_x[case.line.tower_of_interest - 1])
-        return MeanWind(t, normal, np.zeros_like(normal), p)
+        if _synoptic_plain(case, system):
+            v = synoptic_span_speeds(case)
+            normal = np.broadcast_to(v[:, None], (t.size, system.n_spans, system.ne + 1)).copy()
+            return MeanWind(t, normal, np.zeros_like(normal), p)
+        # issue 17: V(z) = v_span (z_agl/z_ref)^alpha at each span node's still-air height, direction
+        # m = (sin d, cos d, 0); normal V m.n_i = V cos(d + h_i), longitudinal V m.e_i = V sin(d + h_i)
+        idx = _span_node_index(system)
+        speed = synoptic_span_speeds(case)[:, None] * profile_factor(case, system.node_height[idx])
+        m = wind_direction_vector(case)
+        cn = system.span_normals @ m  # (n_spans,)
+        cl = _span_along(system) @ m
+        shape = (t.size, system.n_spans, system.ne + 1)
+        normal = np.broadcast_to(speed * cn[:, None], shape).copy()
+        longitudinal = np.broadcast_to(speed * cl[:, None], shape).copy()
+        c = system.clamp_points[case.line.tower_of_interest - 1]
+        return MeanWind(t, normal, longitudinal, p, (float(c[0]), float(c[1])) if system.is_section else None)
     if times is None:
         t0, t1 = event_window(case)
         t = np.linspace(t0, t1, case.analysis.mean_states)
     else:
         t = np.atleast_1d(np.asarray(times, dtype=float))
     field = downburst_field(case)
-    xs = span_node_x(system)
-    vx, vy = field.velocity(xs.ravel(), t)
     shape = (t.size, system.n_spans, system.ne + 1)
-    return MeanWind(t, vy.reshape(shape), vx.reshape(shape), field.point_p)
+    if not system.is_section:
+        xs = span_node_x(system)
+        vx, vy = _equal_span_downburst(case, field, xs.ravel(), t)
+        return MeanWind(t, vy.reshape(shape), vx.reshape(shape), field.point_p)
+    # section form: the field at each span node's plan position and height, resolved on the span's
+    # horizontal normal n_i and direction e_i (a tower node gets each adjacent span's components)
+    idx = _span_node_index(system).ravel()
+    vx, vy = _downburst_nodes(case, system, field, t)
+    vx, vy = vx[:, idx], vy[:, idx]
+    span = np.repeat(np.arange(system.n_spans), system.ne + 1)
+    n, e = system.span_normals[span], _span_along(system)[span]
+    normal = vx * n[None, :, 0] + vy * n[None, :, 1]
+    longitudinal = vx * e[None, :, 0] + vy * e[None, :, 1]
+    return MeanWind(t, normal.reshape(shape), longitudinal.reshape(shape), field.point_p, field.p_xy())
 
 
 def _synoptic_node_speeds(case: Case, system: LineSystem) -> np.ndarray:
@@ -777,22 +1055,50 @@ def _synoptic_node_speeds(case: Case, system: LineSystem) -> np.ndarray:
     return node
 
 
-def mean_normal_at_nodes(case: Case, system: LineSystem, time: np.ndarray) -> np.ndarray:
-    """Running-mean normal speed (toward +y) [m/s] at the global FE nodes, shape (n_steps, n_nodes).
+def mean_components_at_nodes(case: Case, system: LineSystem, time: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Running-mean (normal, longitudinal) components [m/s] at the global FE nodes, shape
+    (n_steps, n_nodes) each: along ``system.node_normals`` (span nodes: the span's normal n_i;
+    tower nodes: the tower frame's y) and along the node's horizontal along-line direction
+    (the normal turned -90 deg in plan; tower nodes: the tower frame's x).
 
-    Nodes at their still-air x (``system.node_x0``).  Synoptic with ``span_speeds``: a
+    This is the synoptic longitudinal component the fluctuating loads need (cos phi = |V_n|/|V|).
+    """
+    time = np.atleast_1d(np.asarray(time, dtype=float))
+    if not system.is_section and case.wind.type == "downburst":
+        vx, vy = _equal_span_downburst(case, downburst_field(case), system.node_x0, time)
+        return vy, vx
+    if case.wind.type == "synoptic" and _synoptic_plain(case, system):
+        return mean_normal_at_nodes(case, system, time), np.zeros((time.size, system.n_nodes))
+    u = mean_vector_at_nodes(case, system, time)
+    n, e = system.node_normals, _node_along(system)
+    return (u[..., 0] * n[None, :, 0] + u[..., 1] * n[None, :, 1],
+            u[..., 0] * e[None, :, 0] + u[..., 1] * e[None, :, 1])
+
+
+def mean_normal_at_nodes(case: Case, system: LineSystem, time: np.ndarray) -> np.ndarray:
+    """Running-mean normal speed [m/s] at the global FE nodes, shape (n_steps, n_nodes): toward +y
+    on the equal-span form, along ``system.node_normals`` on a section.
+
+    Nodes at their still-air position.  Synoptic with ``span_speeds``: a
     tower node shared by two spans takes their average.
     """
     time = np.atleast_1d(np.asarray(time, dtype=float))
-    if case.wind.type == "synoptic":
+    if case.wind.type == "synoptic" and _synoptic_plain(case, system):
         return np.broadcast_to(_synoptic_node_speeds(case, system), (time.size, system.n_nodes)).copy()
-    return downburst_field(case).velocity(system.node_x0, time)[1]
+    if case.wind.type == "downburst" and not system.is_section:
+        return _equal_span_downburst(case, downburst_field(case), system.node_x0, time)[1]
+    return mean_components_at_nodes(case, system, time)[0]
 
 
 def mean_speed_at_nodes(case: Case, system: LineSystem, time: np.ndarray) -> np.ndarray:
     """Running-mean horizontal speed magnitude [m/s] at the global FE nodes, shape (n_steps, n_nodes)."""
     time = np.atleast_1d(np.asarray(time, dtype=float))
     if case.wind.type == "synoptic":
-        return np.abs(mean_normal_at_nodes(case, system, time))
-    vx, vy = downburst_field(case).velocity(system.node_x0, time)
+        if _synoptic_plain(case, system):
+            return np.abs(mean_normal_at_nodes(case, system, time))
+        return np.broadcast_to(np.abs(_synoptic_speed_nodes(case, system)), (time.size, system.n_nodes)).copy()
+    if not system.is_section:
+        vx, vy = _equal_span_downburst(case, downburst_field(case), system.node_x0, time)
+    else:
+        vx, vy = _downburst_nodes(case, system, downburst_field(case), time)
     return np.hypot(vx, vy)

@@ -4,6 +4,11 @@ Point p is the line point nearest the downburst centre (synoptic: the tower of
 interest).  The turbulence at p is the unit field of the FE node nearest p (the
 unit field is homogeneous along the line, so its statistics there are those at p),
 modulated by a(p, t) = I |V_m(p, t)| (downburst) or I V_ref (synoptic) (Chay et al. 2006).
+
+Section form (issue 17): p may lie off the line (the foot of the perpendicular from the
+downburst centre on the tower of interest's frame x axis), so everything is taken at the FE
+node nearest p in plan: its running mean (at its still-air plan position and height above
+ground; normal/longitudinal along its node normal and along-line direction) and its unit field.
 Nothing here prints.
 """
 
@@ -17,7 +22,8 @@ import numpy as np
 from ..case import Case
 from ..errors import CaseError
 from ..system import LineSystem
-from .mean import downburst_field, event_window, mean_velocity_at, point_p
+from .mean import (downburst_field, event_window, mean_components_at_nodes, mean_velocity_at, nearest_node_to_p,
+                   point_p)
 from .turbulence import length_scale, unit_field
 
 
@@ -33,7 +39,9 @@ class PointSeries:
         fluctuation: [m/s] a(p, t) u(t), shape (n_steps,).
         total: [m/s] mean_speed + fluctuation, shape (n_steps,).
         unit: [-] the unit turbulence u(t) used, shape (n_steps,).
-        point_p: [m] x of p; node: global FE node whose unit field is used; node_x: [m] its x.
+        point_p: [m] x of p; node: global FE node whose unit field is used; node_x: [m] its x
+            (section form: p's coordinate along the tower of interest's frame x axis and the
+            node's station).
         realization: 0-based index.
         v_ref: [m/s]; length_scale: [m] L_u; intensity: [-] I; v_max: [m/s] downburst scale (NaN synoptic).
     """
@@ -77,9 +85,15 @@ def point_series(case: Case, realization: int = 0) -> PointSeries:
     system = LineSystem(case.line)
     time = record_times(case)
     xp = point_p(case)
-    node = int(np.argmin(np.abs(system.node_x0 - xp)))
-    vx, vy = mean_velocity_at(case, np.array([xp]), time)
-    vx, vy = vx[:, 0], vy[:, 0]
+    node = nearest_node_to_p(case, system)
+    if system.is_section:
+        # issue 17: the running mean at the node nearest p (its plan position and height)
+        vy, vx = (c[:, node] for c in mean_components_at_nodes(case, system, time))
+        node_x = float(system.node_station[node])
+    else:
+        vx, vy = mean_velocity_at(case, np.array([xp]), time)
+        vx, vy = vx[:, 0], vy[:, 0]
+        node_x = float(system.node_x0[node])
     speed = np.hypot(vx, vy)
     dt = case.analysis.time_step
     u = unit_field(case, system, time.size, dt, realization)[:, node].copy()
@@ -87,5 +101,5 @@ def point_series(case: Case, realization: int = 0) -> PointSeries:
     a = i * (speed if case.wind.type == "downburst" else np.full_like(speed, case.wind.v_ref))
     fluct = a * u
     v_max = downburst_field(case).v_max if case.wind.type == "downburst" else math.nan
-    return PointSeries(time, speed, vy, vx, fluct, speed + fluct, u, float(xp), node, float(system.node_x0[node]),
+    return PointSeries(time, speed, vy, vx, fluct, speed + fluct, u, float(xp), node, node_x,
                        realization, case.wind.v_ref, length_scale(case), i, float(v_max))

@@ -25,8 +25,15 @@ independent uniform phases phi (Deodatis 1996).  For equally spaced nodes
 C_jm = rho^|j-m| with rho = exp(-C f dx / V) (Kac-Murdock-Szego matrix), whose
 Cholesky factor is closed form (L_j0 = rho^j, L_jm = rho^(j-m) sqrt(1 - rho^2)): applying
 it is the AR(1) recursion y_j = rho y_(j-1) + sqrt(1 - rho^2) xi_j, O(N) per frequency
-and vectorised over frequencies.  Non-uniform spacing uses a general dense Cholesky
-per frequency with an eigen-decomposition fallback.
+and vectorised over frequencies.  Ordered points at any spacing (a line section of unequal
+spans, issue 17) use the same recursion with a coefficient per gap, rho_j = exp(-C f ds_j / V)
+(:func:`markov_apply`): exponential coherence along ordered points is Markov, so the
+coherence of nodes j < m is the product of the gap coefficients, exp(-C f (x_m - x_j) / V),
+exactly the Davenport coherence at the separation measured along the line.  The dense
+Cholesky per frequency (:func:`general_apply`, eigen-decomposition fallback) remains for
+unordered points and as the reference.  On a section the points are the nodes' stations
+(distance along the line); across an angle tower the straight plan distance is shorter, and
+the error this makes in the coherence is measured in docs/wind.md ("Sections").
 
 Randomness: realization r uses ``numpy.random.Generator(PCG64(SeedSequence(seed).spawn(r + 1)[r]))``
 only, so its field is bit-identical whatever else is generated and in any process.
@@ -58,7 +65,10 @@ __all__ = [
     "fluctuating_velocity",
     "general_apply",
     "kms_apply",
+    "gap_coherence",
     "length_scale",
+    "markov_apply",
+    "markov_quadratic_form",
     "mean_normal_at_nodes",
     "mean_speed_at_nodes",
     "modulation",
@@ -210,6 +220,66 @@ def kms_apply(rho: np.ndarray, xi: np.ndarray) -> np.ndarray:
     return y
 
 
+def markov_apply(x: np.ndarray, freq: np.ndarray, xi: np.ndarray, decay: float, v_mean: float) -> np.ndarray:
+    """y_k = L_k xi_k with L_k the Cholesky factor of exp(-C f_k |x_j - x_m| / V) for ordered x.
+
+    x [m] shape (n_nodes,), non-decreasing (any spacing); freq [Hz] (n_freq,); xi (n_nodes, n_freq)
+    complex -> y same shape.  Exponential coherence along ordered points is Markov: with the gap
+    coefficients rho_j = exp(-C f (x_j - x_(j-1)) / V) the recursion y_0 = xi_0,
+    y_j = rho_j y_(j-1) + sqrt(1 - rho_j^2) xi_j gives unit variance and
+    E[y_j y_m*] = prod_(j<i<=m) rho_i = exp(-C f (x_m - x_j) / V) (Davenport 1961), i.e. the
+    Cholesky factor of the coherence matrix (the KMS factor of :func:`kms_apply` generalised to
+    unequal gaps).  O(N) per frequency; a coefficient row per distinct gap is computed once.
+    """
+    x = np.asarray(x, dtype=float)
+    gaps = np.diff(x)
+    if np.any(gaps < 0):
+        raise ValueError("the Markov path needs ordered (non-decreasing) x")
+    freq = np.asarray(freq, dtype=float)
+    rows: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+    y = np.empty_like(xi)
+    y[0] = xi[0]
+    prev = y[0]
+    for j in range(1, xi.shape[0]):
+        ds = float(gaps[j - 1])
+        if ds not in rows:
+            # Davenport (1961) coherence of neighbours a gap ds apart, and the innovation weight
+            rho = davenport_coherence(freq, ds, decay, v_mean)
+            rows[ds] = (rho, np.sqrt(np.maximum(1.0 - rho * rho, 0.0)))
+        rho, s = rows[ds]
+        # AR(1) step with the gap's coefficient (Markov property of exp(-a |dx|))
+        prev = rho * prev + s * xi[j]
+        y[j] = prev
+    return y
+
+
+def gap_coherence(x: np.ndarray, freq: np.ndarray, decay: float, v_mean: float) -> np.ndarray:
+    """Davenport coherence of neighbouring points rho_j = exp(-C f (x_j - x_(j-1)) / V) [-] for
+    ordered x [m] (n_nodes,) at f [Hz] (n_f,), shape (n_nodes - 1, n_f) (Davenport 1961)."""
+    gaps = np.diff(np.asarray(x, dtype=float))
+    return davenport_coherence(np.asarray(freq, dtype=float)[None, :], gaps[:, None], decay, v_mean)
+
+
+def markov_quadratic_form(w: np.ndarray, rho_gaps: np.ndarray) -> np.ndarray:
+    """w^H Coh w [-] for the Markov coherence Coh_jm = prod of the gap coefficients between j and m
+    (Davenport coherence at separations along ordered points, any spacing), O(N) per frequency.
+
+    w (..., N, n_f) complex (node axis second to last, frequency last); rho_gaps (N - 1, n_f) from
+    :func:`gap_coherence`.  Returns (..., n_f) real.  With h_j = sum_(i<j) Coh_ij w_i the recursion
+    h_j = rho_j (h_(j-1) + w_(j-1)) holds because Coh_ij = Coh_i,j-1 rho_j (Markov property), and
+    w^H Coh w = sum |w_j|^2 + 2 Re sum_j conj(w_j) h_j.  Equal gaps: the KMS form of the spectral
+    check (core/spectral.py ``_quad_kms_nodes``) -- this is its unequal-spacing generalisation.
+    """
+    h = np.zeros(w.shape[:-2] + w.shape[-1:], dtype=complex)
+    total = np.sum(w.real**2 + w.imag**2, axis=-2)
+    cross = np.zeros(total.shape)
+    for j in range(1, w.shape[-2]):
+        h += w[..., j - 1, :]
+        h *= rho_gaps[j - 1]  # h_j = rho_j (h_(j-1) + w_(j-1))
+        cross += w[..., j, :].real * h.real + w[..., j, :].imag * h.imag
+    return total + 2.0 * cross
+
+
 def _factor(c: np.ndarray) -> np.ndarray:
     """A factor L with L L^T = c: lower Cholesky, or Q sqrt(Lambda) from the eigen-decomposition
     (negative round-off eigenvalues clipped) when c is not numerically positive definite."""
@@ -253,8 +323,9 @@ def synthesize(x: np.ndarray, grid: SpectralGrid, phases: np.ndarray, decay: flo
                method: str = "auto") -> np.ndarray:
     """Unit-variance field at points x [m] for given phases [rad]: shape (n_steps, n_nodes).
 
-    phases shape (n_nodes, n_freq).  ``method``: "kms" (equal spacing required), "general"
-    (dense factor per frequency) or "auto" (KMS when x is equally spaced).
+    phases shape (n_nodes, n_freq).  ``method``: "kms" (equal spacing required), "markov"
+    (ordered x at any spacing), "general" (dense factor per frequency) or "auto" (KMS when x is
+    equally spaced, else Markov when x is non-decreasing, else general).
     u_j(t_n) = sum_k A_k Re[(L_k e^(i phi_k))_j e^(i 2 pi f_k t_n)] (Deodatis 1996), by inverse FFT.
     """
     x = np.asarray(x, dtype=float)
@@ -264,12 +335,14 @@ def synthesize(x: np.ndarray, grid: SpectralGrid, phases: np.ndarray, decay: flo
     xi = np.exp(1j * phases)
     spacing = _uniform_spacing(x)
     if method == "auto":
-        method = "kms" if spacing is not None else "general"
+        method = "kms" if spacing is not None else ("markov" if np.all(np.diff(x) >= 0) else "general")
     if method == "kms":
         if spacing is None:
             raise ValueError("the KMS path needs equally spaced, increasing x")
         rho = davenport_coherence(grid.freq, spacing, decay, v_mean)  # coherence of neighbours: C_jk = rho^|j-k|
         y = kms_apply(rho, xi)
+    elif method == "markov":
+        y = markov_apply(x, grid.freq, xi, decay, v_mean)
     elif method == "general":
         y = general_apply(x, grid.freq, xi, decay, v_mean)
     else:
@@ -287,8 +360,11 @@ def unit_field(case: Case, system: LineSystem, n_steps: int, dt: float, realizat
 
     n_steps samples at dt [s]; realization: 0-based index.  Returns shape (n_steps, n_nodes).
     Bit-identical for the same case, seed, n_steps, dt and realization.
+    Points: the nodes' still-air x (equal-span form) or stations, the distance along the line
+    (section form, issue 17: the Markov path; see :func:`markov_apply`).  The coherence uses
+    the one speed V_ref whatever the profile (docs/wind.md, "Sections").
     """
-    x = system.node_x0
+    x = system.node_station if system.is_section else system.node_x0
     v = float(case.wind.v_ref)
     if not v > 0:
         raise CaseError("value 0.0 is not allowed for turbulence synthesis: expected v_ref > 0",
@@ -302,6 +378,9 @@ def modulation(case: Case, system: LineSystem, time: np.ndarray) -> np.ndarray:
     """a(x, t) [m/s] = I V_m(x, t) (downburst, speed magnitude at the nodes) or I V_ref (synoptic).
 
     Shape (n_steps, n_nodes) for a downburst, (1, 1) for synoptic (broadcasts).  Chay et al. (2006).
+    Synoptic with a power-law profile: sigma_u = I V_ref at every height (I is the intensity at
+    the reference height; the surface-layer sigma_u is about constant with height, sigma_u ~ 2.5 u*,
+    Burton et al., Wind Energy Handbook 2001, sec. 2.6.3 after ESDU 1985; docs/wind.md).
     """
     i = case.wind.turbulence_intensity
     # Chay et al. (2006), paper section 2.2: a = I V_m(x, t) (downburst), I V_ref (synoptic)

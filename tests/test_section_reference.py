@@ -110,7 +110,7 @@ def test_straight_section_still_air_does_not_move(stem):
     half-spans (V_B of the left span + V_A of the right), all to the mesh's O(1/n^2) ~3e-5."""
     sol = _ref(stem)
     st = sol.still
-    assert np.max(np.abs(st.clamp_displacement)) < 2e-3  # [m] (measured < 1e-4)
+    assert np.max(np.abs(st.clamp_displacement)) < 2e-4  # [m] (measured 1.9e-5: mesh error + penalty stretch)
     np.testing.assert_allclose(st.tension, H0, rtol=1e-4)
     cats = sol.geometry.catenary
     for j in range(1, len(cats)):

@@ -255,6 +255,8 @@ def _linecheck_json(command: str, stem: str, tmp_path: Path, *extra: str) -> dic
 
 def _lc_reactions(doc: dict) -> tuple[np.ndarray, np.ndarray]:
     """(tower-frame, global) reactions [N] from a static JSON, shape (n_towers, 3) each."""
+    missing = [t.get("index") for t in doc["towers"] if not isinstance(t.get("global"), dict)]
+    assert not missing, f'static JSON towers {missing} lack the "global" reactions block (issue 17 contract)'
     tw = np.array([[t["Rx"], t["Ry"], t["Rz"]] for t in doc["towers"]], dtype=float)
     gl = np.array([[t["global"]["Rx"], t["global"]["Ry"], t["global"]["Rz"]] for t in doc["towers"]], dtype=float)
     return tw, gl

@@ -140,8 +140,9 @@ def read_section(path: str | Path) -> Section:
     data = tomllib.loads(p.read_text(encoding="utf-8"))
     line, wind = data["line"], data.get("wind", {})
     if "towers_file" in line:
-        with open(p.parent / line["towers_file"], newline="", encoding="utf-8") as fh:
-            rows = [dict(r) for r in csv.DictReader(fh)]
+        with open(p.parent / line["towers_file"], newline="", encoding="utf-8-sig") as fh:
+            text = [ln for ln in fh if ln.strip() and not ln.lstrip().startswith("#")]  # comment lines
+        rows = [{(k or "").strip(): (v or "").strip() for k, v in r.items()} for r in csv.DictReader(text)]
     else:
         rows = list(line["towers"])
     towers = tuple(_tower_from_row(r, k) for k, r in enumerate(rows))

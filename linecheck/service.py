@@ -19,7 +19,7 @@ import numpy as np
 from .core import budget
 from .core.case import Case
 from .core.damping import aerodynamic_damping, stiffness_proportional
-from .core.dynamics import integrate
+from .core.dynamics import DynamicResponse, integrate
 from .core.errors import Cancelled
 from .core.model import build_model
 from .core.results import Statistics, compute_statistics
@@ -431,8 +431,13 @@ def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: n
         if quad:
             f_i += per_q * (v[i] * v[i] - sig2)
         loads[:, i, :] = f_i[:, free]
-        # loads at pinned nodes go straight into their supports (R_y)
-        direct[:, i, 3 * np.flatnonzero(~system.suspension) + 1] = f_i[:, pinned]
+        # loads at pinned nodes go straight into their supports (R_y; a section: along the node normal)
+        if system.straight_level:
+            direct[:, i, 3 * np.flatnonzero(~system.suspension) + 1] = f_i[:, pinned]
+        else:
+            b = system.node_normals[pinned]
+            direct[:, i, 3 * np.flatnonzero(~system.suspension)] = f_i[:, pinned] * b[:, 0]
+            direct[:, i, 3 * np.flatnonzero(~system.suspension) + 1] = f_i[:, pinned] * b[:, 1]
     return loads, direct
 
 
@@ -513,10 +518,13 @@ def run_case(
     cb = None if progress is None else (lambda d, n: progress("steps 2-3: dynamics", d, n))
     resp = integrate(models, damping, state_of_step, loads, dt, direct=direct,
                      model_at=_interpolated_models(case, st, bracket, weights) if interpolate_states else None,
-                     second_order=second, second_order_start=int(np.argmax(keep)), progress=cb, cancel=cancel)
+                     second_order=second, second_order_start=int(np.argmax(keep)), progress=cb, cancel=cancel,
+                     load_dirs=None if system.straight_level else system.node_normals[models[0].dofs.free_nodes])
+    # every reaction from here on in its tower's own frame (issue 17; a straight line: the global frame)
+    resp = DynamicResponse(system.to_tower_frames(resp.fluctuating), system.to_tower_frames(resp.background))
 
     # ---- mean M(t): step-1 reactions interpolated to the record grid (wind-induced)
-    rw = mean.reactions_wind  # (n_k, n_towers, 3)
+    rw = system.to_tower_frames(mean.reactions_wind)  # (n_k, n_towers, 3)
     if mean.time.size == 1:
         M = np.broadcast_to(rw[0], (t.size,) + rw.shape[1:]).copy()
     else:
@@ -524,7 +532,9 @@ def run_case(
         M = np.stack([np.interp(t, mean.time, flat[:, i]) for i in range(flat.shape[1])], axis=1).reshape(
             (t.size,) + rw.shape[1:])
     Bk, Rk = resp.background[:, keep], resp.resonant[:, keep]
-    stats = compute_statistics(M[keep], Bk, Rk, mean.still_air.reactions, case.g_yp_L, window=peak_window_steps(case))
+    gL = case.g_yp * system.eq17_lengths if system.is_section else case.g_yp_L  # Eq. 17 per tower (issue 17)
+    stats = compute_statistics(M[keep], Bk, Rk, system.to_tower_frames(mean.still_air.reactions), gL,
+                               window=peak_window_steps(case))
     j = case.line.tower_of_interest - 1
     spectral = spectral_analysis(case, static=st, synoptic=sm) if sm is not None and spectral_check else None
     return RunResult(
@@ -819,16 +829,23 @@ def spectral_analysis(case: Case, *, static: StaticResult | None = None,
     line, wind = case.line, case.wind
     t = record_time(case)
     j = case.line.tower_of_interest - 1
-    mean_r = mean.reactions_wind[0, j]
+    rw = st.system.to_tower_frames(mean.reactions_wind)  # each tower's own frame (issue 17)
+    mean_r = rw[0, j]
     from .core.results import ZERO_MEAN_RTOL
 
-    tol = ZERO_MEAN_RTOL * float(np.abs(mean.reactions_wind[0]).max())
+    tol = ZERO_MEAN_RTOL * float(np.abs(rw[0]).max())
     L_u = length_scale(case)
     exact = random_vibration(
         sm.model, sm.damping, sm.load_per_v, mean_r, j, modes=sm.modes, sigma=wind.turbulence_intensity * wind.v_ref, length_scale=L_u,
         v_mean=wind.v_ref, coherence_decay=wind.coherence_decay, duration=float(t[-1] - t[0]),
         band=(1e-5, 0.5 / case.analysis.time_step), zero_mean_tol=tol,
     )
+    reason = closed_form_not_applicable(case, st.system)
+    if reason:
+        from .core.spectral import DavenportEstimate
+
+        nan = float("nan")
+        return SpectralResult(case, exact, DavenportEstimate(*([nan] * 9)), False, f"not applicable: {reason}")
     H = float(mean.tension[0].mean())
     mu = line.mass_per_length
     span = st.system.common_span_length  # the closed form is for equal spans
@@ -849,6 +866,25 @@ def spectral_analysis(case: Case, *, static: StaticResult | None = None,
                 f"differs by {100 * diff:.0f} % from the exact estimate (> 15 %): the closed form's uniform "
                 "influence line and single mode do not represent this system; use estimate 1")
     return SpectralResult(case, exact, dav, ok, note)
+
+
+def closed_form_not_applicable(case: Case, system: LineSystem) -> str:
+    """Why the Davenport/Castanheta closed form (estimate 2) does not apply to this case, or ""
+    when it does: it assumes one straight row of equal, level spans, a uniform wind normal to
+    the line and one mean speed (issue 17)."""
+    if not system.is_section:
+        if case.wind.direction != 0.0 or case.wind.profile_exponent != 0.0:
+            return "the closed form assumes a uniform wind normal to the line (direction 0, no profile)"
+        return ""
+    if not system.equal_spans:
+        return "the spans of this section are unequal (the closed form is for one span length)"
+    if np.any(system.tower_angles):
+        return "the section has angle towers (the closed form is for a straight line)"
+    if np.ptp(system.clamp_points[:, 2]) > 0.0:
+        return "the section has inclined spans (the closed form is for level spans)"
+    if case.wind.direction != 0.0 or case.wind.profile_exponent != 0.0:
+        return "the closed form assumes a uniform wind normal to the line (direction 0, no profile)"
+    return ""
 
 
 @dataclass(frozen=True)
@@ -973,8 +1009,11 @@ def code_loads(case: Case, *, strict: bool = True) -> list:
     src = str(case.source) if case.source else None
     if wind.type == "downburst":
         return [C.downburst_load(code) for code in C.CODES]
-    # the codes' wind span: the section's common span (equal spans)
-    args = (wind.v_ref, line.height, LineSystem(line).common_span_length, line.diameter, line.drag_coefficient)
+    # the codes' wind span: the section's common span (equal spans); a section of unequal spans:
+    # Eq. 17's L_x at the tower of interest (line.span_length, docs/codes.md "Sections")
+    system = LineSystem(line)
+    span = system.common_span_length if system.equal_spans else float(line.span_length)
+    args = (wind.v_ref, line.height, span, line.diameter, line.drag_coefficient)
     calls = {
         "ASCE74": lambda: C.asce74_wire_load(*args, cc.asce74_exposure or C.TERRAIN_MAP["ASCE74"][cc.terrain],
                                              source=src),
@@ -1011,7 +1050,11 @@ def codes_analysis(case: Case, run: RunResult | None = None, *, strict: bool = T
     n_spans = line.spans
     speeds = np.asarray(wind.span_speeds if wind.span_speeds is not None else [wind.v_ref] * n_spans, dtype=float)
     scale = (speeds / wind.v_ref) ** 2 if wind.v_ref > 0 else np.ones(n_spans)
-    half = 0.5 * LineSystem(line).span_lengths * scale  # [m] equivalent half spans at v_ref
+    system = LineSystem(line)
+    if system.is_section or wind.direction != 0.0:
+        # the wind's normal component on every span, cos(d + h_i) (issue 17; docs/codes.md "Sections")
+        scale = scale * np.cos(np.radians(wind.direction) + system.span_headings) ** 2
+    half = 0.5 * system.span_lengths * scale  # [m] equivalent half spans at v_ref
     eq_span = np.zeros(n_spans + 1)
     eq_span[:-1] += half
     eq_span[1:] += half

@@ -20,6 +20,7 @@ CORE_MODULES = [
     "linecheck.core.spectral",
     "linecheck.core.codes",
     "linecheck.core.second_order",
+    "linecheck.core.catenary",
     "linecheck.core.wind.mean",
     "linecheck.core.wind.turbulence",
     "linecheck.core.wind.point",

@@ -108,6 +108,41 @@ drag = "linear"
 tension = "linear"
 ```
 
+## Sections: towers, angles and terrain (issue 17)
+
+A real section is described by its towers instead of the equal-span keys: `[line] tension` (H0,
+the still-air horizontal tension at clipping-in) and either one `[[line.towers]]` table per
+tower, in line order, or `towers_file = "section.csv"` (a CSV with a header row and the same
+columns: `name, station, ground, height, support, angle, insulator_length`; blank cells take
+the default; `#` lines are comments). `spans`, `span_length`, `sag`, `height` and `supports`
+are then not given (the loader derives them for display: `span_length` is Eq. 17's L_x, the
+mean of the two spans adjacent to the tower of interest). `cases/examples/section-12span.toml`
+is a worked example. The definitions (plan geometry, clipping-in, loads, tower frames) are in
+docs/method.md, "Line sections".
+
+```toml
+[line]
+tension = 20000.0          # N
+[[line.towers]]
+name = "T1"
+station = 0.0              # m along the line
+ground = 0.0               # m
+height = 43.0              # m above ground (clamp, still air)
+support = "strain"         # both end towers "strain"
+angle = 0.0                # deg, + turning left; 0 at the ends
+# insulator_length = 4.0   # suspension towers only (default: [line] insulator_length)
+```
+
+Section cross-checks (one line naming file, key or CSV row and column, value and what is
+allowed; exit 2): stations strictly increasing with spans of 10–3000 m; end towers `"strain"`
+with `angle = 0`; `insulator_length` only on suspension towers and below `height`; `height` >
+0 (a clamp below ground is refused); `tension` > W L/2 on every span (sag W L²/8H0 below a
+quarter of the span) and the still-air parabola clear of the straight ground line between
+towers; not both `towers_file` and `[[line.towers]]`; a CSV with a missing column, an unknown
+column or a non-number is refused naming its row and column. `[wind] direction`,
+`profile_exponent` and `reference_height` apply to both forms (equal-span form: every node at
+`height`).
+
 `drag` and `tension` (issue 16) choose how much of the non-linearity the method keeps. The
 paper's method is `drag = "linear"` (Eq. 5: the drag's v² term dropped) and `tension =
 "linear"` (reactions linear in the motion); the paper cases pin both and reproduce the paper's

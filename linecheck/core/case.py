@@ -23,6 +23,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from .errors import CaseError
 
 SUPPORT_TYPES = ("strain", "suspension")
@@ -99,19 +101,30 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         FieldSpec("description", "str", "", "one-line description", default=""),
     ),
     "line": (
-        _i("spans", "-", "number of spans in the modelled section", required=True, low=1, high=200),
-        _f("span_length", "m", "span length L_x (equal spans)", required=True, low=10.0, high=3000.0),
-        _f("sag", "m", "still-air mid-span sag S", required=True, low=0.0, high=None, low_open=True),
+        _i("spans", "-", "number of spans in the modelled section (equal-span form)", low=1, high=200),
+        _f("span_length", "m", "span length L_x (equal-span form)", low=10.0, high=3000.0),
+        _f("sag", "m", "still-air mid-span sag S (equal-span form)", low=0.0, high=None, low_open=True),
         _f("weight", "N/m", "conductor weight per unit length W", required=True, low=0.0, high=1000.0, low_open=True),
         _f("diameter", "m", "projected area per unit length D, i.e. the diameter of a single conductor (paper Table 1)", required=True, low=0.0, high=1.0, low_open=True),
         _f("drag_coefficient", "-", "drag coefficient C_d", default=1.0, low=0.0, high=3.0, low_open=True),
         _f("area", "m2", "conductor cross-section A", required=True, low=0.0, high=0.1, low_open=True),
         _f("elastic_modulus", "Pa", "elastic modulus E", required=True, low=1e8, high=1e12),
-        _f("height", "m", "average conductor elevation", required=True, low=1.0, high=500.0),
+        _f("height", "m", "average conductor elevation (equal-span form)", low=1.0, high=500.0),
         _f("insulator_length", "m", "suspension insulator length v", default=4.0, low=0.0, high=20.0, low_open=True),
         FieldSpec("supports", "str_list", "-", 'one per tower: "strain" or "suspension"', choices=SUPPORT_TYPES),
         _i("tower_of_interest", "-", "1-based tower whose reactions are reported", default=1, low=1),
         _i("elements_per_span", "-", "cable finite elements per span (step 2)", default=10, low=2, high=200),
+        _f("tension", "N", "section form: still-air horizontal tension H0 at clipping-in", low=0.0, high=1e7, low_open=True),
+        FieldSpec("towers_file", "str", "", "section form: CSV tower table (same columns as [[line.towers]]), relative to the case file"),
+    ),
+    "line.towers": (  # one [[line.towers]] table (or CSV row) per tower, in line order (issue 17)
+        FieldSpec("name", "str", "", "tower label shown in tables and sheets (default T1, T2, ...)"),
+        _f("station", "m", "horizontal distance along the line from the first tower", required=True, low=-1e7, high=1e7),
+        _f("ground", "m", "ground elevation at the tower", default=0.0, low=-1000.0, high=9000.0),
+        _f("height", "m", "conductor clamp height above ground in still air (> 0: a clamp below ground is not allowed)", required=True, low=0.0, high=500.0, low_open=True),
+        FieldSpec("support", "choice", "-", '"strain" or "suspension"; both end towers "strain"', required=True, choices=SUPPORT_TYPES),
+        _f("angle", "deg", "horizontal deviation of the line at the tower, + = turning left; 0 at the end towers", default=0.0, low=-90.0, high=90.0, low_open=True),
+        _f("insulator_length", "m", "suspension insulator length (default: line.insulator_length); suspension towers only", low=0.0, high=20.0, low_open=True),
     ),
     "wind": (
         FieldSpec("type", "choice", "-", "wind type", required=True, choices=WIND_TYPES),
@@ -121,6 +134,9 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         _f("coherence_decay", "-", "Davenport coherence decay constant C", default=10.0, low=0.0, high=100.0, low_open=True),
         _f("length_scale", "m", "von Karman length scale L_u (default: synoptic 52/0.3, downburst D_j)", low=0.0, high=1e5, low_open=True),
         FieldSpec("span_speeds", "float_list", "m/s", "synoptic only: mean speed per span (default v_ref on every span)", low=0.0, high=150.0),
+        _f("direction", "deg", "mean wind vector V (sin d, cos d, 0): 0 = +y, normal to the first span", default=0.0, low=-360.0, high=360.0),
+        _f("profile_exponent", "-", "power-law exponent alpha of V(z) = v_ref (z / reference_height)^alpha (0: uniform)", default=0.0, low=0.0, high=1.0),
+        _f("reference_height", "m", "height above ground of v_ref (default: the mean clamp height above ground)", low=0.0, high=1000.0, low_open=True),
     ),
     "wind.downburst": (
         FieldSpec("model", "choice", "-", 'running-mean model (default: "table" with a field file, else "holmes-oliver")', choices=DOWNBURST_MODELS),
@@ -171,8 +187,29 @@ def field_spec(section: str, key: str) -> FieldSpec:
 
 # --------------------------------------------------------------------------- dataclasses
 @dataclass(frozen=True)
+class Tower:
+    """One tower of a section (issue 17; docs/case-files.md "Sections").  SI, angles in degrees."""
+
+    name: str
+    station: float  # [m] horizontal distance along the line from the first tower
+    ground: float  # [m] ground elevation
+    height: float  # [m] still-air clamp height above ground
+    support: str  # SUPPORT_TYPES
+    angle: float = 0.0  # [deg] line deviation, + = turning left
+    insulator_length: float | None = None  # [m]; None = the line's default (suspension towers)
+
+
+@dataclass(frozen=True)
 class Line:
-    """Conductor system of one line section (paper Table 1)."""
+    """Conductor system of one line section (paper Table 1).
+
+    Two forms: the paper's equal-span form (``spans``, ``span_length``, ``sag``, ``height``,
+    ``supports``) and the section form (``towers`` + ``tension``, issue 17), for which the
+    loader derives ``spans`` (n_towers - 1), ``span_length`` (Eq. 17's L_x: the mean of the two
+    spans adjacent to the tower of interest), ``sag`` (W L_x^2 / 8 H0, display only),
+    ``height`` (mean clamp height above ground) and ``supports`` (from the towers) for display;
+    the numerical path reads the section's geometry from :class:`~linecheck.core.system.LineSystem`.
+    """
 
     spans: int
     span_length: float  # [m]
@@ -187,6 +224,14 @@ class Line:
     supports: tuple[str, ...]
     tower_of_interest: int  # 1-based
     elements_per_span: int = 10
+    tension: float | None = None  # [N] H0 at clipping-in (section form)
+    towers: tuple[Tower, ...] | None = None  # section form: one per tower, in line order
+    towers_file: str | None = None  # section form: CSV the towers were read from (as written)
+
+    @property
+    def is_section(self) -> bool:
+        """True for the section (towers) form, False for the paper's equal-span form."""
+        return self.towers is not None
 
     @property
     def n_towers(self) -> int:
@@ -241,6 +286,9 @@ class Wind:
     length_scale: float | None = None  # [m]; None = default of the wind type
     span_speeds: tuple[float, ...] | None = None  # [m/s]
     downburst: Downburst | None = None
+    direction: float = 0.0  # [deg] mean wind vector V (sin d, cos d, 0)
+    profile_exponent: float = 0.0  # [-] V(z) = v_ref (z / z_ref)^alpha
+    reference_height: float | None = None  # [m]; None = mean clamp height above ground
 
 
 @dataclass(frozen=True)
@@ -483,11 +531,26 @@ def case_from_dict(
     for required in ("line", "wind"):
         if required not in data:
             raise ctx.error("", required, f"missing required table [{required}]")
-    line_d = _read_section(data["line"], "line", ctx)
+    line_data = dict(data["line"]) if isinstance(data["line"], dict) else data["line"]
+    towers_data = line_data.pop("towers", None) if isinstance(line_data, dict) else None
+    line_d = _read_section(line_data, "line", ctx)
     wind_d = _read_section(data["wind"], "wind", ctx)
     an_d = _read_section(data.get("analysis", {}), "analysis", ctx)
 
     # ---- line cross-checks
+    if towers_data is not None or line_d["towers_file"] is not None or line_d["tension"] is not None:
+        line = _section_line(line_d, towers_data, ctx, base_dir)
+    else:
+        line = _equal_span_line(line_d, ctx)
+    return _finish_case(data, top, line, wind_d, an_d, ctx, file, default_name, base_dir)
+
+
+def _equal_span_line(line_d: dict[str, Any], ctx: _Ctx) -> Line:
+    """The paper's equal-span form: ``spans``, ``span_length``, ``sag``, ``height`` (and ``supports``)."""
+    for key in ("spans", "span_length", "sag", "height"):
+        if line_d[key] is None:
+            raise ctx.error("line", key, f"missing required key: expected {field_spec('line', key).allowed()} "
+                            "(or describe the section with [[line.towers]] or towers_file and tension)")
     n_towers = line_d["spans"] + 1
     if line_d["supports"] is None:
         if line_d["spans"] == 1:
@@ -513,7 +576,192 @@ def case_from_dict(
     if "suspension" in sup and line_d["insulator_length"] >= line_d["height"]:
         raise ctx.error("line", "insulator_length", f"value {line_d['insulator_length']!r} is not allowed with "
                         f"height = {line_d['height']!r} and suspension towers: expected insulator_length < height")
-    line = Line(**line_d)
+    return Line(**line_d)
+
+
+TOWER_COLUMNS = tuple(spec.name for spec in SCHEMA["line.towers"])
+MAX_TOWERS = 201  # 200 spans (the equal-span form's limit)
+_EQUAL_SPAN_KEYS = ("spans", "span_length", "sag", "height", "supports")
+
+
+def _tower_line(text: str | None, k: int, key: str | None) -> int | None:
+    """1-based file line of ``key`` in the k-th (0-based) ``[[line.towers]]`` table."""
+    if text is None:
+        return None
+    count = -1
+    inside = False
+    for n, raw in enumerate(text.splitlines(), start=1):
+        stripped = raw.strip()
+        if stripped.startswith("["):
+            inside = re.match(r"^\[\[\s*line\s*\.\s*towers\s*\]\]", stripped) is not None
+            if inside:
+                count += 1
+                if count == k and key is None:
+                    return n
+            continue
+        if inside and count == k and key is not None and re.match(rf"^\s*\"?{re.escape(key)}\"?\s*=", raw):
+            return n
+    return None
+
+
+class _TowerCtx(_Ctx):
+    """Error context of one tower: an inline [[line.towers]] table or a CSV row."""
+
+    def __init__(self, ctx: _Ctx, k: int, csv_file: str | None, row: int | None) -> None:
+        super().__init__(ctx.file, ctx.text)
+        self.k, self.csv_file, self.row = k, csv_file, row
+
+    def error(self, section: str, key: str | None, message: str) -> CaseError:
+        if self.csv_file is not None:
+            where = f"row {self.row}" + (f", column {key}" if key else "")
+            return CaseError(message, file=self.csv_file, key=where)
+        dotted = f"line.towers[{self.k + 1}]" + (f".{key}" if key else "")
+        return CaseError(message, file=self.file, key=dotted, line=_tower_line(self.text, self.k, key))
+
+
+def _read_towers_csv(path: Path, shown: str, ctx: _Ctx) -> list[tuple[dict[str, Any], int]]:
+    """Rows of a tower CSV as raw dicts (numbers parsed) with their 1-based file row numbers."""
+    import csv
+    import io
+
+    text = read_text_file(path, "a CSV tower table", MAX_CASE_BYTES)
+    lines = [ln for ln in io.StringIO(text)]
+    rows = list(csv.reader(lines))
+    # skip blank and comment lines, remembering file row numbers
+    numbered = [(i + 1, r) for i, r in enumerate(rows) if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
+    if not numbered:
+        raise CaseError(f"is empty: expected a header row with the columns {', '.join(TOWER_COLUMNS)} and one row per tower",
+                        file=str(path))
+    head_row, header = numbered[0]
+    header = [h.strip() for h in header]
+    for h in header:
+        if h not in TOWER_COLUMNS:
+            close = difflib.get_close_matches(h, TOWER_COLUMNS, n=1, cutoff=0.5)
+            hint = f'; did you mean "{close[0]}"?' if close else ""
+            raise CaseError(f"unknown column {_fmt(h)}{hint} (allowed: {', '.join(TOWER_COLUMNS)})", file=str(path),
+                            key=f"row {head_row}")
+    if len(set(header)) != len(header):
+        raise CaseError(f"header {_fmt(header)} repeats a column: expected each of {', '.join(TOWER_COLUMNS)} at most once",
+                        file=str(path), key=f"row {head_row}")
+    for spec in SCHEMA["line.towers"]:
+        if spec.required and spec.name not in header:
+            raise CaseError(f"missing column {_fmt(spec.name)}: expected the columns {', '.join(TOWER_COLUMNS)} "
+                            f"(required: station, height, support)", file=str(path), key=f"row {head_row}")
+    specs = {sp.name: sp for sp in SCHEMA["line.towers"]}
+    out = []
+    for row_no, r in numbered[1:]:
+        if len(r) > len(header):
+            raise CaseError(f"has {len(r)} cells: expected at most {len(header)} (one per header column)",
+                            file=str(path), key=f"row {row_no}")
+        d: dict[str, Any] = {}
+        for col, cell in zip(header, r):
+            cell = cell.strip()
+            if cell == "":
+                continue
+            if specs[col].kind == "float":
+                try:
+                    d[col] = float(cell)
+                except ValueError:
+                    raise CaseError(f"value {_fmt(cell)} is not a number: expected {specs[col].allowed()}",
+                                    file=str(path), key=f"row {row_no}, column {col}") from None
+            else:
+                d[col] = cell
+        out.append((d, row_no))
+    return out
+
+
+def _section_line(line_d: dict[str, Any], towers_data: Any, ctx: _Ctx, base_dir: Path | None) -> Line:
+    """The section form (issue 17): [[line.towers]] or towers_file, and tension H0."""
+    for key in _EQUAL_SPAN_KEYS:
+        if line_d[key] is not None:
+            raise ctx.error("line", key, f"value {_fmt(list(line_d[key]) if isinstance(line_d[key], tuple) else line_d[key])} "
+                            "is not allowed with a tower table: the towers define the section (remove "
+                            f"{key}, or remove [[line.towers]]/towers_file/tension to use the equal-span form)")
+    if towers_data is not None and line_d["towers_file"] is not None:
+        raise ctx.error("line", "towers_file", f"value {_fmt(line_d['towers_file'])} is not allowed together with "
+                        "[[line.towers]]: give the towers either inline or in the file, not both")
+    if line_d["tension"] is None:
+        raise ctx.error("line", "tension", f"missing required key for a tower table: expected {field_spec('line', 'tension').allowed()} "
+                        "(still-air horizontal tension H0 at clipping-in)")
+    raw: list[tuple[dict[str, Any], _TowerCtx]] = []
+    if line_d["towers_file"] is not None:
+        path = Path(line_d["towers_file"])
+        if not path.is_absolute() and base_dir is not None:
+            path = base_dir / path
+        if not path.exists():
+            raise ctx.error("line", "towers_file", f"value {_fmt(line_d['towers_file'])}: file {path} does not exist "
+                            "(expected a CSV tower table, see docs/case-files.md)")
+        for k, (d, row_no) in enumerate(_read_towers_csv(path, line_d["towers_file"], ctx)):
+            raw.append((d, _TowerCtx(ctx, k, str(path), row_no)))
+    elif towers_data is None:
+        raise ctx.error("line", "towers", "missing: give one [[line.towers]] table per tower or towers_file = \"section.csv\"")
+    else:
+        if not isinstance(towers_data, list) or not all(isinstance(t, dict) for t in towers_data):
+            raise ctx.error("line", "towers", f"value {_fmt(towers_data)} is not allowed: expected [[line.towers]] tables, one per tower")
+        raw = [(d, _TowerCtx(ctx, k, None, None)) for k, d in enumerate(towers_data)]
+    n = len(raw)
+    if not 2 <= n <= MAX_TOWERS:
+        raise ctx.error("line", "towers_file" if line_d["towers_file"] else "towers",
+                        f"has {n} towers: expected 2 to {MAX_TOWERS} towers (1 to {MAX_TOWERS - 1} spans)")
+    towers = []
+    for k, (d, tctx) in enumerate(raw):
+        td = _read_section(d, "line.towers", tctx)
+        if td["name"] is None:
+            td["name"] = f"T{k + 1}"
+        end = k in (0, n - 1)
+        if end and td["support"] != "strain":
+            raise tctx.error("", "support", f"value {_fmt(td['support'])} is not allowed at an end tower: expected \"strain\" "
+                             "(a suspension end leaves the section unrestrained along the line)")
+        if end and td["angle"] != 0.0:
+            raise tctx.error("", "angle", f"value {td['angle']!r} is not allowed at an end tower: expected 0 (the line "
+                             "deviates only at interior towers)")
+        if td["insulator_length"] is not None and td["support"] != "suspension":
+            raise tctx.error("", "insulator_length", f"value {td['insulator_length']!r} is not allowed at a strain tower: "
+                             "expected it on suspension towers only (remove it)")
+        v = td["insulator_length"] if td["insulator_length"] is not None else line_d["insulator_length"]
+        if td["support"] == "suspension" and v >= td["height"]:
+            raise tctx.error("", "height", f"value {td['height']!r} is not allowed with insulator length {v!r}: expected "
+                             "height > insulator_length (the insulator's top would be below its clamp's ground)")
+        if k and td["station"] <= towers[-1].station:
+            raise tctx.error("", "station", f"value {td['station']!r} is not allowed: expected stations increasing along the "
+                             f"line (the previous tower is at {towers[-1].station!r} m)")
+        if k:
+            span = td["station"] - towers[-1].station
+            if not 10.0 <= span <= 3000.0:
+                raise tctx.error("", "station", f"value {td['station']!r} gives a span of {span:g} m: expected spans "
+                                 "from 10 to 3000 m")
+        towers.append(Tower(**td))
+    H0, W = line_d["tension"], line_d["weight"]
+    for i in range(n - 1):
+        a, b = towers[i], towers[i + 1]
+        L = b.station - a.station
+        sag = W * L**2 / (8.0 * H0)  # parabolic mid-span sag (Irvine 1981 Eq. 2.8)
+        if sag >= 0.25 * L:
+            raise ctx.error("line", "tension", f"value {H0!r} is too low for span {i + 1} ({a.name}-{b.name}, {L:g} m): its "
+                            f"sag W L^2/(8 H0) = {sag:.4g} m exceeds a quarter of the span; expected tension > "
+                            f"W L/2 = {0.5 * W * L:.6g} N")
+        # lowest clearance above the ground line (parabola between the clamps)
+        s = np.linspace(0.0, 1.0, 201)
+        clear = a.height + (b.height - a.height) * s - 4.0 * sag * s * (1.0 - s)
+        if clear.min() <= 0.0:
+            raise ctx.error("line", "tension", f"value {H0!r} lets span {i + 1} ({a.name}-{b.name}) reach the ground "
+                            f"(lowest still-air clearance {clear.min():.3g} m): expected a higher tension or taller towers")
+    toi = line_d["tower_of_interest"]
+    if toi > n:
+        raise ctx.error("line", "tower_of_interest", f"value {toi} is out of range: expected an integer from 1 to {n} (number of towers)")
+    stations = np.array([t.station for t in towers])
+    spans = np.diff(stations)
+    j = toi - 1
+    adj = [spans[i] for i in (j - 1, j) if 0 <= i < n - 1]
+    L_x = float(sum(adj) / len(adj))  # Eq. 17's L_x: mean of the adjacent spans (issue 17)
+    d = dict(line_d)
+    d.update(spans=n - 1, span_length=L_x, sag=W * L_x**2 / (8.0 * H0),
+             height=float(np.mean([t.height for t in towers])),
+             supports=tuple(t.support for t in towers), towers=tuple(towers))
+    return Line(**d)
+
+
+def _finish_case(data, top, line: Line, wind_d, an_d, ctx: _Ctx, file, default_name, base_dir) -> Case:
 
     # ---- wind cross-checks
     db_data = data["wind"].get("downburst")
@@ -669,6 +917,9 @@ def case_hash(path: str | Path) -> str:
 
 
 # --------------------------------------------------------------------------- editing / writing
+_QUIET_DEFAULTS = ("direction", "profile_exponent")
+
+
 def case_to_dict(case: Case) -> dict[str, Any]:
     """The TOML document of a case (only keys that are set), inverse of :func:`case_from_dict`."""
     def pick(obj: Any, section: str) -> dict[str, Any]:
@@ -684,7 +935,16 @@ def case_to_dict(case: Case) -> dict[str, Any]:
     if case.description:
         doc["description"] = case.description
     doc["line"] = pick(case.line, "line")
+    if case.line.is_section:  # the towers define the section: the derived equal-span keys are not written
+        for key in _EQUAL_SPAN_KEYS:
+            doc["line"].pop(key, None)
+        if case.line.towers_file is None:
+            doc["line"]["towers"] = [{k: v for k, v in dataclasses.asdict(t).items() if v is not None}
+                                     for t in case.line.towers]
     doc["wind"] = pick(case.wind, "wind")
+    for key in _QUIET_DEFAULTS:  # issue 17 keys at their defaults are not written (older documents unchanged)
+        if doc["wind"].get(key) == field_spec("wind", key).default:
+            doc["wind"].pop(key)
     if case.wind.downburst is not None:
         db = pick(case.wind.downburst, "wind.downburst")
         if db.get("preset"):
@@ -728,6 +988,11 @@ def case_to_toml(case: Case) -> str:
         lines.append("")
         lines.append(f"[{section}]")
         emit(section, table)
+        if section == "line":
+            for tower in table.get("towers", ()):
+                lines.append("")
+                lines.append("[[line.towers]]")
+                emit("line.towers", tower)
     return "\n".join(lines) + "\n"
 
 

@@ -72,14 +72,22 @@ def aerodynamic_damping(case: Case, model: LinearModel, vn_nodes: np.ndarray, no
     ab = np.zeros((BANDWIDTH + 1, n_dof))
     c = coef * model.tributary[free] * np.abs(vn_nodes[free])  # (n_free,)
     first = model.dofs.node_dof[free]
+    system = model.system
     if case.analysis.damping == "paper":
-        ab[BANDWIDTH, first + 1] = c  # Eq. 9: transverse DOF only
+        if system.straight_level:
+            ab[BANDWIDTH, first + 1] = c  # Eq. 9: transverse DOF only
+        else:  # along each node's transverse direction b (issue 17): c b b^T
+            b = system.node_normals[free]
+            _add_node_blocks(ab, first, c[:, None, None] * b[:, :, None] * b[:, None, :])
         return project_axial(model, ab)  # a rigid insulator carries the axial part
     if nodes is None:
         raise ValueError("quasi-steady damping needs the mean-state node coordinates")
     e = node_tangents(model, nodes)[free]  # (n_free, 3)
     P = np.eye(3)[None] - e[:, :, None] * e[:, None, :]
-    w = P[:, :, 1]  # the wind (+y) projected normal to the axis
+    if system.straight_level:
+        w = P[:, :, 1]  # the wind (+y) projected normal to the axis
+    else:  # the node's transverse load direction b projected normal to the axis (issue 17)
+        w = np.einsum("nab,nb->na", P, system.node_normals[free])
     w = w / np.linalg.norm(w, axis=1)[:, None]
     ww = w[:, :, None] * w[:, None, :]
     blocks = c[:, None, None] * (ww + 0.5 * (P - ww))

@@ -101,6 +101,7 @@ def integrate(
     second_order_start: int = 0,
     progress: Callable[[int, int], None] | None = None,
     cancel: threading.Event | None = None,
+    load_dirs: np.ndarray | None = None,
 ) -> DynamicResponse:
     """Steps 2 and 3 for all realizations at once.
 
@@ -126,6 +127,8 @@ def integrate(
             the linear reactions).
         progress: ``progress(done, total)`` about every 1 % of the steps (per block).
         cancel: stop early (raises :class:`Cancelled`).
+        load_dirs: [-] unit direction of every free node's transverse load, shape (n_free, 3)
+            (issue 17: a section's span normals); None = the global y axis (a straight line).
 
     Returns:
         :class:`DynamicResponse` with tower reactions.  The record starts from the
@@ -152,8 +155,17 @@ def integrate(
     def loads_full(f: np.ndarray) -> np.ndarray:
         """y-loads (m, n_free) -> full transposed right-hand sides (m, n_dof)."""
         out = np.zeros((f.shape[0], n_dof))
-        out[:, ydof] = f
+        if load_dirs is None:
+            out[:, ydof] = f
+        else:  # along every node's load direction
+            out.reshape(f.shape[0], n_free, 3)[:] = f[..., None] * load_dirs
         return out
+
+    def from_ydof(A: np.ndarray) -> np.ndarray:
+        """Rows of a (n_dof, m) array combined along the load directions -> (n_free, m)."""
+        if load_dirs is None:
+            return A[ydof]
+        return np.einsum("nca,nc->na", A.reshape(n_free, 3, -1), load_dirs)
 
     # -------- step 3: quasi-static background, one factorisation per mean state
     R_B = np.empty((n_steps, n_real, n_r))
@@ -169,10 +181,14 @@ def integrate(
         for k in np.unique(state_of_step):
             c = _factor(models[k].K_band, np.zeros(n_dof), f"stiffness of mean state {k + 1}")
             # static transfer from the y-loads to the reactions, (G K^-1 P)^T = (K^-1 G^T)[y]
-            TB = np.ascontiguousarray(_solve(c, np.asfortranarray(models[k].G.T))[ydof])  # (n_free, n_r)
+            TB = np.ascontiguousarray(from_ydof(_solve(c, np.asfortranarray(models[k].G.T))))  # (n_free, n_r)
             if second_order is not None:  # (K^-1 P)^T: the y-loads to the quasi-static displacements
                 E = np.zeros((n_dof, n_free), order="F")
-                E[ydof, np.arange(n_free)] = 1.0
+                if load_dirs is None:
+                    E[ydof, np.arange(n_free)] = 1.0
+                else:
+                    for comp in range(3):
+                        E[3 * np.arange(n_free) + comp, np.arange(n_free)] = load_dirs[:, comp]
                 X = np.ascontiguousarray(_solve(c, E))  # (n_dof, n_free)
             all_steps = np.flatnonzero(state_of_step == k)
             for i0 in range(0, all_steps.size, chunk):
@@ -210,7 +226,7 @@ def integrate(
     st: _Stepper | None = None
     V = A = None
     for s0, s1 in zip(starts, ends):
-        new = _Stepper.build(*model_of(int(s0)), nm)
+        new = _Stepper.build(*model_of(int(s0)), nm, load_dirs)
         if st is None:
             U = st_rotate(U, None, new)
             V = np.zeros_like(U)
@@ -337,13 +353,13 @@ class _Stepper:
     rest: object  # off-diagonal part of C~ (scipy CSR) or None
     a1: float
     r2: float  # 2/dt
-    ycoef: np.ndarray  # local components of a unit global y-load, (n_nodes, 3)
+    ycoef: np.ndarray  # local components of a unit load along each node's load direction (global y), (n_nodes, 3)
     axial: np.ndarray  # rotated coordinates along the insulator axes, (n_susp,)
     nz: np.ndarray  # coordinates that enter the reactions, (n_nz,)
     GT: np.ndarray  # [N/m] (G T)^T rows nz, (n_nz, n_r)
 
     @staticmethod
-    def build(model: LinearModel, c_band: np.ndarray, nm: Newmark) -> "_Stepper":
+    def build(model: LinearModel, c_band: np.ndarray, nm: Newmark, load_dirs: np.ndarray | None = None) -> "_Stepper":
         T = node_bases(model, c_band)
         Kr = rotate_band(model.K_band, T)
         Cr = rotate_band(c_band, T)
@@ -366,7 +382,8 @@ class _Stepper:
         Gr = np.einsum("rna,naj->rnj", model.G.reshape(model.G.shape[0], -1, 3), T).reshape(model.G.shape)
         nz = np.flatnonzero(np.any(Gr != 0.0, axis=0))
         return _Stepper(T, chat, dm, nm.a0 * dm + nm.a1 * dc, nm.a2 * dm + dc, rest, nm.a1, 2.0 / nm.dt,
-                        np.ascontiguousarray(T[:, 1, :]), axial, nz, np.ascontiguousarray(Gr.T[nz]))
+                        np.ascontiguousarray(T[:, 1, :] if load_dirs is None else np.einsum("naj,na->nj", T, load_dirs)),
+                        axial, nz, np.ascontiguousarray(Gr.T[nz]))
 
     def reactions(self, U: np.ndarray) -> np.ndarray:
         """[N] G u for rotated vectors U (..., n_dof) -> (..., n_r), accumulated coordinate

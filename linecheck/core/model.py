@@ -185,7 +185,7 @@ def build_model(system: LineSystem, state: StaticState) -> LinearModel:
                     ab[u + i - j, j] += blk[a_, b_]
 
     # insulators (issue 4): axially stiff, geometric stiffness R_res/v transversely
-    v = line.insulator_length
+    v_all = system.insulator_lengths  # per tower (issue 17; equal-span form: line.insulator_length)
     # stiffest cable element of the section (equal spans: every element, L_u / ne)
     ea_cable_el = line.ea / float(system.element_unstretched_lengths.min())
     k_ax = INSULATOR_AXIAL_FACTOR * ea_cable_el
@@ -193,6 +193,7 @@ def build_model(system: LineSystem, state: StaticState) -> LinearModel:
     axes, axial_dof = [], []
     K_axial = np.zeros_like(ab)
     for j in np.flatnonzero(system.suspension):
+        v = v_all[j]
         d = state.displacement[j]
         axis = np.array([d[0], d[1], d[2] - v]) / v  # from fixed point to attachment (points down)
         axis /= np.linalg.norm(axis)
@@ -301,13 +302,19 @@ def condensed(model: LinearModel, damping_band: np.ndarray | None = None) -> Con
 
 
 def reaction_matrix_direct(system: LineSystem) -> np.ndarray:
-    """D: reactions from nodal y-loads applied at pinned nodes, shape (n_towers*3, n_nodes).
+    """D: reactions from nodal transverse loads applied at pinned nodes, shape (n_towers*3, n_nodes).
 
-    A load applied directly at a pinned node goes straight into its support.
+    A load applied directly at a pinned node goes straight into its support (along the
+    node's load direction, :attr:`LineSystem.node_normals`; global y on a straight line).
     """
     D = np.zeros((3 * system.n_towers, system.n_nodes))
     for j in np.flatnonzero(~system.suspension):
-        D[3 * j + 1, system.tower_nodes[j]] = 1.0
+        if system.straight_level:
+            D[3 * j + 1, system.tower_nodes[j]] = 1.0
+        else:
+            b = system.node_normals[system.tower_nodes[j]]
+            D[3 * j, system.tower_nodes[j]] = b[0]
+            D[3 * j + 1, system.tower_nodes[j]] = b[1]
     return D
 
 

@@ -121,7 +121,7 @@ def compute_statistics(
     background: np.ndarray,
     resonant: np.ndarray,
     still_air: np.ndarray,
-    g_yp_L: float,
+    g_yp_L: float | np.ndarray,
     window: int | None = None,
 ) -> Statistics:
     """Statistics of Eqs 15-17 from response histories.
@@ -137,7 +137,8 @@ def compute_statistics(
         background: [N] B(t), shape (n_real, n_t, n_towers, 3).
         resonant: [N] R(t) = F - B, same shape.
         still_air: [N] still-air reactions, shape (n_towers, 3).
-        g_yp_L: [N] normalising force g*_yp L_x (Eq. 17).
+        g_yp_L: [N] normalising force g*_yp L_x (Eq. 17): a number, or one per tower (n_towers,)
+            (a section: L_x the mean of the tower's two adjacent spans).
         window: samples per peak window (None: the whole record).
     """
     scale = max(float(np.abs(mean).max()), 1e-300)
@@ -170,8 +171,10 @@ def compute_statistics(
         cont_m = np.where(pk_dy > 0, mean_max / pk_dy, np.nan)
         cont_bg = np.where(pk_dy > 0, (pk_qs - mean_max) / pk_dy, np.nan)
         cont_r = np.where(pk_dy > 0, (pk_dy - pk_qs) / pk_dy, np.nan)
-        norm = pk_dy / g_yp_L if g_yp_L > 0 else np.full_like(pk_dy, np.nan)
-        norm_t = pk_dy_t / g_yp_L if g_yp_L > 0 else np.full_like(pk_dy, np.nan)
+        g = np.asarray(g_yp_L, dtype=float)
+        gL = g[:, None] if g.ndim else g_yp_L  # per tower (a section's L_x differs, issue 17)
+        norm = pk_dy / gL if np.all(g > 0) else np.full_like(pk_dy, np.nan)
+        norm_t = pk_dy_t / gL if np.all(g > 0) else np.full_like(pk_dy, np.nan)
     return Statistics(
         mean_max=mean_max,
         rms_background=rms_b,

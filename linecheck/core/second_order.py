@@ -86,7 +86,7 @@ def second_order_operator(model: LinearModel, state: StaticState) -> SecondOrder
     e_el = seg / Le[:, None]
     c_el = (line.ea - state.element_tension) / Le**2  # (EA - N)/L_e^2, k L_e = EA (Eq. 7)
     sus = np.flatnonzero(system.suspension)
-    v = line.insulator_length
+    v = system.insulator_lengths[sus]  # per tower (issue 17)
     k_ax = INSULATOR_AXIAL_FACTOR * line.ea / float(system.element_unstretched_lengths.min())  # as model.py
     c_in = (k_ax * v - state.insulator_force[sus]) / v**2
     n_el, n_s = e_el.shape[0], sus.size

@@ -246,16 +246,60 @@ def _general_band(ab_upper: np.ndarray) -> np.ndarray:
 def _quad_kms(w: np.ndarray, rho: np.ndarray) -> np.ndarray:
     """w^H Coh w for Coh_ij = rho^|i-j| (equally spaced nodes), O(N) per frequency.
 
-    Args: w (n_f, ..., N) complex; rho (n_f,) in [0, 1).  Returns (n_f, ...) real.
+    Args: w (n_f, ..., N) complex; rho (n_f,) in [0, 1), or per gap (n_f, N-1) for unequally
+        spaced points (Markov coherence Coh_ij = prod of the gaps' rho between i and j,
+        issue 17).  Returns (n_f, ...) real.
     """
-    r = rho.reshape((-1,) + (1,) * (w.ndim - 2))
+    gap = rho.ndim == 2
+    shape = (-1,) + (1,) * (w.ndim - 2)
+    r = rho.reshape(shape) if not gap else None
     h = np.zeros(w.shape[:-1], dtype=complex)
     total = np.sum(np.abs(w) ** 2, axis=-1)
     cross = np.zeros(w.shape[:-1])
     for j in range(1, w.shape[-1]):
-        h = r * (h + w[..., j - 1])  # h_j = sum_{i<j} rho^(j-i) w_i
+        rj = r if not gap else rho[:, j - 1].reshape(shape)
+        h = rj * (h + w[..., j - 1])  # h_j = sum_{i<j} rho^(j-i) w_i
         cross += np.real(np.conj(w[..., j]) * h)
     return total + 2.0 * cross
+
+
+def markov_rho(system, f: np.ndarray, coherence_decay: float, v_mean: float) -> np.ndarray:
+    """Davenport coherence of neighbouring FE nodes, exp(-C f dx / V) (Davenport 1961).
+
+    Equally spaced nodes (the equal-span form): shape (n_f,) with dx the element length
+    (Kac-Murdock-Szego coherence).  A section: per gap, shape (n_f, n_nodes - 1), dx the plan
+    distance between neighbouring still-air nodes (:attr:`LineSystem.node_gaps`); the
+    coherence of non-neighbours is then the product along the line (Markov), as in the
+    turbulence synthesis (docs/wind.md, "Sections")."""
+    if not system.is_section:
+        dx = system.uniform_element_length
+        return np.exp(-coherence_decay * f * dx / v_mean)
+    return np.exp(-coherence_decay * f[:, None] * system.node_gaps[None, :] / v_mean)
+
+
+def tower_rows(model: LinearModel, A: np.ndarray, tower: int) -> np.ndarray:
+    """The three reaction rows of ``tower`` of A (3 n_towers, ...) in the tower's own frame
+    (issue 17: x along its mean heading, y turned +90 deg, z down; a straight line: as is)."""
+    rows = A[3 * tower:3 * tower + 3]
+    system = model.system
+    if system.straight_level:
+        return rows
+    psi = system.tower_headings[tower]
+    Q = np.array([[np.cos(psi), np.sin(psi), 0.0], [-np.sin(psi), np.cos(psi), 0.0], [0.0, 0.0, 1.0]])
+    return np.tensordot(Q, rows, axes=1)
+
+
+def load_rows(model: LinearModel, A: np.ndarray) -> np.ndarray:
+    """Rows of a DOF array A (n_dof, ...) taken along every free node's transverse load
+    direction -> (n_free, ...): the y rows on a straight line, sum_c b_c A[3i + c] on a section."""
+    free = model.dofs.free_nodes
+    ydof = model.dofs.node_dof[free] + 1
+    system = model.system
+    if system.straight_level:
+        return A[ydof]
+    b = system.node_normals[free]
+    first = model.dofs.node_dof[free]
+    return sum(b[:, c].reshape((-1,) + (1,) * (A.ndim - 1)) * A[first + c] for c in range(3))
 
 
 MODAL_CONDITION_LIMIT = 1e8  # eigenvalue condition number above which the modal sum is not trusted
@@ -290,10 +334,9 @@ class ModalTransfer:
         ex, S = modes.expansion, modes.S
         n_t = S.shape[1]
         free = model.dofs.free_nodes
-        ydof = model.dofs.node_dof[free] + 1
-        G = model.G[3 * tower:3 * tower + 3]
+        G = tower_rows(model, model.G, tower)
         r = G @ (S @ ex.right[:n_t])  # (3, n_e)
-        c = ex.left[n_t:].conj().T @ (S[ydof].T / modes.mass[:, None])  # (n_e, n_free)
+        c = ex.left[n_t:].conj().T @ (load_rows(model, S).T / modes.mass[:, None])  # (n_e, n_free)
         A = r.T[:, :, None] * (c / ex.norm[:, None])[:, None, :]  # (n_e, 3, n_free)
         lam = ex.poles
         pair = lam.imag > 0.0
@@ -446,13 +489,14 @@ def _banded_solve(blocks, omega: np.ndarray, rhs: np.ndarray) -> np.ndarray:
 
 def _quad_kms_nodes(w: np.ndarray, rho: np.ndarray) -> np.ndarray:
     """:func:`_quad_kms` with the node axis second to last and frequency last:
-    w (..., N, n_f) complex, rho (n_f,) -> (..., n_f) real."""
+    w (..., N, n_f) complex, rho (n_f,) or per gap (N-1, n_f) -> (..., n_f) real."""
     h = np.zeros(w.shape[:-2] + w.shape[-1:], dtype=complex)
     total = np.sum(w.real**2 + w.imag**2, axis=-2)
     cross = np.zeros(total.shape)
+    gap = rho.ndim == 2
     for j in range(1, w.shape[-2]):
         h += w[..., j - 1, :]
-        h *= rho  # h_j = sum_{i<j} rho^(j-i) w_i
+        h *= rho if not gap else rho[j - 1]  # h_j = sum_{i<j} rho^(j-i) w_i
         cross += w[..., j, :].real * h.real + w[..., j, :].imag * h.imag
     return total + 2.0 * cross
 
@@ -522,16 +566,14 @@ def random_vibration(
     system = model.system
     n_dof = model.mass.size
     free = model.dofs.free_nodes
-    rows = slice(3 * tower, 3 * tower + 3)
-    Gt = model.G[rows]  # (3, n_dof)
-    Dt = reaction_matrix_direct(system)[rows]  # (3, n_nodes)
-    ydof = model.dofs.node_dof[free] + 1
+    Gt = tower_rows(model, model.G, tower)  # (3, n_dof), in the tower's frame
+    Dt = tower_rows(model, reaction_matrix_direct(system), tower)  # (3, n_nodes)
 
     # background transfer t_B = G K^-1 P + D (K symmetric: solve with G^T)
     K_gen = _general_band(model.K_band)
     xB = solve_banded((BANDWIDTH, BANDWIDTH), K_gen, Gt.T)  # (n_dof, 3)
     tB = Dt.astype(complex).copy()
-    tB[:, free] += xB[ydof].T
+    tB[:, free] += load_rows(model, xB).T
 
     if modes is None:
         modes = complex_modes(model, damping, max_hz=band[1] * 1.5)
@@ -543,11 +585,10 @@ def random_vibration(
                                  v_mean=v_mean, coherence_decay=coherence_decay, max_hz=np.inf)
         refine = mc.significant(GRID_SIGNIFICANCE)
     f = frequency_grid(band[0], band[1], modes, refine=refine)
-    dx = system.uniform_element_length  # KMS coherence: equally spaced nodes
     # the synthesis scales the spectrum to unit variance below its top frequency
     # (linecheck.core.wind.turbulence.spectral_grid); do the same here
     Sv = von_karman(f, sigma, length_scale, v_mean) / float(von_karman_cumulative(band[1], length_scale, v_mean))
-    rho = np.exp(-coherence_decay * f * dx / v_mean)  # Davenport coherence between neighbours
+    rho = markov_rho(system, f, coherence_decay, v_mean)  # Davenport coherence between neighbours
     SB = np.empty((f.size, 3))
     SF = np.empty((f.size, 3))
     SR = np.empty((f.size, 3))
@@ -557,11 +598,15 @@ def random_vibration(
     rhs = Gt.T.reshape(-1, 3, 3)  # (n_free_nodes, 3 dofs, 3 reactions): K symmetric, solve with G^T
 
     def direct(omega: np.ndarray) -> np.ndarray:  # (3, n_free, n_f)
-        return dynamic_solve(blocks, omega, rhs)[:, 1].transpose(1, 0, 2)  # y DOF of every free node
+        X = dynamic_solve(blocks, omega, rhs)  # (n_free, 3 dofs, 3 reactions, n_f)
+        if system.straight_level:
+            return X[:, 1].transpose(1, 0, 2)  # y DOF of every free node
+        b = system.node_normals[free]  # along every node's load direction (issue 17)
+        return np.einsum("ncrf,nc->rnf", X, b)
 
     transfer, method = direct, "direct"
     if modal_ok:
-        modal = ModalTransfer(model, modes, tower, xB[ydof].T)
+        modal = ModalTransfer(model, modes, tower, load_rows(model, xB).T)
         check = 2 * np.pi * f[:: max(1, f.size // 40)]
         ref = direct(check)
         if np.abs(modal(check) - ref).max() <= MODAL_CHECK_RTOL * np.abs(ref).max():
@@ -574,7 +619,7 @@ def random_vibration(
         tF[:, free] += transfer(2 * np.pi * fc)
         sl = slice(c0, c0 + fc.size)
         tFa = tF * aT
-        q = _quad_kms_nodes(np.concatenate([np.broadcast_to(tBaT, tF.shape), tFa, tFa - tBaT]), rho[sl])
+        q = _quad_kms_nodes(np.concatenate([np.broadcast_to(tBaT, tF.shape), tFa, tFa - tBaT]), rho[sl].T if rho.ndim == 2 else rho[sl])
         SB[sl], SF[sl], SR[sl] = (Sv[sl, None] * q[3 * i:3 * i + 3].T for i in range(3))
 
     def integ(y: np.ndarray) -> np.ndarray:
@@ -734,15 +779,13 @@ def modal_contributions(
     lam, vl, vr = modes.poles[sel], modes.left[:, sel], modes.right[:, sel]
     f = modes.frequencies_hz[sel]
     free = model.dofs.free_nodes
-    ydof = model.dofs.node_dof[free] + 1
-    rows = slice(3 * tower, 3 * tower + 3)
+    Gt = tower_rows(model, model.G, tower)  # in the tower's frame (issue 17)
     norm = np.abs(modes.norm[sel])  # |chi^H psi|
-    r = (model.G[rows] @ S) @ vr  # (3, n_modes) reaction per unit modal amplitude
-    L = S[ydof].T / modes.mass[:, None]  # M*^-1 S^T maps a y-load at free node i to b
+    r = (Gt @ S) @ vr  # (3, n_modes) reaction per unit modal amplitude
+    L = load_rows(model, S).T / modes.mass[:, None]  # M*^-1 S^T maps a y-load at free node i to b
     cvec = np.zeros((lam.size, system.n_nodes), dtype=complex)
     cvec[:, free] = (vl.conj().T @ L) * load_per_v[free][None, :]
-    dx = system.uniform_element_length  # KMS coherence: equally spaced nodes
-    rho = np.exp(-coherence_decay * f * dx / v_mean)
+    rho = markov_rho(system, f, coherence_decay, v_mean)
     SQ = von_karman(f, sigma, length_scale, v_mean) * _quad_kms(cvec, rho)
     rate = -lam.real
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -750,11 +793,11 @@ def modal_contributions(
     rms = np.abs(r.T) * np.sqrt(var)[:, None]
     # background r.m.s. by the quasi-static transfer, integrated over the spectrum
     K_gen = _general_band(model.K_band)
-    xB = solve_banded((BANDWIDTH, BANDWIDTH), K_gen, model.G[rows].T)
-    tB = reaction_matrix_direct(system)[rows].astype(float).copy()
-    tB[:, free] += xB[ydof].T
+    xB = solve_banded((BANDWIDTH, BANDWIDTH), K_gen, Gt.T)
+    tB = tower_rows(model, reaction_matrix_direct(system), tower).astype(float).copy()
+    tB[:, free] += load_rows(model, xB).T
     fb = np.geomspace(1e-5, 10.0, 600)
-    rhob = np.exp(-coherence_decay * fb * dx / v_mean)
+    rhob = markov_rho(system, fb, coherence_decay, v_mean)
     wb = np.broadcast_to((tB * load_per_v[None, :])[None], (fb.size, 3, system.n_nodes)).astype(complex)
     SB = von_karman(fb, sigma, length_scale, v_mean)[:, None] * _quad_kms(wb, rhob)
     rms_b = np.sqrt(np.trapezoid(SB, fb, axis=0))

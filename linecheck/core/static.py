@@ -246,6 +246,8 @@ def solve_static(
         raise ValueError(f"gy must have shape {(system.n_spans, system.ne + 1)}, got {gy.shape}")
     if not np.all(np.isfinite(gy)):
         raise ConvergenceError(f"{label}: non-finite mean-wind load")
+    if system.is_section:
+        return _section_states(system, gy[None], [label], tol=tol, max_iter=max_iter, initial=initial)[0]
     if initial is not None:
         d = initial.displacement.copy()
         H = initial.tension.copy()
@@ -428,6 +430,65 @@ def _final_state(system: LineSystem, Lu: np.ndarray, my_hat: np.ndarray, mz_hat:
     )
 
 
+def section_loads(system: LineSystem, gy: np.ndarray) -> np.ndarray:
+    """Load vectors per unit unstretched length [N/m] of a section: weight W downward plus the
+    transverse intensity gy along each span's horizontal normal, shape gy.shape + (3,)."""
+    p = gy[..., None] * system.span_normals[:, None, :]
+    p[..., 2] -= system.line.weight
+    return p
+
+
+def _section_states(system: LineSystem, gy: np.ndarray, labels: list[str], *, tol: float, max_iter: int,
+                    initial: StaticState | None = None, progress=None, cancel=None) -> list[StaticState]:
+    """Step 1 of the section form (issue 17): exact elastic spans, Newton over the suspension
+    clamps (:mod:`linecheck.core.catenary`); the same StaticState as the paper's solver."""
+    from .catenary import equilibrium, start_tension
+
+    n_s = gy.shape[0]
+    line = system.line
+    Lu = system.unstretched_lengths
+    clamps = system.clamp_points
+    p = section_loads(system, gy)
+    if initial is not None:
+        pos = np.broadcast_to(clamps + initial.displacement, (n_s,) + clamps.shape).copy()
+        H = np.broadcast_to(initial.tension, (n_s, system.n_spans))
+    else:
+        pos = np.broadcast_to(clamps, (n_s,) + clamps.shape).copy()
+        wres = np.hypot(line.weight, np.abs(gy).mean(axis=-1))  # resultant-load start (as the paper solver)
+        H = system.tension_nominal * wres / line.weight
+    N0 = start_tension(np.diff(pos, axis=1), p, Lu, H)
+    eq = equilibrium(clamps, system.insulator_tops, system.insulator_lengths, system.suspension,
+                     system.tower_along, p, Lu, line.ea, pos, N0, labels=labels, tol=tol, max_iter=max_iter,
+                     progress=progress, cancel=cancel)
+    e_span = np.stack([np.cos(system.span_headings), np.sin(system.span_headings), np.zeros(system.n_spans)], axis=1)
+    out = []
+    for j in range(n_s):
+        sol_r = eq.spans.r[j]  # (n_spans, ne+1, 3)
+        nodes = np.empty((system.n_nodes, 3))
+        r = eq.p[j, :-1, None, :] + sol_r
+        nodes[:-1] = r[:, :-1].reshape(-1, 3)
+        nodes[-1] = r[-1, -1]
+        f = eq.force[j]
+        R = f * np.array([1.0, 1.0, -1.0])  # force on the tower's fixed point, R_z downward
+        T_el = eq.spans.element_tension[j].reshape(-1)
+        strain = T_el.max() / line.ea
+        if strain > MAX_STRAIN or not np.isfinite(strain):
+            raise ConvergenceError(
+                f"{labels[j]}: no admissible equilibrium: conductor strain {strain:.3g} exceeds {MAX_STRAIN:g} "
+                f"(tension {T_el.max():.4g} N); check the loads")
+        out.append(StaticState(
+            displacement=eq.p[j] - clamps,
+            reactions=R,
+            tension=np.einsum("ij,ij->i", eq.spans.N0[j], e_span),
+            insulator_force=np.linalg.norm(f, axis=1),
+            nodes=nodes,
+            element_tension=T_el,
+            iterations=int(eq.iterations[j]),
+            residual=float(eq.residual[j]),
+        ))
+    return out
+
+
 def _tridiag_solve(sub: np.ndarray, diag: np.ndarray, sup: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Thomas algorithm vectorised over a leading axis: (n_b, k-1), (n_b, k), (n_b, k-1), (n_b, k).
 
@@ -483,6 +544,8 @@ def solve_static_batch(
     bad = np.flatnonzero(~np.all(np.isfinite(gy.reshape(n_s, -1)), axis=1))
     if bad.size:
         raise ConvergenceError(f"{labels[bad[0]]}: non-finite mean-wind load")
+    if system.is_section:
+        return _section_states(system, gy, labels, tol=tol, max_iter=max_iter, progress=progress, cancel=cancel)
     still = still_air_state(system)
     d = np.broadcast_to(still.displacement, (n_s, nt, 3))
     H = np.broadcast_to(still.tension, (n_s, system.n_spans))

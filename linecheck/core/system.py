@@ -68,6 +68,8 @@ class LineSystem:
     @cached_property
     def span_lengths(self) -> np.ndarray:
         """Horizontal length of every span [m], shape (n_spans,) (equal spans: L_x each)."""
+        if self.is_section:
+            return np.diff(self.stations)
         return np.full(self.n_spans, float(self.line.span_length))
 
     @property
@@ -87,7 +89,12 @@ class LineSystem:
 
     @cached_property
     def unstretched_lengths(self) -> np.ndarray:
-        """Unstretched conductor length of every span L_u [m], shape (n_spans,)."""
+        """Unstretched conductor length of every span L_u [m], shape (n_spans,).
+
+        Section form: the inclined elastic catenary with horizontal tension H0 between the two
+        still-air clamps (Irvine 1981, :func:`~linecheck.core.catenary.clip_in`)."""
+        if self.is_section:
+            return self._clip_in[0]
         return np.full(self.n_spans, self.unstretched_length)
 
     @cached_property
@@ -114,15 +121,231 @@ class LineSystem:
     # ------------------------------------------------------------------ per-tower geometry
     @cached_property
     def tower_x(self) -> np.ndarray:
-        """Tower stations [m] (still-air clamp x), shape (n_towers,)."""
+        """Tower stations [m] along the line from the first tower, shape (n_towers,)
+        (equal-span form: also the still-air clamp x)."""
+        if self.is_section:
+            return self.stations
         return np.arange(self.n_towers, dtype=float) * self.line.span_length
 
     @cached_property
     def clamp_points(self) -> np.ndarray:
-        """Still-air conductor clamp points (x, y, z) [m], shape (n_towers, 3); level (z = 0), y = 0."""
+        """Still-air conductor clamp points (x, y, z) [m], shape (n_towers, 3).
+
+        Equal-span form: level (z = 0) on y = 0.  Section form: plan position P_j (the first
+        span along +x, span i turned by its heading h_i) and z = ground + height (docs/method.md,
+        "Line sections")."""
         p = np.zeros((self.n_towers, 3))
+        if self.is_section:
+            h = self.span_headings
+            L = self.span_lengths
+            p[1:, 0] = np.cumsum(L * np.cos(h))
+            p[1:, 1] = np.cumsum(L * np.sin(h))
+            p[:, 2] = self.ground + np.array([t.height for t in self.line.towers])
+            return p
         p[:, 0] = self.tower_x
         return p
+
+    # ------------------------------------------------------------------ section form (issue 17)
+    @property
+    def is_section(self) -> bool:
+        """True when the case describes its towers ([[line.towers]] / towers_file)."""
+        return self.line.is_section
+
+    @cached_property
+    def stations(self) -> np.ndarray:
+        """[m] horizontal distance along the line of every tower from the first, (n_towers,)."""
+        if not self.is_section:
+            return self.tower_x
+        s = np.array([t.station for t in self.line.towers], dtype=float)
+        return s - s[0]
+
+    @cached_property
+    def ground(self) -> np.ndarray:
+        """[m] ground elevation at every tower, (n_towers,) (equal-span form: 0 with clamps at -height)."""
+        if not self.is_section:
+            return np.full(self.n_towers, -float(self.line.height))
+        return np.array([t.ground for t in self.line.towers], dtype=float)
+
+    @cached_property
+    def tower_angles(self) -> np.ndarray:
+        """[rad] horizontal line deviation at every tower, + turning left, (n_towers,)."""
+        if not self.is_section:
+            return np.zeros(self.n_towers)
+        return np.radians([t.angle for t in self.line.towers])
+
+    @cached_property
+    def span_headings(self) -> np.ndarray:
+        """[rad] heading h_i of every span from +x (sum of the angles of towers 1..i), (n_spans,)."""
+        return np.cumsum(self.tower_angles[:-1])
+
+    @cached_property
+    def tower_headings(self) -> np.ndarray:
+        """[rad] heading of every tower's frame x axis: mean of its two spans' headings (ends: its span's)."""
+        h = self.span_headings
+        out = np.empty(self.n_towers)
+        out[0], out[-1] = h[0], h[-1]
+        out[1:-1] = 0.5 * (h[:-1] + h[1:])
+        return out
+
+    @property
+    def straight_level(self) -> bool:
+        """True when the frames of every tower and node are the global axes (no rotation needed):
+        the equal-span form, or a section without angles."""
+        return not self.is_section or not np.any(self.tower_angles)
+
+    def to_tower_frames(self, R: np.ndarray) -> np.ndarray:
+        """Reactions (..., n_towers, 3) from the global frame (x, y, z down) to every tower's own
+        frame: x along its mean heading psi_j, y = x turned +90 deg in plan, z down.
+
+        R'_x = R_x cos psi + R_y sin psi, R'_y = -R_x sin psi + R_y cos psi, R'_z = R_z.  Returns
+        ``R`` itself (no copy) when every tower frame is the global frame."""
+        if self.straight_level:
+            return R
+        c, s = np.cos(self.tower_headings), np.sin(self.tower_headings)
+        out = np.array(R, dtype=float, copy=True)
+        out[..., 0] = R[..., 0] * c + R[..., 1] * s
+        out[..., 1] = -R[..., 0] * s + R[..., 1] * c
+        return out
+
+    def from_tower_frames(self, R: np.ndarray) -> np.ndarray:
+        """Inverse of :meth:`to_tower_frames`."""
+        if self.straight_level:
+            return R
+        c, s = np.cos(self.tower_headings), np.sin(self.tower_headings)
+        out = np.array(R, dtype=float, copy=True)
+        out[..., 0] = R[..., 0] * c - R[..., 1] * s
+        out[..., 1] = R[..., 0] * s + R[..., 1] * c
+        return out
+
+    @cached_property
+    def insulator_lengths(self) -> np.ndarray:
+        """[m] insulator length v_j of every tower (strain towers: the line default, unused), (n_towers,)."""
+        v = float(self.line.insulator_length)
+        if not self.is_section:
+            return np.full(self.n_towers, v)
+        return np.array([t.insulator_length if t.insulator_length is not None else v for t in self.line.towers])
+
+    @cached_property
+    def insulator_tops(self) -> np.ndarray:
+        """[m] fixed top of every insulator, v_j straight above the still-air clamp, (n_towers, 3)."""
+        tops = self.clamp_points.copy()
+        tops[:, 2] += self.insulator_lengths
+        return tops
+
+    @cached_property
+    def span_chords(self) -> np.ndarray:
+        """[m] still-air chord of every span (second clamp - first), (n_spans, 3)."""
+        return np.diff(self.clamp_points, axis=0)
+
+    @cached_property
+    def span_normals(self) -> np.ndarray:
+        """[-] horizontal unit normal n_i = (-sin h_i, cos h_i, 0) of every span (the drag direction), (n_spans, 3)."""
+        h = self.span_headings
+        return np.stack([-np.sin(h), np.cos(h), np.zeros_like(h)], axis=1)
+
+    @cached_property
+    def tower_along(self) -> np.ndarray:
+        """[-] horizontal unit vector of every tower frame's x axis, (n_towers, 3)."""
+        h = self.tower_headings
+        return np.stack([np.cos(h), np.sin(h), np.zeros_like(h)], axis=1)
+
+    @cached_property
+    def _clip_in(self) -> tuple[np.ndarray, np.ndarray]:
+        from .catenary import clip_in
+
+        c = self.span_chords
+        H0 = np.full(self.n_spans, float(self.line.tension))
+        return clip_in(H0, self.span_lengths, c[:, 2], self.line.weight, self.line.ea)
+
+    @cached_property
+    def clip_in_nodes(self) -> np.ndarray:
+        """[m] node positions of the clipped-in catenaries (insulators vertical), (n_nodes, 3):
+        the still-air shape the wind is evaluated on (section form)."""
+        from .catenary import solve_spans
+
+        Lu, V0 = self._clip_in
+        e = np.stack([np.cos(self.span_headings), np.sin(self.span_headings), np.zeros(self.n_spans)], axis=1)
+        N0 = float(self.line.tension) * e
+        N0[:, 2] = V0
+        p = np.zeros((self.n_spans, self.ne + 1, 3))
+        p[..., 2] = -self.line.weight
+        sol = solve_spans(self.span_chords, p, Lu, self.line.ea, N0, what="clipping-in")
+        r = self.clamp_points[:-1, None, :] + sol.r
+        nodes = np.empty((self.n_nodes, 3))
+        nodes[:-1] = r[:, :-1].reshape(-1, 3)
+        nodes[-1] = r[-1, -1]
+        return nodes
+
+    @cached_property
+    def node_xyz0(self) -> np.ndarray:
+        """[m] still-air position of every global FE node (x, y, z), (n_nodes, 3).
+
+        Equal-span form: (node_x0, 0, 0) (the paper's wind sees a straight, level line).
+        Section form: the clipped-in catenaries (:attr:`clip_in_nodes`)."""
+        if self.is_section:
+            return self.clip_in_nodes
+        out = np.zeros((self.n_nodes, 3))
+        out[:, 0] = self.node_x0
+        return out
+
+    @cached_property
+    def node_station(self) -> np.ndarray:
+        """[m] horizontal distance along the line of every FE node from the first tower, (n_nodes,)."""
+        if not self.is_section:
+            return self.node_x0
+        xyz = self.node_xyz0
+        span = self.span_of_node(np.arange(self.n_nodes))
+        e = np.stack([np.cos(self.span_headings), np.sin(self.span_headings)], axis=1)[span]
+        return self.stations[span] + np.einsum("ij,ij->i", xyz[:, :2] - self.clamp_points[span, :2], e)
+
+    @cached_property
+    def node_height(self) -> np.ndarray:
+        """[m] still-air height above ground of every FE node (ground interpolated linearly in
+        station between towers), (n_nodes,).  Equal-span form: ``height`` everywhere."""
+        if not self.is_section:
+            return np.full(self.n_nodes, float(self.line.height))
+        g = np.interp(self.node_station, self.stations, self.ground)
+        return self.node_xyz0[:, 2] - g
+
+    @cached_property
+    def node_normals(self) -> np.ndarray:
+        """[-] horizontal unit normal of every FE node, the direction of its transverse load and
+        of its "y" DOF (span nodes: the span's normal; tower nodes: the tower frame's y), (n_nodes, 3)."""
+        span = self.span_of_node(np.arange(self.n_nodes))
+        n = self.span_normals[span].copy()
+        h = self.tower_headings
+        n[self.tower_nodes] = np.stack([-np.sin(h), np.cos(h), np.zeros_like(h)], axis=1)
+        return n
+
+    @cached_property
+    def node_frames(self) -> np.ndarray:
+        """[-] per-node orthonormal bases, columns (along-line horizontal, normal, up), (n_nodes, 3, 3):
+        the DOF frames of a section with angles (identity otherwise)."""
+        b = self.node_normals
+        T = np.zeros((self.n_nodes, 3, 3))
+        T[:, 0, 0], T[:, 1, 0] = b[:, 1], -b[:, 0]  # along = normal turned -90 deg
+        T[:, :, 1] = b
+        T[:, 2, 2] = 1.0
+        return T
+
+    @cached_property
+    def node_gaps(self) -> np.ndarray:
+        """[m] plan distance between neighbouring still-air FE nodes, (n_nodes - 1,): the spacing
+        of the Markov (exponential) coherence along the line (equal-span form: the element length)."""
+        if not self.is_section:
+            return np.repeat(self.element_lengths, self.ne)
+        return np.linalg.norm(np.diff(self.node_xyz0[:, :2], axis=0), axis=1)
+
+    @cached_property
+    def eq17_lengths(self) -> np.ndarray:
+        """[m] Eq. 17's L_x at every tower: the mean of its adjacent spans (ends: its span), (n_towers,)."""
+        return np.array([self.span_lengths_at_tower(j) for j in range(self.n_towers)])
+
+    def span_lengths_at_tower(self, j: int) -> float:
+        """[m] Eq. 17's L_x at tower j (0-based): the mean of its adjacent spans' horizontal lengths."""
+        L = self.span_lengths
+        adj = [L[i] for i in (j - 1, j) if 0 <= i < self.n_spans]
+        return float(sum(adj) / len(adj))
 
     @cached_property
     def weight_spans(self) -> np.ndarray:
@@ -161,7 +384,9 @@ class LineSystem:
 
     @property
     def tension_nominal(self) -> float:
-        """T0 = W L_x^2 / (8 S) [N] (paper Table 1, parabolic cable)."""
+        """T0 = W L_x^2 / (8 S) [N] (paper Table 1, parabolic cable); section form: H0."""
+        if self.is_section:
+            return float(self.line.tension)
         L, S = self.line.span_length, self.line.sag
         return self.line.weight * L**2 / (8.0 * S)
 

@@ -21,6 +21,8 @@ import math
 from dataclasses import dataclass, field, fields
 from typing import Any
 
+import numpy as np
+
 from ..core.errors import CaseError
 
 #: Version of the run-result JSON layout.  1 (no "schema_version" key): before issue 18,
@@ -410,14 +412,24 @@ class EnvelopeEntry(_Block):
 
 @dataclass(frozen=True)
 class Tower:
-    """Tower ``index`` (1-based): support type and its typed reaction blocks."""
+    """Tower ``index`` (1-based): support type and its typed reaction blocks.
+
+    ``section`` (section form only, issue 17): the tower's ``name``, ``station``, ``ground``,
+    ``height``, ``angle`` [deg], ``heading`` [deg] (its frame's x axis from the global x: the
+    reactions are in that frame) and ``global``: the still-air and step-1 mean reactions in the
+    global frame (x along the first span, y to its left, z down)."""
 
     index: int
     support: str
     reactions: dict[str, ReactionResult]
+    section: dict[str, Any] | None = None
 
     def to_json(self) -> dict[str, Any]:
-        return {"index": self.index, "support": self.support, "reactions": _reactions_json(self.reactions)}
+        d: dict[str, Any] = {"index": self.index, "support": self.support}
+        if self.section is not None:
+            d.update(self.section)
+        d["reactions"] = _reactions_json(self.reactions)
+        return d
 
 
 @dataclass(frozen=True)
@@ -445,6 +457,27 @@ def models_of(reactions: dict[str, dict[str, ReactionResult]]) -> dict[str, dict
                     best, who = v, name
             env[r][s.name] = EnvelopeEntry(best, who)
     return env
+
+
+SECTION_TOWER_KEYS = ("name", "station", "ground", "height", "angle", "heading", "global")
+
+
+def section_tower(res: Any, k: int) -> dict[str, Any] | None:
+    """The section metadata of tower k (0-based) of a run (None for the equal-span form)."""
+    system = res.system
+    if not system.is_section:
+        return None
+    t = system.line.towers[k]
+    m = res.static.mean
+    still = m.still_air.reactions[k]
+    total = m.reactions[:, k]
+    big = int(np.argmax(np.abs(m.reactions_wind[:, k]).max(axis=1))) if m.time.size > 1 else 0
+    return {
+        "name": t.name, "station": float(system.stations[k]), "ground": t.ground, "height": t.height,
+        "angle": t.angle, "heading": float(np.degrees(system.tower_headings[k])),
+        "global": {"still_air": {r: _f(still[c]) for c, r in enumerate(REACTIONS)},
+                   "mean": {r: _f(total[big, c]) for c, r in enumerate(REACTIONS)}},
+    }
 
 
 #: Header fields of :class:`RunDocument`, in JSON order, with their JSON types (for the schema).
@@ -562,7 +595,8 @@ class RunDocument:
         try:
             head = {k: d[k] for k, _ in HEADER_FIELDS}
             reactions = _reactions_from(d["reactions"])
-            towers = tuple(Tower(int(t["index"]), t["support"], _reactions_from(t["reactions"])) for t in d["towers"])
+            towers = tuple(Tower(int(t["index"]), t["support"], _reactions_from(t["reactions"]),
+                                 {k: t[k] for k in SECTION_TOWER_KEYS if k in t} or None) for t in d["towers"])
             until = Until.from_json(d["until"]) if d.get("until") is not None else None
 
             def opt(key: str, read: Any) -> Any:
@@ -633,7 +667,7 @@ def document_of(res: Any, **blocks: Any) -> RunDocument:
         peak_window=case.analysis.peak_window, windows=int(res.windows),
         design_fractile=case.analysis.design_fractile,
         reactions=reactions_of(summary, j),
-        towers=tuple(Tower(k + 1, case.line.supports[k], reactions_of(summary, k))
+        towers=tuple(Tower(k + 1, case.line.supports[k], reactions_of(summary, k), section_tower(res, k))
                      for k in range(res.system.n_towers)),
         until=until, **blocks,
     )
@@ -698,6 +732,13 @@ def json_schema() -> dict[str, Any]:
             "towers": {"type": "array", "items": {
                 "type": "object",
                 "properties": {"index": {"type": "integer"}, "support": {"enum": ["strain", "suspension"]},
+                               "name": {"type": "string"}, "station": {"type": "number"},
+                               "ground": {"type": "number"}, "height": {"type": "number"},
+                               "angle": {"type": "number"}, "heading": {"type": "number"},
+                               "global": {"type": "object", "description": "section form: still-air and "
+                                          "step-1 mean reactions [N] in the global frame (x along the first span, "
+                                          "y to its left, z down); the tower's reactions are in its own frame, "
+                                          "x along heading"},
                                "reactions": {"$ref": "#/$defs/reactions"}},
                 "required": ["index", "support", "reactions"], "additionalProperties": False}},
             "still_air": {"type": "object"},

@@ -54,35 +54,52 @@ def static_to_dict(res: StaticResult) -> dict[str, Any]:
         return _num(a if series else a[0])
 
     still = m.still_air
+    # every tower's reactions in its own frame (issue 17; the equal-span form: the global frame)
+    R = system.to_tower_frames(m.reactions)
+    R0 = system.to_tower_frames(still.reactions)
     towers = []
     for j in range(system.n_towers):
-        towers.append({
-            "index": j + 1,
-            "support": case.line.supports[j],
-            "Rx": pick(m.reactions[:, j, 0]),
-            "Ry": pick(m.reactions[:, j, 1]),
-            "Rz": pick(m.reactions[:, j, 2]),
-            "Rx_wind": pick(m.reactions[:, j, 0] - still.reactions[j, 0]),
-            "Ry_wind": pick(m.reactions[:, j, 1] - still.reactions[j, 1]),
-            "Rz_wind": pick(m.reactions[:, j, 2] - still.reactions[j, 2]),
-            "Rx_still_air": _num(still.reactions[j, 0]),
-            "Ry_still_air": _num(still.reactions[j, 1]),
-            "Rz_still_air": _num(still.reactions[j, 2]),
+        t: dict[str, Any] = {"index": j + 1, "support": case.line.supports[j]}
+        if system.is_section:
+            tw = case.line.towers[j]
+            t.update(name=tw.name, station=_num(system.stations[j]), ground=tw.ground, height=tw.height,
+                     angle=tw.angle, heading=_num(np.degrees(system.tower_headings[j])))
+        t.update({
+            "Rx": pick(R[:, j, 0]),
+            "Ry": pick(R[:, j, 1]),
+            "Rz": pick(R[:, j, 2]),
+            "Rx_wind": pick(R[:, j, 0] - R0[j, 0]),
+            "Ry_wind": pick(R[:, j, 1] - R0[j, 1]),
+            "Rz_wind": pick(R[:, j, 2] - R0[j, 2]),
+            "Rx_still_air": _num(R0[j, 0]),
+            "Ry_still_air": _num(R0[j, 1]),
+            "Rz_still_air": _num(R0[j, 2]),
             "dx": pick(m.displacement[:, j, 0]),
             "dy": pick(m.displacement[:, j, 1]),
             "dz": pick(m.displacement[:, j, 2]),
         })
+        if system.is_section:  # the global frame too (x along the first span, y to its left, z down)
+            t["global"] = {"Rx": pick(m.reactions[:, j, 0]), "Ry": pick(m.reactions[:, j, 1]),
+                           "Rz": pick(m.reactions[:, j, 2]),
+                           "Rx_still_air": _num(still.reactions[j, 0]), "Ry_still_air": _num(still.reactions[j, 1]),
+                           "Rz_still_air": _num(still.reactions[j, 2])}
+        towers.append(t)
     spans = []
     for n in range(system.n_spans):
-        spans.append({
+        sp = {
             "index": n + 1,
             "tension": pick(m.tension[:, n]),
             "tension_still_air": _num(still.tension[n]),
             "tension_nominal": _num(system.tension_nominal),
-        })
+        }
+        if system.is_section:
+            sp.update(length=_num(system.span_lengths[n]), unstretched_length=_num(system.unstretched_lengths[n]),
+                      heading=_num(np.degrees(system.span_headings[n])))
+        spans.append(sp)
     doc: dict[str, Any] = {
         **_header(case),
-        "unstretched_length": _num(system.unstretched_length),
+        # the equal-span form's L_u; a section: the total (every span's in "spans")
+        "unstretched_length": _num(system.unstretched_lengths.sum() if system.is_section else system.unstretched_length),
         "towers": towers,
         "spans": spans,
     }
@@ -148,10 +165,12 @@ def run_document(res: Any, *, full_histories: bool = False, max_points: int = 20
     j = res.tower_index
     still = res.static.mean.still_air
     m = res.static.mean
+    still_r = res.system.to_tower_frames(still.reactions)  # the tower's own frame (issue 17)
+    wind_r = res.system.to_tower_frames(m.reactions_wind)
     blocks: dict[str, Any] = {
-        "still_air": StillAir({r: _num(still.reactions[j, c]) for c, r in enumerate(REACTIONS)}, _num(still.tension),
+        "still_air": StillAir({r: _num(still_r[j, c]) for c, r in enumerate(REACTIONS)}, _num(still.tension),
                               _num(res.system.tension_nominal), case.line.sag),
-        "static": StaticSeries(_num(m.time), {r: _num(m.reactions_wind[:, j, c]) for c, r in enumerate(REACTIONS)},
+        "static": StaticSeries(_num(m.time), {r: _num(wind_r[:, j, c]) for c, r in enumerate(REACTIONS)},
                                _num(m.tension),
                                {k: _num(m.displacement[:, j, c]) for c, k in enumerate(("dx", "dy", "dz"))}),
         "parameters": case_parameters(case),

@@ -1010,9 +1010,9 @@ def code_loads(case: Case, *, strict: bool = True) -> list:
     if wind.type == "downburst":
         return [C.downburst_load(code) for code in C.CODES]
     # the codes' wind span: the section's common span (equal spans); a section of unequal spans:
-    # Eq. 17's L_x at the tower of interest (line.span_length, docs/codes.md "Sections")
+    # Eq. 17's L_x at the tower of interest (docs/codes.md "Sections")
     system = LineSystem(line)
-    span = system.common_span_length if system.equal_spans else float(line.span_length)
+    span = system.common_span_length if system.equal_spans else system.span_lengths_at_tower(line.tower_of_interest - 1)
     args = (wind.v_ref, line.height, span, line.diameter, line.drag_coefficient)
     calls = {
         "ASCE74": lambda: C.asce74_wire_load(*args, cc.asce74_exposure or C.TERRAIN_MAP["ASCE74"][cc.terrain],

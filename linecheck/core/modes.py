@@ -27,10 +27,15 @@ class Modes:
 
     frequencies_hz: np.ndarray
     shapes: np.ndarray
+    frames: np.ndarray | None = None  # per-node (along, normal, up) bases of a section with angles
 
     def dominant_direction(self) -> np.ndarray:
-        """Index (0 x, 1 y, 2 z) of the direction holding most of each mode's kinetic energy, (n_modes,)."""
-        return np.argmax((self.shapes**2).sum(axis=1), axis=1)
+        """Index (0 x, 1 y, 2 z) of the direction holding most of each mode's kinetic energy, (n_modes,).
+
+        On a section with angle towers x, y, z are every node's own along-line, transverse
+        (horizontal normal) and vertical directions (issue 17)."""
+        sh = self.shapes if self.frames is None else np.einsum("mna,nab->mnb", self.shapes, self.frames)
+        return np.argmax((sh**2).sum(axis=1), axis=1)
 
 
 def natural_modes(model: LinearModel, n_modes: int = 20) -> Modes:
@@ -46,4 +51,5 @@ def natural_modes(model: LinearModel, n_modes: int = 20) -> Modes:
     shapes = np.zeros((n, model.system.n_nodes, 3))
     free = model.dofs.free_nodes
     shapes[:, free, :] = phi.T.reshape(n, free.size, 3)
-    return Modes(freq, shapes)
+    system = model.system
+    return Modes(freq, shapes, None if system.straight_level else system.node_frames)

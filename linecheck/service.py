@@ -286,6 +286,12 @@ def synoptic_model(case: Case, st: StaticResult, *, vectors: bool = True) -> Syn
     vn = to_global_nodes(system, st.wind.normal)[0]
     line, wind = case.line, case.wind
     a = wind.air_density * line.drag_coefficient * line.diameter * model.tributary * vn  # Eq. 5 per unit v
+    if system.is_section or wind.direction != 0.0:
+        # the normal component of the along-wind fluctuation, v cos(phi), as the time domain
+        # (fluctuating_loads; issue 17): cos(phi) = |V_n| / |V|
+        vl = record_mean_wind(case, st, np.zeros(1))[1][0]
+        speed = np.hypot(vn, vl)
+        a = a * np.where(speed > 0, np.abs(vn) / np.where(speed > 0, speed, 1.0), 1.0)
     f_top = 0.75 / case.analysis.time_step
     modes = complex_modes(model, damping, max_hz=f_top, vectors=vectors)
     return SynopticModel(model, damping, a, modes)
@@ -378,7 +384,13 @@ def record_mean_wind(case: Case, st: StaticResult, t: np.ndarray) -> tuple[np.nd
     system = st.system
     if case.wind.type == "synoptic":
         vn = np.broadcast_to(to_global_nodes(system, st.wind.normal)[0], (t.size, system.n_nodes))
-        return vn, None
+        if not system.is_section and case.wind.direction == 0.0:
+            return vn, None  # the paper's wind: normal to the line, cos(phi) = 1
+        from .core.wind.mean import mean_components_at_nodes
+
+        # oblique wind (issue 17): the longitudinal component gives cos(phi) = |V_n|/|V| of the fluctuation
+        vl = np.broadcast_to(mean_components_at_nodes(case, system, t[:1])[1][0], (t.size, system.n_nodes))
+        return vn, vl
     mw = mean_wind(case, system, t)
     return to_global_nodes(system, mw.normal), to_global_nodes(system, mw.longitudinal)
 

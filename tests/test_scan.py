@@ -140,7 +140,9 @@ def test_cli_scan_table_csv_and_dynamic(tmp_path):
 def test_scan_ranks_by_the_expected_dynamic_peak(tmp_path):
     """Issue 20: with dynamic_realizations the scan runs steps 1-3 at every position; the value
     ranked is the realization mean of the dynamic peak |M+B+R| at the tower of interest, equal
-    to run_case's own statistics there (same seeds), never below the point's largest |mean|."""
+    to run_case's own statistics there (same seeds).  (It is not bounded below by the point's
+    largest |mean|: a downburst's mean peak is brief, and a realization whose gust is negative
+    through it peaks lower -- case01-six at R = 1.1 D_j: 6.46 kN against a 7.23 kN mean.)"""
     from linecheck.batch.tasks import apply_changes, scan_changes
     from linecheck.service import run_case
 
@@ -148,7 +150,7 @@ def test_scan_ranks_by_the_expected_dynamic_peak(tmp_path):
     grid = ScanGrid.from_options(load_case(path), "1.2,1.6Dj", "30", None)
     res = run_scan(path, grid, hold="vref", dynamic_realizations=2)
     assert res.dynamic is not None and res.dynamic.shape == (2, 3)
-    assert np.all(res.dynamic >= np.abs(res.peak) * (1 - 1e-12))  # M+B+R peaks include the mean's
+    assert np.all(np.isfinite(res.dynamic)) and np.all(res.dynamic > 0)
     crit = res.critical("Ry", "peak")
     r, th, dj = res.points[crit.index]
     again = run_case(apply_changes(load_case(path), scan_changes(r, th, dj)), realizations=[0, 1], spectral_check=False)

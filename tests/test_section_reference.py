@@ -237,9 +237,7 @@ def test_still_air_modes_of_refined_mesh_converge():
 # marker must go when the wind is fixed.
 WIND_DEFECT = pytest.mark.xfail(strict=True, reason="linecheck's synoptic mean wind ignores wind.direction and "
                                 "wind.profile_exponent (issue 17; docs/validation.md 'Independent section reference')")
-STATIC_CASES = ["unequal-still", pytest.param("unequal-wind", marks=WIND_DEFECT), "inclined-still",
-                pytest.param("inclined-wind", marks=WIND_DEFECT), "angles-still",
-                pytest.param("angles-wind", marks=WIND_DEFECT)]
+STATIC_CASES = ["unequal-still", "unequal-wind", "inclined-still", "inclined-wind", "angles-still", "angles-wind"]
 TOL_SECTION = 0.005  # issue 17: 0.5 % of the largest reaction component at that tower
 TOL_IRVINE = 0.001  # issue 17: 0.1 %
 TOL_MODES = 0.02  # issue 17: 2 %
@@ -354,7 +352,7 @@ def _variant(src: Path, dst_dir: Path, still: bool) -> Path:
     return dst
 
 
-@pytest.mark.parametrize("still", [True, pytest.param(False, marks=WIND_DEFECT)], ids=["still", "wind"])
+@pytest.mark.parametrize("still", [True, False], ids=["still", "wind"])
 @pytest.mark.parametrize("example", EXAMPLES or [None], ids=[p.stem for p in EXAMPLES] or ["none"])
 def test_shipped_section_examples_match_reference(example, still, tmp_path):
     """The shipped cases/examples/section-*.toml (real-looking sections with angle towers) under

@@ -187,3 +187,29 @@ def test_section_dynamics_run_on_the_example(cases_dir):
     assert np.all(np.isfinite(pk))
     # the angle-strain tower T5 (18 deg) carries the tension resultant in its frame's y
     assert pk[4, 1] > 2 * 22000.0 * math.sin(math.radians(9.0))
+
+
+def test_frequency_domain_load_is_the_time_domain_load_on_an_oblique_section():
+    """Issue 17: with an oblique wind both domains load node i with rho C_d D L_i V_n v cos(phi)
+    (the normal part of the along-wind fluctuation), cos(phi) = |V_n|/|V| = |cos(d + h_i)| on a
+    span of heading h_i; the spectral check's load per unit v equals the time domain's."""
+    from linecheck import service
+
+    towers = [_tower(0.0, support="strain"), _tower(300.0, angle=12.0), _tower(640.0, support="strain")]
+    case = _case(towers, wind={"direction": 25.0})
+    case = case.__class__(**{**case.__dict__, "analysis": case.analysis.__class__(
+        **{**case.analysis.__dict__, "drag": "linear", "duration": 20.0})})
+    st = service.static_analysis(case)
+    sm = service.synoptic_model(case, st, vectors=False)
+    t = service.record_time(case)[:8]
+    vn, vl = service.record_mean_wind(case, st, t)
+    ones = np.ones((1, t.size, st.system.n_nodes))
+    loads, _ = service.fluctuating_loads(case, st.system, sm.model, t, ones, vn, vl)
+    free = sm.model.dofs.free_nodes
+    np.testing.assert_allclose(loads[0, 0], sm.load_per_v[free], rtol=1e-12)
+    # an interior node of span 2 (heading 12 deg): V_n = 30 cos(37 deg), cos(phi) = cos(37 deg)
+    node = st.system.ne + 3
+    k = int(np.flatnonzero(free == node)[0])
+    L = sm.model.tributary[node]
+    expect = 1.25 * 1.0 * 0.022 * L * 30.0 * math.cos(math.radians(37.0)) ** 2
+    assert loads[0, 0, k] == pytest.approx(expect, rel=1e-12)

@@ -64,10 +64,15 @@ def test_synoptic_normal_is_profile_times_cos_d_plus_h_per_span():
     h = _headings_deg()
     np.testing.assert_array_equal(h, [0, 0, 0, 0, 18, 18, 18, 18, 14, 14, 14, 14])
     z = s.node_height[_span_nodes(s)]
-    # the span ends are the clamps: their heights above ground are the CSV's (index mapping check)
-    hc = np.array([float(t["height"]) for t in _towers()])
-    np.testing.assert_allclose(z[:, 0], hc[:-1], rtol=0, atol=1e-9)
-    np.testing.assert_allclose(z[:, -1], hc[1:], rtol=0, atol=1e-9)
+    # the span ends are the clamps: their heights above ground are the CSV's plus the still-air
+    # lift of a swung insulator (angle towers; issue 17: heights from the still-air shape)
+    from linecheck.core.static import still_air_state
+
+    hc = np.array([float(t["height"]) for t in _towers()]) + still_air_state(s).displacement[:, 2]
+    assert 0.05 < hc[8] - 36.0 < 0.1  # T9 (4 deg suspension angle) swings and lifts its clamp
+    # (to 2 mm: a clamp that swings along the line by dx sits over ground shifted by slope * dx)
+    np.testing.assert_allclose(z[:, 0], hc[:-1], rtol=0, atol=2e-3)
+    np.testing.assert_allclose(z[:, -1], hc[1:], rtol=0, atol=2e-3)
     assert np.unique(np.round(z, 6)).size > 100  # the profile sees distinct heights
     # m = (sin d, cos d, 0), n_i = (-sin h, cos h, 0): m.n_i = cos(d + h); e_i = (cos h, sin h, 0): m.e_i = sin(d + h)
     v = 35.0 * (z / 10.0) ** 0.16
@@ -85,11 +90,14 @@ def test_synoptic_components_at_tower_nodes_use_the_tower_frame_and_span_speeds(
     s = LineSystem(case.line)
     vn, vl = wm.mean_components_at_nodes(case, s, np.zeros(1))
     speed = wm.mean_speed_at_nodes(case, s, np.zeros(1))[0]
-    hc = np.array([float(t["height"]) for t in _towers()])
+    from linecheck.core.static import still_air_state
+
+    hc = np.array([float(t["height"]) for t in _towers()]) + still_air_state(s).displacement[:, 2]
     # T5 (index 4): spans at 0 and 18 deg, frame heading 9 deg; T9 (index 8): 18 and 14 -> 16 deg
     for j, psi in ((4, 9.0), (8, 16.0)):
         node = j * s.ne
-        v = 0.5 * (speeds[j - 1] + speeds[j]) * (hc[j] / 10.0) ** 0.16  # mean of the two spans' speeds
+        assert s.node_height[node] == pytest.approx(hc[j], abs=2e-3)  # the clamp, lifted by its swing
+        v = 0.5 * (speeds[j - 1] + speeds[j]) * (s.node_height[node] / 10.0) ** 0.16  # mean of the two spans' speeds
         assert speed[node] == pytest.approx(v, rel=1e-13)
         assert vn[0, node] == pytest.approx(v * math.cos(math.radians(30.0 + psi)), rel=1e-12)
         assert vl[0, node] == pytest.approx(v * math.sin(math.radians(30.0 + psi)), rel=1e-12)
@@ -180,13 +188,17 @@ def test_section_uses_the_markov_chain_along_the_line_and_its_error_vs_plan_dist
     s = LineSystem(case.line)
     x = s.node_station
     gaps = np.hypot(*np.diff(s.node_xyz0[:, :2], axis=0).T)
-    np.testing.assert_allclose(np.diff(x), gaps, rtol=0, atol=1e-9)  # ds_j: plan distance of neighbours
+    # ds_j: the stations' differences, the neighbours' plan distance to 0.2 % (the swung clamp of
+    # the 4 deg angle tower T9 moves 0.84 m off the straight line; its station is measured along
+    # the next span's heading, 6 cm off the plan distance of its one gap)
+    np.testing.assert_allclose(np.diff(x), gaps, rtol=2e-3, atol=0)
+    np.testing.assert_array_equal(s.node_gaps, np.diff(x))  # the spectral check uses the same gaps
     assert not np.allclose(np.diff(x), np.diff(x)[0], rtol=1e-6)  # unequal: not the KMS path
     # the chain implies exp(-a sum ds) for non-neighbours; Davenport uses the plan distance d <= sum ds
     S = np.abs(np.subtract.outer(x, x))
     xy = s.node_xyz0[:, :2]
     D = np.hypot(*(xy[:, None, :] - xy[None, :, :]).transpose(2, 0, 1))
-    assert np.all(D <= S + 1e-9)
+    assert np.all(D <= S + 0.1)  # (stations of swung clamps are projections: a few cm off a path length)
     a_grid = case.wind.coherence_decay * np.arange(1, 601) / 600.0 / case.wind.v_ref  # f = 1/600 .. 1 Hz
     err = max(float(np.max(np.exp(-a * D) - np.exp(-a * S))) for a in a_grid)
     # sup over all f of exp(-a d) - exp(-a s) is at a* = ln(s/d)/(s - d) (derivative zero)
@@ -279,7 +291,7 @@ def test_downburst_point_series_and_table_heights_on_a_section():
     s = LineSystem(case.line)
     ps = point_series(case, 0)
     # Theta = 0: p is the tower of interest T7 itself, the nearest node its clamp node
-    assert ps.node == 6 * s.ne and ps.node_x == pytest.approx(2005.0, abs=1e-9)
+    assert ps.node == 6 * s.ne and ps.node_x == pytest.approx(2005.0, abs=0.02)  # T7's clamp swings 9 mm back
     t = record_times(case)
     vec = wm.mean_vector_at_nodes(case, s, t)[:, ps.node, :2]
     np.testing.assert_allclose(ps.mean_speed, np.hypot(vec[:, 0], vec[:, 1]), rtol=1e-14)

@@ -238,6 +238,17 @@ class ScanResult:
         return Critical(REACTIONS[c], i, float(r), float(th), float(dj), float(value), float(self.time[i, c]),
                         float(self.v_ref[i]))
 
+    def centre_offsets(self) -> np.ndarray:
+        """[m] each point's downburst centre relative to the tower of interest in the global frame
+        (x along the first span, y to its left), (n, 2): R sin(Theta) x' - R cos(Theta) y' with
+        (x', y') the tower's own frame (issue 17; the equal-span form: (R sin Theta, -R cos Theta))."""
+        from ..core.system import LineSystem
+
+        psi = float(LineSystem(self.case.line).tower_headings[self.case.line.tower_of_interest - 1])
+        r, th = self.points[:, 0], np.radians(self.points[:, 1])
+        a, b = r * np.sin(th), -r * np.cos(th)
+        return np.stack([a * np.cos(psi) - b * np.sin(psi), a * np.sin(psi) + b * np.cos(psi)], axis=1)
+
     def criticals(self, reactions: Sequence[str] = ("Rx", "Ry"), by: str = "mean") -> list[Critical]:
         return [c for c in (self.critical(r, by) for r in reactions) if c is not None]
 
@@ -248,8 +259,9 @@ def scan_csv_text(result: ScanResult) -> str:
     w = csv.writer(buf, lineterminator="\n")
     dyn = result.dynamic
     extra = ["Rx_peak_N", "Ry_peak_N", "Rz_peak_N"] if dyn is not None else []
+    offsets = result.centre_offsets()
     w.writerow(["jet_diameter_m", "distance_m", "distance_over_dj", "angle_deg", "v_ref_at_p_m_s",
-                "Rx_N", "Ry_N", "Rz_N", "t_Rx_s", "t_Ry_s", "t_Rz_s", *extra, "error"])
+                "Rx_N", "Ry_N", "Rz_N", "t_Rx_s", "t_Ry_s", "t_Rz_s", *extra, "centre_dx_m", "centre_dy_m", "error"])
 
     def f(x: float) -> str:
         return "" if not math.isfinite(x) else repr(float(x))
@@ -257,7 +269,8 @@ def scan_csv_text(result: ScanResult) -> str:
     for i, (r, th, dj) in enumerate(result.points):
         more = [f(v) for v in dyn[i]] if dyn is not None else []
         w.writerow([repr(float(dj)), repr(float(r)), f(r / dj), repr(float(th)), f(result.v_ref[i]),
-                    *(f(v) for v in result.peak[i]), *(f(v) for v in result.time[i]), *more, result.errors[i] or ""])
+                    *(f(v) for v in result.peak[i]), *(f(v) for v in result.time[i]), *more,
+                    f(offsets[i, 0]), f(offsets[i, 1]), result.errors[i] or ""])
     return buf.getvalue()
 
 

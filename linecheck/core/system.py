@@ -281,9 +281,13 @@ class LineSystem:
         """[m] still-air position of every global FE node (x, y, z), (n_nodes, 3).
 
         Equal-span form: (node_x0, 0, 0) (the paper's wind sees a straight, level line).
-        Section form: the clipped-in catenaries (:attr:`clip_in_nodes`)."""
+        Section form: the still-air equilibrium under weight (issue 17: "height above ground of a
+        conductor point: from the still-air shape"; at angle towers the insulators have swung;
+        on a straight section it is the clipped-in shape, :attr:`clip_in_nodes`)."""
         if self.is_section:
-            return self.clip_in_nodes
+            from .static import still_air_state  # the step-1 solver needs no wind geometry
+
+            return still_air_state(self).nodes
         out = np.zeros((self.n_nodes, 3))
         out[:, 0] = self.node_x0
         return out
@@ -330,11 +334,12 @@ class LineSystem:
 
     @cached_property
     def node_gaps(self) -> np.ndarray:
-        """[m] plan distance between neighbouring still-air FE nodes, (n_nodes - 1,): the spacing
-        of the Markov (exponential) coherence along the line (equal-span form: the element length)."""
+        """[m] distance along the line between neighbouring still-air FE nodes (their stations),
+        (n_nodes - 1,): the spacing of the Markov (exponential) coherence along the line, the same
+        as the turbulence synthesis' (equal-span form: the element length)."""
         if not self.is_section:
             return np.repeat(self.element_lengths, self.ne)
-        return np.linalg.norm(np.diff(self.node_xyz0[:, :2], axis=0), axis=1)
+        return np.diff(self.node_station)  # as the turbulence synthesis (Markov along the stations)
 
     @cached_property
     def eq17_lengths(self) -> np.ndarray:
@@ -374,12 +379,18 @@ class LineSystem:
 
     @cached_property
     def node_x0(self) -> np.ndarray:
-        """Still-air x of every global FE node [m], shape (n_nodes,)."""
+        """Still-air x of every global FE node [m], shape (n_nodes,) (a section: its station,
+        the horizontal distance along the line, :attr:`node_station`)."""
+        if self.is_section:
+            return self.node_station
         return np.arange(self.n_nodes) * (self.line.span_length / self.ne)
 
     @cached_property
     def span_node_x0(self) -> np.ndarray:
-        """Still-air x of each span's FE nodes [m], shape (n_spans, ne+1)."""
+        """Still-air x of each span's FE nodes [m], shape (n_spans, ne+1) (a section: stations)."""
+        if self.is_section:
+            x = self.node_station
+            return np.stack([x[i * self.ne:(i + 1) * self.ne + 1] for i in range(self.n_spans)])
         return self.tower_x[:-1, None] + self.node_s[None, :] * self.span_lengths[:, None]
 
     @property

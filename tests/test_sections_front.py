@@ -14,6 +14,7 @@ import dataclasses
 import json
 import math
 import re
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -25,7 +26,8 @@ from linecheck.cli.app import app
 from linecheck.core.case import case_to_dict, load_case, with_values
 from linecheck.excel.writer import write_workbook
 from linecheck.io.jsonout import run_to_dict
-from linecheck.io.section import line_from_parameters, line_summary, section_geometry, section_summary, tower_rows
+from linecheck.io.section import (insulators_known, line_from_parameters, line_summary, section_geometry,
+                                  section_summary, tower_rows)
 
 from .conftest import CASES
 
@@ -116,6 +118,12 @@ def test_line_from_parameters_inline_file_and_paper():
     line = line_from_parameters(file_params, towers)
     assert [(t.name, t.station, t.ground, t.height, t.angle) for t in line.towers] == \
         [(t.name, t.station, t.ground, t.height, t.angle) for t in case.line.towers]
+    assert line.towers[8].insulator_length is None  # T9's 4.6 m is not in towers[]: unknown, not guessed
+    assert insulators_known(params) and not insulators_known(file_params, towers)
+    # typed tower entries (attributes instead of keys), with their insulator lengths
+    typed = [SimpleNamespace(**t, insulator_length=c.insulator_length) for t, c in zip(towers, case.line.towers)]
+    assert line_from_parameters(file_params, typed).towers == case.line.towers
+    assert insulators_known(file_params, typed)
     paper = json.loads(json.dumps(case_to_dict(load_case(CASES / "paper" / "case01-six.toml"))))
     assert line_from_parameters(paper) is None
 
@@ -225,3 +233,21 @@ def test_excel_section_from_a_towers_file_says_where_the_table_is(section_book):
     texts = [c.value for r in ws.iter_rows(min_col=1, max_col=1) for c in r if isinstance(c.value, str)]
     assert ("Section: the tower table is not in this result (the case read it from section-12span.csv); "
             "see the case file.") in texts
+
+
+def test_cli_export_of_a_section_result(section_book, tmp_path):
+    """``linecheck export`` reads a section result's JSON and writes the Section block."""
+    paper = load_case(CASES / "paper" / "case09-single.toml")
+    paper = dataclasses.replace(paper, analysis=dataclasses.replace(paper.analysis, duration=20.0, realizations=1))
+    doc = run_to_dict(service.run_case(paper))
+    doc["case"] = "section-inline"
+    doc["parameters"] = json.loads(json.dumps(case_to_dict(inline_case())))
+    src = tmp_path / "section.json"
+    src.write_text(json.dumps(doc), encoding="utf-8")
+    out = tmp_path / "section.xlsx"
+    r = CliRunner().invoke(app, ["export", str(src), "--excel", str(out)])
+    assert r.exit_code == 0, r.output
+    ws = load_workbook(out)["section-inline"]
+    texts = [c.value for row in ws.iter_rows(min_col=1, max_col=1) for c in row if isinstance(c.value, str)]
+    assert "Section: 13 towers, 12 spans, 255-420 m, 2 angle towers, H0 = 22 kN" in texts
+    assert sum(1 for ch in ws._charts if ch.title is not None and _chart_title(ch).startswith("Section")) == 2

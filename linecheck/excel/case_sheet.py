@@ -13,7 +13,8 @@ from openpyxl.worksheet.worksheet import Worksheet
 from ..core.case import SCHEMA, Line
 from ..io.display import flag_state, flag_text
 from ..io.document import STAT_BY_NAME, STAT_TABLE, RunDocument
-from ..io.section import COLUMN_UNITS, line_from_parameters, section_geometry, section_summary, tower_rows
+from ..io.section import (COLUMN_UNITS, insulators_known, line_from_parameters, section_geometry, section_summary,
+                          tower_rows)
 from . import template as tpl
 from .cells import (
     FLAG_NOTE,
@@ -166,14 +167,18 @@ def _section_table(cur: Cursor, doc: RunDocument, line: Line) -> None:
     keys = ("station", "ground", "height", "support", "angle", "insulator_length", "span")
     cur.header([""] + [f"({COLUMN_UNITS[k]})" if COLUMN_UNITS[k] else "" for k in keys])
     toi = doc.tower_of_interest
+    known = insulators_known(doc.parameters, doc.towers)
     for r in rows:
         cur.put(cur.row, 1, f"{r.name}{' *' if r.index == toi else ''}", "lc_text")
+        ins = r.insulator_used if known or r.support != "suspension" else "?"
         for k, (v, fmt) in enumerate(((r.station, "0.0"), (r.ground, "0.0"), (r.height, "0.0"), (r.support, None),
-                                      (r.angle, "0.0"), (r.insulator_used, "0.00"), (r.span, "0.0"))):
+                                      (r.angle, "0.0"), (ins, "0.00"), (r.span, "0.0"))):
             cur.put(cur.row, 2 + k, v, "lc_number" if is_num(v) else "lc_text", fmt)
         cur.row += 1
     cur.note(f"* tower of interest ({toi}); clamp elevation = ground + height; insulator: length in force at "
              "suspension towers (line default where not given); span: horizontal length to the next tower.")
+    if not known:
+        cur.note("?: the insulator lengths of the towers are not in this result (see the case's tower table).")
     cur.note("Charts: plan (clamp points, first span along +x) and profile (clamps, ground and the still-air "
              "conductor) to the right.")
 

@@ -152,7 +152,7 @@ def line_from_parameters(parameters: dict | None, towers: Any = ()) -> Line | No
             if not (_finite(station) and _finite(height)):
                 return None
             row = {"station": float(station), "height": float(height), "support": get("support")}
-            for key in ("name", "ground", "angle"):
+            for key in ("name", "ground", "angle", "insulator_length"):
                 if get(key) is not None:
                     row[key] = get(key)
             rows.append(row)
@@ -165,3 +165,17 @@ def line_from_parameters(parameters: dict | None, towers: Any = ()) -> Line | No
     except CaseError:
         return None
     return case.line if case.line.is_section else None
+
+
+def insulators_known(parameters: dict | None, towers: Any = ()) -> bool:
+    """Whether a result document states every suspension tower's insulator length: always with
+    the towers in its case parameters; from ``towers[]`` only when each suspension entry carries
+    ``insulator_length`` (else :func:`line_from_parameters` fell back to the line's default)."""
+    line = (parameters or {}).get("line") if isinstance(parameters, dict) else None
+    if isinstance(line, dict) and "towers" in line:
+        return True
+    for t in towers or ():
+        get = t.get if isinstance(t, dict) else (lambda k, _t=t: getattr(_t, k, None))
+        if get("support") == "suspension" and get("insulator_length") is None:
+            return False
+    return True

@@ -119,14 +119,18 @@ class ParameterEditor(Vertical):
             changed = before != t
             mark = Text("*", style="bold yellow") if changed else ""
             span = Text(value_text(r.span) if r.span is not None else "", style="dim")
-            label = Text(f"{r.name}{' *' if r.index == case.line.tower_of_interest else ''}")
+            toi = r.index == case.line.tower_of_interest
+            if toi:
+                cells[0].stylize("bold underline")
+            label = Text(f"{r.index}" + (" ToI" if toi else ""), style="bold" if toi else "dim")
             table.add_row(mark, *cells, span, key=str(r.index - 1), label=label)
         if table.row_count:
             table.cursor_coordinate = cursor if cursor.row < table.row_count else table.cursor_coordinate
         src = f" (from {case.line.towers_file})" if case.line.towers_file else " (inline)"
         title = Text("towers: ", style="bold")
         title.append(f"{section_summary(case.line)}, H0 {case.line.tension:g} N{src}")
-        title.append("   enter edits the highlighted cell; * tower of interest, () line default", style="dim")
+        title.append("   enter edits the highlighted cell; ToI tower of interest, * edited, () line default",
+                     style="dim")
         self.query_one("#towers-title", Static).update(title)
 
     def _cells(self, key: str, spec: FieldSpec) -> tuple[Any, ...]:

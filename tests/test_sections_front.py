@@ -251,3 +251,17 @@ def test_cli_export_of_a_section_result(section_book, tmp_path):
     texts = [c.value for row in ws.iter_rows(min_col=1, max_col=1) for c in row if isinstance(c.value, str)]
     assert "Section: 13 towers, 12 spans, 255-420 m, 2 angle towers, H0 = 22 kN" in texts
     assert sum(1 for ch in ws._charts if ch.title is not None and _chart_title(ch).startswith("Section")) == 2
+
+
+def test_tui_parameter_keys_of_each_form():
+    """The TUI parameter table lists one form's line keys: a section hides the equal-span keys its
+    towers derive, an equal-span case the section keys; the per-tower keys are the tower table's."""
+    from linecheck.tui.formatting import fields_for
+
+    section = [k for k, _ in fields_for("synoptic", True)]
+    paper = [k for k, _ in fields_for("synoptic", False)]
+    equal = ["line.spans", "line.span_length", "line.sag", "line.height", "line.supports"]
+    assert not set(equal) & set(section) and set(equal) <= set(paper)
+    assert {"line.tension", "line.towers_file"} <= set(section) and not {"line.tension", "line.towers_file"} & set(paper)
+    assert not [k for k in section + paper if k.startswith("line.towers.")]
+    assert set(section) - set(paper) == {"line.tension", "line.towers_file"}

@@ -144,10 +144,11 @@ SECTION_KEYS = ("line.tension", "line.towers_file")
 def fields_for(wind_type: str, section: bool | None = None) -> list[tuple[str, FieldSpec]]:
     """:func:`iter_fields` without the keys of the other wind type (a synoptic case does not
     list the downburst keys); with ``section`` True, without the equal-span keys the towers
-    derive (they are in the tower table); with ``section`` None, every line key."""
+    derive (they are in the tower table); False, without the section form's ``tension`` and
+    ``towers_file`` (an equal-span case has no tower table); None, every line key."""
     hidden = tuple(p for t, prefixes in ONLY_FOR.items() if t != wind_type for p in prefixes)
-    if section:
-        hidden += EQUAL_SPAN_KEYS
+    if section is not None:
+        hidden += EQUAL_SPAN_KEYS if section else SECTION_KEYS
     return [(k, spec) for k, spec in iter_fields() if not k.startswith(hidden)]
 
 

@@ -124,6 +124,11 @@ def test_line_from_parameters_inline_file_and_paper():
     typed = [SimpleNamespace(**t, insulator_length=c.insulator_length) for t, c in zip(towers, case.line.towers)]
     assert line_from_parameters(file_params, typed).towers == case.line.towers
     assert insulators_known(file_params, typed)
+    # a typed document tower keeps the section keys in its `section` dict (issue 17 JSON)
+    nested = [SimpleNamespace(index=t["index"], support=t["support"], reactions={},
+                              section={k: v for k, v in t.items() if k not in ("index", "support")}) for t in towers]
+    assert [(t.name, t.station, t.height) for t in line_from_parameters(file_params, nested).towers] == \
+        [(t.name, t.station, t.height) for t in case.line.towers]
     paper = json.loads(json.dumps(case_to_dict(load_case(CASES / "paper" / "case01-six.toml"))))
     assert line_from_parameters(paper) is None
 

@@ -124,6 +124,17 @@ def section_geometry(line: Line) -> SectionGeometry:
                            node_z=system.node_xyz0[:, 2].copy())
 
 
+def _getter(t: Any):
+    """Key reader of one ``towers[]`` entry: a JSON dict, a typed document tower (its section
+    metadata in ``t.section``, its support in ``t.support``) or any object with attributes."""
+    if isinstance(t, dict):
+        return t.get
+    sec = getattr(t, "section", None)
+    if isinstance(sec, dict):
+        return lambda k: sec[k] if k in sec else getattr(t, k, None)
+    return lambda k: getattr(t, k, None)
+
+
 def _finite(v: Any) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
@@ -134,9 +145,10 @@ def line_from_parameters(parameters: dict | None, towers: Any = ()) -> Line | No
 
     ``parameters``: the document's case parameters (``case_to_dict``); its ``line.towers`` list
     when the case gave the towers inline.  A case that read them from ``towers_file`` keeps only
-    the file name there: then ``towers`` (the document's ``towers[]`` entries, typed or JSON) are
-    used when they carry ``station`` and ``height`` (and ``name``, ``ground``, ``angle``,
-    ``support``); suspension insulators take the line's default length.  The line is validated
+    the file name there: then ``towers`` (the document's ``towers[]`` entries: JSON dicts, typed
+    towers with their ``section`` metadata, or objects) are used when they carry ``station`` and
+    ``height`` (and ``name``, ``ground``, ``angle``, ``support``, ``insulator_length``); without
+    ``insulator_length`` a suspension tower takes the line's default (:func:`insulators_known`).  The line is validated
     again (the case loader's rules); a document that does not validate gives None.
     """
     if not isinstance(parameters, dict) or not isinstance(parameters.get("line"), dict):
@@ -147,7 +159,7 @@ def line_from_parameters(parameters: dict | None, towers: Any = ()) -> Line | No
             return None
         rows = []
         for t in towers or ():
-            get = t.get if isinstance(t, dict) else (lambda k, _t=t: getattr(_t, k, None))
+            get = _getter(t)
             station, height = get("station"), get("height")
             if not (_finite(station) and _finite(height)):
                 return None
@@ -175,7 +187,7 @@ def insulators_known(parameters: dict | None, towers: Any = ()) -> bool:
     if isinstance(line, dict) and "towers" in line:
         return True
     for t in towers or ():
-        get = t.get if isinstance(t, dict) else (lambda k, _t=t: getattr(_t, k, None))
+        get = _getter(t)
         if get("support") == "suspension" and get("insulator_length") is None:
             return False
     return True

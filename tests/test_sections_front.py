@@ -270,3 +270,15 @@ def test_tui_parameter_keys_of_each_form():
     assert {"line.tension", "line.towers_file"} <= set(section) and not {"line.tension", "line.towers_file"} & set(paper)
     assert not [k for k in section + paper if k.startswith("line.towers.")]
     assert set(section) - set(paper) == {"line.tension", "line.towers_file"}
+
+
+def test_spectral_line_without_a_closed_form():
+    """On unequal spans the closed form (and its ASCE 74 factor) is not applicable: a line of text,
+    not a formatting error."""
+    from linecheck.cli.spectral_cmd import davenport_line
+
+    note = "not applicable: the spans of this section are unequal (the closed form is for one span length)"
+    doc = {"davenport": {"applicable": False, "note": note, "GF_ASCE74": None}}
+    assert davenport_line(doc) == f"closed form (Davenport/Castanheta): not shown: {note}. ASCE 74 wire GRF n/a."
+    doc["davenport"]["GF_ASCE74"] = 1.23456
+    assert davenport_line(doc).endswith("ASCE 74 wire GRF 1.235.")

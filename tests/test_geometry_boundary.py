@@ -23,7 +23,7 @@ GEOMETRY_CODE = {"core/case.py", "core/system.py"}
 
 # front ends / documents that display or copy the case's key; they never compute with it
 DISPLAY_ONLY = {
-    "tui/widgets/browser.py": "case browser line: '6 spans x 300 m' summary text",
+    "io/section.py": "one-line line summary of the front ends: '6 spans x 300 m' (equal-span form)",
     "io/document.py": "run document copies the case's span_length key into the JSON identity block",
     "excel/summary.py": "summary sheet prints the document's span_length column",
 }

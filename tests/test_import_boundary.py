@@ -29,6 +29,7 @@ CORE_MODULES = [
     "linecheck.io.jsonout",
     "linecheck.io.display",
     "linecheck.io.document",
+    "linecheck.io.section",
 ]
 
 

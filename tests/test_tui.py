@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import asyncio
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -18,7 +19,7 @@ import pytest
 from typer.testing import CliRunner
 
 from linecheck import service
-from linecheck.core.case import case_to_toml, load_case, with_value
+from linecheck.core.case import case_to_toml, load_case, with_value, with_values
 from linecheck.core.errors import CaseError
 from linecheck.io.document import RunDocument
 from linecheck.io.jsonout import run_to_dict
@@ -28,9 +29,11 @@ textual = pytest.importorskip("textual")
 from textual.command import CommandList  # noqa: E402
 from textual.widgets import DataTable, Input, Static, TabbedContent  # noqa: E402
 
+from linecheck.tui import files  # noqa: E402
 from linecheck.tui import messages as msg  # noqa: E402
 from linecheck.tui.app import LinecheckApp  # noqa: E402
 from linecheck.tui.commands import LinecheckCommands  # noqa: E402
+from linecheck.tui.formatting import tower_dicts  # noqa: E402
 from linecheck.tui.plotting import PlotView  # noqa: E402
 from linecheck.tui.widgets.browser import CaseBrowser  # noqa: E402
 from linecheck.tui.screens.confirm import ConfirmScreen  # noqa: E402
@@ -616,3 +619,148 @@ async def test_model_spread_action(tmp_path: Path) -> None:
         assert doc["models"]["holmes-oliver"] == doc["reactions"]
         notes = str(app.query_one("#summary-notes", Static).render())
         assert "ring-jet" in notes and "envelope" in notes
+
+
+# --------------------------------------------------------------------------- sections (issue 17)
+SECTION = ROOT / "cases" / "examples" / "section-12span.toml"
+
+
+@pytest.fixture
+def section_case(tmp_path: Path) -> Path:
+    """A copy of the 12-span example (TOML + CSV) in a case folder."""
+    folder = tmp_path / "cases"
+    folder.mkdir()
+    for name in (SECTION.name, "section-12span.csv"):
+        (folder / name).write_text((SECTION.parent / name).read_text(encoding="utf-8"), encoding="utf-8")
+    return folder / SECTION.name
+
+
+def _csv_rows() -> list[list[str]]:
+    lines = (SECTION.parent / "section-12span.csv").read_text(encoding="utf-8").splitlines()
+    return [ln.split(",") for ln in lines if not ln.startswith("#")][1:]  # without the header
+
+
+async def edit_tower(pilot, app: LinecheckApp, row: int, column: str, text: str, *, submit: bool = True) -> None:
+    """Highlight cell ``column`` of tower row ``row`` (0-based) in the tower table, enter, type, enter."""
+    await pilot.press("2")
+    table = app.query_one("#towers-table", DataTable)
+    table.focus()
+    table.cursor_coordinate = (row, table.get_column_index(column))
+    await pilot.press("enter")
+    await wait_for(pilot, lambda: app.focused is app.query_one("#edit-input", Input), "the editor")
+    await pilot.press("end", "ctrl+u", *text)
+    await pilot.pause()
+    if submit:
+        await pilot.press("enter")
+        await pilot.pause()
+
+
+async def test_section_browser_and_tower_table(section_case: Path) -> None:
+    messages = Recorder()
+    app = LinecheckApp([section_case.parent])
+    async with app.run_test(size=SIZE, message_hook=messages.append) as pilot:
+        await pilot.pause()
+        # the browser's preview: a section summary, not "n spans x L m"
+        shown = str(app.query_one("#case-preview", Static).render())
+        assert "12 spans, 255-420 m, 2 angle towers, tower of interest 7" in shown
+        assert "13 towers from section-12span.csv, H0 22 kN, angles T5 +18 deg, T9 -4 deg" in shown
+        assert " x " not in shown.split("line", 1)[1].split("\n", 1)[0]
+        await pilot.press("enter")
+        await wait_for(pilot, lambda: of_type(messages, msg.CaseOpened), "CaseOpened", messages)
+        await pilot.press("2")
+        await pilot.pause()
+        box, table = app.query_one("#towers-box"), app.query_one("#towers-table", DataTable)
+        assert box.display and table.region.height >= table.row_count + 1  # every tower on screen
+        rows = _csv_rows()
+        assert table.row_count == len(rows) == 13
+        for k, ref in enumerate(rows):
+            cells = [str(c) for c in table.get_row_at(k)]
+            name, station, ground, height, support, angle, ins = ref
+            span = "" if k + 1 == len(rows) else f"{float(rows[k + 1][1]) - float(station):g}"
+            # insulator: the tower's own, "(4.2)" for the line default, empty at strain towers
+            ins_shown = ins if ins else ("" if support == "strain" else "(4.2)")
+            assert cells == ["", name, f"{float(station):g}", f"{float(ground):g}", f"{float(height):g}", support,
+                             f"{float(angle):g}", ins_shown, span], k
+        # the parameter table lists the section keys, not the equal-span keys the towers derive
+        keys = [table_key for table_key in app.query_one("#params-table", DataTable).rows]
+        names = [k.value for k in keys]
+        assert "line.tension" in names and "line.towers_file" in names
+        assert "line.span_length" not in names and "line.supports" not in names
+        assert not [n for n in names if n.startswith("line.towers.")]
+
+
+async def test_section_tower_edit_marks_the_case_and_saves_inline(section_case: Path, tmp_path: Path) -> None:
+    messages = Recorder()
+    app = LinecheckApp([section_case])
+    async with app.run_test(size=SIZE, message_hook=messages.append) as pilot:
+        await wait_for(pilot, lambda: app.case is not None, "the case", messages)
+        original = app.case
+        await edit_tower(pilot, app, 3, "height", "35")
+        changed = of_type(messages, msg.ParameterChanged)
+        assert changed and changed[-1].key == "line.towers[4].height" and changed[-1].value == 35.0
+        assert app.case.line.towers[3].height == 35.0 and app.case.line.towers_file is None
+        assert app.case.line.towers[:3] == original.line.towers[:3]
+        assert app.edited and "(edited)" in app.sub_title
+        assert "1 edited (*)" in str(app.query_one("#params-title", Static).render())
+        table = app.query_one("#towers-table", DataTable)
+        assert str(table.get_row_at(3)[0]) == "*" and str(table.get_row_at(2)[0]) == ""
+        assert app.focused is table  # back on the table after the edit
+        # the mean clamp height the equal-span display key derives follows the edit:
+        # (sum of the CSV heights + 5 m) / 13
+        heights = [float(r[3]) for r in _csv_rows()]
+        assert app.case.line.height == pytest.approx((sum(heights) + 5.0) / 13, rel=1e-12)
+
+        # save as: the towers written inline, the edit noted, reloading gives the same towers
+        path = tmp_path / "edited.toml"
+        saved = files.case_for_saving(app.case, app.original, path)
+        assert "line.towers[4].height = 35" in saved.description
+        files.save_case(saved, path, replace=False)
+        again = load_case(path)
+        assert again.line.towers == app.case.line.towers and again.line.towers_file is None
+
+        # revert: the file's table again, no marker
+        app.action_revert()
+        await pilot.pause()
+        assert app.case is original and not app.edited
+        assert str(app.query_one("#towers-table", DataTable).get_row_at(3)[0]) == ""
+
+
+async def test_section_invalid_tower_cell_shows_the_cli_message(section_case: Path, tmp_path: Path) -> None:
+    messages = Recorder()
+    app = LinecheckApp([section_case])
+    async with app.run_test(size=SIZE, message_hook=messages.append) as pilot:
+        await wait_for(pilot, lambda: app.case is not None, "the case", messages)
+        before = app.case
+        await edit_tower(pilot, app, 3, "station", "600")  # T4 before T3 (655 m)
+        rejected = of_type(messages, msg.ParameterRejected)
+        assert rejected and rejected[-1].key == "line.towers[4].station"
+        shown = str(app.query_one("#edit-message", Static).render())
+        expected = ("line.towers[4].station: value 600.0 is not allowed: expected stations increasing along the "
+                    "line (the previous tower is at 655.0 m)")
+        assert shown == f"{section_case}: {expected}" and rejected[-1].message == shown
+        assert "\n" not in shown
+        assert app.query_one("#edit-input", Input).has_class("-invalid")
+        assert app.case is before and not app.edited
+
+        # the CLI on a file holding that table says the same after its file:line prefix
+        bad = tmp_path / "bad.toml"
+        inline = with_values(before, {"line.towers_file": None, "line.towers": tower_dicts(before)})
+        text = case_to_toml(inline).replace("station = 940.0", "station = 600.0")
+        bad.write_text(text, encoding="utf-8")
+        from linecheck.cli.app import app as cli
+
+        res = CliRunner().invoke(cli, ["check", str(bad)])
+        assert res.exit_code == 2
+        out = res.output.strip()
+        assert out.endswith(expected) and re.search(rf"error:\S* {re.escape(str(bad))}:\d+: line\.towers\[4\]", out)
+
+        # an end tower cannot be suspension: the loader's words, as you type
+        await pilot.press("escape")
+        await pilot.pause()
+        await edit_tower(pilot, app, 12, "support", "suspension", submit=False)
+        shown = str(app.query_one("#edit-message", Static).render())
+        assert shown.startswith(f"{section_case}: line.towers[13].support: value \"suspension\" is not allowed at "
+                                "an end tower: expected \"strain\"")
+        await pilot.press("escape")
+        await pilot.pause()
+        assert app.case is before

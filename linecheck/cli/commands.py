@@ -12,6 +12,7 @@ from .. import service
 from ..core.errors import CaseError
 from ..io.atomic import check_target
 from ..io.jsonout import static_to_dict, write_json
+from ..io.section import section_summary, tower_rows
 from .app import CaseArg, CasesArg, JsonOpt, app, console, err_console, handle_errors, read_case
 from .limits import warn as limits_warn
 from .progress import progress_bar
@@ -32,8 +33,18 @@ def check(cases: CasesArg) -> None:
             continue
         console.print(f"[green]ok[/] {escape(str(path))}  [dim]{escape(case.name)}: {escape(case.description)}[/]",
                       highlight=False)
+        if case.line.is_section:
+            console.print(f"   section: {escape(section_line(case))}", highlight=False, soft_wrap=True)
     if failed:
         raise typer.Exit(2)
+
+
+def section_line(case) -> str:
+    """``"13 towers T1-T13, 12 spans, 255-420 m, 2 angle towers; tower of interest 7 (T7)"``."""
+    rows = tower_rows(case.line)
+    toi = case.line.tower_of_interest
+    return (f"{len(rows)} towers {rows[0].name}-{rows[-1].name}, {section_summary(case.line)}; "
+            f"tower of interest {toi} ({rows[toi - 1].name})")
 
 
 @app.command()
@@ -49,14 +60,17 @@ def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     m = res.mean
     toi = case.line.tower_of_interest - 1
     table = Table(title=f"{case.name}: step-1 mean reactions (kN)", title_justify="left")
-    for col in ("tower", "support", "Rx", "Ry", "Rz", "Rx wind", "Ry wind", "Rz wind"):
-        table.add_column(col, justify="right")
+    rows = tower_rows(case.line)  # sections: tower names and stations (issue 17)
+    names = ("name", "station (m)") if rows else ()
+    for col in ("tower", *names, "support", "Rx", "Ry", "Rz", "Rx wind", "Ry wind", "Rz wind"):
+        table.add_column(col, justify="left" if col == "name" else "right")
     rw = m.reactions_wind
     for j in range(res.system.n_towers):
         k = int(abs(rw[:, j, 1]).argmax()) if case.wind.type == "downburst" else 0
         mark = " *" if j == toi else ""
+        ident = (escape(rows[j].name), f"{rows[j].station:g}") if rows else ()
         table.add_row(
-            f"{j + 1}{mark}", case.line.supports[j],
+            f"{j + 1}{mark}", *ident, case.line.supports[j],
             *(f"{m.reactions[k, j, c] / 1e3:.3f}" for c in range(3)),
             *(f"{rw[k, j, c] / 1e3:.3f}" for c in range(3)),
         )

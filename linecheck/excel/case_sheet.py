@@ -10,9 +10,11 @@ from openpyxl.styles import Font, PatternFill
 from openpyxl.utils import get_column_letter
 from openpyxl.worksheet.worksheet import Worksheet
 
-from ..core.case import SCHEMA
+from ..core.case import SCHEMA, Line
 from ..io.display import flag_state, flag_text
 from ..io.document import STAT_BY_NAME, STAT_TABLE, RunDocument
+from ..io.section import (COLUMN_UNITS, insulators_known, line_from_parameters, section_geometry, section_summary,
+                          tower_rows)
 from . import template as tpl
 from .cells import (
     FLAG_NOTE,
@@ -33,7 +35,7 @@ from .cells import (
     stat_cell,
     wind_label,
 )
-from .charts import CHART_COL, CHART_ROWS, CHART_W, case_charts
+from .charts import CHART_COL, CHART_ROWS, CHART_W, case_charts, section_charts
 
 
 def write_case(ws: Worksheet, doc: RunDocument, threshold: float, chart_points: int, summary: Worksheet,
@@ -56,14 +58,21 @@ def write_case(ws: Worksheet, doc: RunDocument, threshold: float, chart_points: 
     info.append(f"dt = {doc.time_step:g} s")
     cur.put(3, 3, ", ".join(info), "lc_subtitle")
     cur.row = 4
+    section = line_from_parameters(doc.parameters, doc.towers)  # None: the paper's equal-span form
     if doc.parameters is not None:
         _inputs_table(cur, doc, doc.parameters)
+    if section is not None:
+        _section_table(cur, doc, section)
+    elif _is_section_doc(doc):
+        cur.row += 1
+        cur.note("Section: the tower table is not in this result (the case read it from "
+                 f"{doc.parameters['line'].get('towers_file')}); see the case file.")
     _still_air_and_step1(cur, doc)
     _stats_table(cur, doc)
     if doc.models is not None:
         _models_table(cur, doc)
     contrib_rows = _contributions_table(cur, doc, threshold, flagged)
-    _towers_table(cur, doc)
+    _towers_table(cur, doc, section)
     if doc.spectral is not None:
         _spectral(cur, doc, doc.spectral)
     elif doc.wind == "synoptic":
@@ -77,6 +86,10 @@ def write_case(ws: Worksheet, doc: RunDocument, threshold: float, chart_points: 
     # ---- charts (data outside the print area)
     bottom = 2
     charts = case_charts(ws, doc, chart_points, contrib_rows)
+    if section is not None:  # plan and profile first: they describe the sheet's line (issue 17)
+        geo, _next = section_charts(ws, section_geometry(section), [r.name for r in tower_rows(section)],
+                                    ws.max_column + 2)
+        charts = geo + charts
     for k, ch in enumerate(charts):
         ws.add_chart(ch, f"{get_column_letter(CHART_COL)}{2 + k * CHART_ROWS}")
         bottom = 2 + (k + 1) * CHART_ROWS
@@ -91,7 +104,10 @@ def write_case(ws: Worksheet, doc: RunDocument, threshold: float, chart_points: 
 def _inputs_table(cur: Cursor, doc: RunDocument, params: dict) -> None:
     cur.section("Inputs (case parameters)")
     cur.header(["Key", "Unit", "Value", "", "Description", "", "", ""])
+    is_section = _is_section_doc(doc)
     for section, specs in SCHEMA.items():
+        if section == "line.towers":  # one row per tower: the Section block (issue 17)
+            continue
         if section == "":
             table = params
         elif section == "wind.downburst":
@@ -108,6 +124,8 @@ def _inputs_table(cur: Cursor, doc: RunDocument, params: dict) -> None:
                 value = table.get(spec.name) or getattr(doc, spec.name)
             else:
                 value = table.get(spec.name)
+            if value is None and is_section and section == "line" and spec.name in _EQUAL_SPAN_KEYS:
+                value = "(section: see Section)"
             if value is None:
                 preset = (table or {}).get("preset")
                 value = "(from preset)" if preset and spec.name in ("jet_diameter", "distance", "angle") else "(default)"
@@ -128,6 +146,41 @@ def _inputs_table(cur: Cursor, doc: RunDocument, params: dict) -> None:
         cur.put(cur.row, 4, None, "lc_text")
         cur.put(cur.row, 5, "normalising force ½ ρ C_d V_ref² D L_x", "lc_note")
         cur.row += 1
+
+
+_EQUAL_SPAN_KEYS = ("spans", "span_length", "sag", "height", "supports")
+
+
+def _is_section_doc(doc: RunDocument) -> bool:
+    """The result is of a section-form case (towers inline or in a towers_file)."""
+    line = (doc.parameters or {}).get("line")
+    return isinstance(line, dict) and ("towers" in line or line.get("towers_file") is not None)
+
+
+def _section_table(cur: Cursor, doc: RunDocument, line: Line) -> None:
+    """The Section block (issue 17): one row per tower, as in the case, plus the span to the next."""
+    rows = tower_rows(line)
+    src = f", towers from {line.towers_file}" if line.towers_file else ""
+    cur.section(f"Section: {len(rows)} towers, {section_summary(line)}, H0 = {line.tension / 1e3:g} kN{src}")
+    labels = ["Tower", "station", "ground", "height", "support", "angle", "insulator", "span to next"]
+    cur.header(labels)
+    keys = ("station", "ground", "height", "support", "angle", "insulator_length", "span")
+    cur.header([""] + [f"({COLUMN_UNITS[k]})" if COLUMN_UNITS[k] else "" for k in keys])
+    toi = doc.tower_of_interest
+    known = insulators_known(doc.parameters, doc.towers)
+    for r in rows:
+        cur.put(cur.row, 1, f"{r.name}{' *' if r.index == toi else ''}", "lc_text")
+        ins = r.insulator_used if known or r.support != "suspension" else "?"
+        for k, (v, fmt) in enumerate(((r.station, "0.0"), (r.ground, "0.0"), (r.height, "0.0"), (r.support, None),
+                                      (r.angle, "0.0"), (ins, "0.00"), (r.span, "0.0"))):
+            cur.put(cur.row, 2 + k, v, "lc_number" if is_num(v) else "lc_text", fmt)
+        cur.row += 1
+    cur.note(f"* tower of interest ({toi}); clamp elevation = ground + height; insulator: length in force at "
+             "suspension towers (line default where not given); span: horizontal length to the next tower.")
+    if not known:
+        cur.note("?: the insulator lengths of the towers are not in this result (see the case's tower table).")
+    cur.note("Charts: plan (clamp points, first span along +x) and profile (clamps, ground and the still-air "
+             "conductor) to the right.")
 
 
 def _list_text(values: list) -> str:
@@ -288,14 +341,16 @@ def _contributions_table(cur: Cursor, doc: RunDocument, threshold: float,
     return first, last
 
 
-def _towers_table(cur: Cursor, doc: RunDocument) -> None:
+def _towers_table(cur: Cursor, doc: RunDocument, section: Line | None = None) -> None:
     if not doc.towers:
         return
+    names = [r.name for r in tower_rows(section)] if section is not None else []
     cur.section("Every tower: dynamic peak and maximum mean reactions (kN)")
     cur.header(["Tower", "", "peak Rx", "peak Ry", "peak Rz", "max|M| Rx", "max|M| Ry", "max|M| Rz"])
     for t in doc.towers:
         mark = " *" if t.index == doc.tower_of_interest else ""
-        cur.put(cur.row, 1, f"{t.index} {t.support}{mark}", "lc_text")
+        name = f" {names[t.index - 1]}" if 0 < t.index <= len(names) else ""
+        cur.put(cur.row, 1, f"{t.index}{name} {t.support}{mark}", "lc_text")
         cur.put(cur.row, 2, "kN", "lc_text")
         for k, r in enumerate(REACTIONS):
             cur.put(cur.row, 3 + k, kn(t.reactions[r]["peak_dynamic"].mean), fmt=KN)

@@ -183,3 +183,55 @@ def case_charts(ws: Worksheet, doc: Any, chart_points: int, contrib_rows: tuple[
     return charts
 
 
+
+
+def _marker_series(ws: Worksheet, xcol: int, ycol: int, row0: int, n: int, color: str, symbol: str,
+                   line: bool) -> Series:
+    s = _line_series(ws, xcol, ycol, row0, n, color, 19050)
+    s.marker.symbol = symbol
+    s.marker.size = 6
+    s.marker.graphicalProperties.solidFill = color
+    s.marker.graphicalProperties.line.solidFill = color
+    if not line:
+        s.graphicalProperties.line.noFill = True
+    return s
+
+
+def section_charts(ws: Worksheet, geom: Any, names: list[str], col: int) -> tuple[list, int]:
+    """Plan and profile of a line section (issue 17) from ``geom``
+    (:class:`~linecheck.io.section.SectionGeometry`); data written from column ``col``.
+
+    Plan: the still-air clamp points, y against x (first span along +x).  Profile: clamp
+    elevation, ground and the still-air conductor (clipped-in catenaries) against station.
+    Returns the charts and the next free data column.
+    """
+    row0 = 3
+    n = geom.station.size
+    ws.cell(row=row0 - 1, column=col, value="Section geometry (m, still air)").style = "lc_note"
+    for k, (header, values) in enumerate((("x (m)", geom.x), ("y (m)", geom.y), ("station (m)", geom.station),
+                                          ("clamp z (m)", geom.z), ("ground (m)", geom.ground))):
+        _write_column(ws, col + k, row0, header, np.asarray(values, dtype=float))
+    set_value(ws.cell(row=row0, column=col + 5), "tower")
+    for i, name in enumerate(names):
+        set_value(ws.cell(row=row0 + 1 + i, column=col + 5), name)
+    _write_column(ws, col + 6, row0, "conductor station (m)", np.asarray(geom.node_station, dtype=float))
+    _write_column(ws, col + 7, row0, "conductor z (m)", np.asarray(geom.node_z, dtype=float))
+
+    plan = _scatter("Section plan: clamp points (first span along +x)", "x (m)", "y (m)")
+    plan.scatterStyle = "lineMarker"
+    plan.series.append(_marker_series(ws, col, col + 1, row0, n, "2E75B6", "circle", line=True))
+    plan.legend = None
+    profile = _scatter("Section profile: clamps, ground and still-air conductor", "station (m)", "elevation (m)")
+    profile.scatterStyle = "lineMarker"
+    m = geom.node_station.size
+    profile.series.append(_line_series(ws, col + 6, col + 7, row0, m, "C55A11", 12700))
+    profile.series.append(_marker_series(ws, col + 2, col + 3, row0, n, "2E75B6", "triangle", line=False))
+    profile.series.append(_line_series(ws, col + 2, col + 4, row0, n, "548235", 19050))
+    profile.x_axis.scaling.min = float(np.min(geom.station))
+    profile.x_axis.scaling.max = float(np.max(geom.station))
+    lo = float(min(np.min(geom.ground), np.min(geom.node_z)))
+    hi = float(np.max(geom.z))
+    pad = 0.05 * (hi - lo) if hi > lo else 1.0
+    profile.y_axis.scaling.min = math.floor(lo - pad)
+    profile.y_axis.scaling.max = math.ceil(hi + pad)
+    return [plan, profile], col + 9

@@ -119,9 +119,12 @@ def compare_rows(pinned: RunDocument, current: RunDocument) -> list[tuple[str, .
 
 # --------------------------------------------------------------------------- parameters
 def iter_fields() -> list[tuple[str, FieldSpec]]:
-    """Every case key as ``(dotted key, spec)`` in schema order."""
+    """Every case key as ``(dotted key, spec)`` in schema order; the per-tower keys of a section
+    ([[line.towers]]) are not keys of the case but cells of its tower table (:func:`tower_differences`)."""
     out = []
     for section, specs in SCHEMA.items():
+        if section == "line.towers":
+            continue
         for spec in specs:
             out.append((f"{section}.{spec.name}" if section else spec.name, spec))
     return out
@@ -132,11 +135,53 @@ ONLY_FOR = {"downburst": ("wind.downburst.", "analysis.mean_states"),
             "synoptic": ("wind.span_speeds", "analysis.burn_in")}
 
 
-def fields_for(wind_type: str) -> list[tuple[str, FieldSpec]]:
+# keys of one form of the line (issue 17): a section's towers derive the equal-span keys (shown in
+# the tower table instead), and an equal-span case has no tower table to go with tension/towers_file
+EQUAL_SPAN_KEYS = ("line.spans", "line.span_length", "line.sag", "line.height", "line.supports")
+SECTION_KEYS = ("line.tension", "line.towers_file")
+
+
+def fields_for(wind_type: str, section: bool | None = None) -> list[tuple[str, FieldSpec]]:
     """:func:`iter_fields` without the keys of the other wind type (a synoptic case does not
-    list the downburst keys)."""
+    list the downburst keys); with ``section`` True, without the equal-span keys the towers
+    derive (they are in the tower table); False, without the section form's ``tension`` and
+    ``towers_file`` (an equal-span case has no tower table); None, every line key."""
     hidden = tuple(p for t, prefixes in ONLY_FOR.items() if t != wind_type for p in prefixes)
+    if section is not None:
+        hidden += EQUAL_SPAN_KEYS if section else SECTION_KEYS
     return [(k, spec) for k, spec in iter_fields() if not k.startswith(hidden)]
+
+
+#: Columns of the TUI tower table: the [[line.towers]] keys (editable) and the derived span.
+TOWER_KEYS = ("name", "station", "ground", "height", "support", "angle", "insulator_length")
+
+
+def tower_dicts(case: Case) -> list[dict[str, Any]]:
+    """The towers of a section case as [[line.towers]] tables (keys that are set), for
+    :func:`~linecheck.core.case.with_values` (``{"line.towers_file": None, "line.towers": ...}``)."""
+    return [{k: getattr(t, k) for k in TOWER_KEYS if getattr(t, k) is not None} for t in case.line.towers or ()]
+
+
+def tower_key(k: int, column: str) -> str:
+    """``line.towers[k+1].column``: the key the case validation names for tower ``k`` (0-based)."""
+    return f"line.towers[{k + 1}].{column}"
+
+
+def tower_differences(a: Case, b: Case) -> list[tuple[str, str, str]]:
+    """Tower-table cells that differ: ``(line.towers[k].column, value in a, value in b)``; a
+    changed number of towers is one row ``("line.towers", "13 towers", "12 towers")``."""
+    ta, tb = a.line.towers or (), b.line.towers or ()
+    if ta == tb:
+        return []
+    if len(ta) != len(tb):
+        return [("line.towers", f"{len(ta)} towers", f"{len(tb)} towers")]
+    out = []
+    for k, (x, y) in enumerate(zip(ta, tb)):
+        for col in TOWER_KEYS:
+            va, vb = getattr(x, col), getattr(y, col)
+            if va != vb:
+                out.append((tower_key(k, col), value_text(va) or "(default)", value_text(vb) or "(default)"))
+    return out
 
 
 def get_value(case: Case, dotted: str) -> Any:
@@ -192,11 +237,17 @@ def parse_value(spec: FieldSpec, text: str) -> Any:
 def case_differences(a: Case, b: Case) -> list[tuple[str, str, str]]:
     """Keys whose values differ: ``(dotted key, value in a, value in b)``."""
     out = []
+    derived = EQUAL_SPAN_KEYS if a.line.is_section or b.line.is_section else ()  # from the towers
+    towers = tower_differences(a, b)
+    if towers and a.line.is_section and b.line.is_section:
+        derived += ("line.towers_file",)  # an edited tower table is held inline: the cells say what changed
     for dotted, _spec in iter_fields():
+        if dotted in derived:
+            continue
         va, vb = get_value(a, dotted), get_value(b, dotted)
         if va != vb:
             out.append((dotted, value_text(va) or "(default)", value_text(vb) or "(default)"))
-    return out
+    return out + towers
 
 
 # --------------------------------------------------------------------------- spectral

@@ -19,6 +19,8 @@ Design check of conductor reactions under downburst and synoptic winds
 - `1` `2` `3` `4` `5`: tabs Cases, Parameters, Results, Compare, Codes (design codes beside the peaks)
 - arrows, `enter`: move; open a case (Cases) or edit a parameter (Parameters)
 - `e`: edit the highlighted parameter; `enter` applies, `esc` cancels
+- a section case (towers) has its tower table under the parameters: `tab` to it, arrows to a
+  cell, `enter` edits it (checked like the case file; saved as inline `[[line.towers]]`)
 - `s`: save the edited case as a new TOML file in the working folder (an existing file is never
   replaced silently; a shipped case folder such as `cases/paper/` needs a second `enter`)
 - `r`: run the case (steps 1-3, natural frequencies, wind at p); `c` cancels the run

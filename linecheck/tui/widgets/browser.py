@@ -11,6 +11,7 @@ from textual.widgets import Static, Tree
 
 from ...core.case import load_case
 from ...core.errors import LinecheckError
+from ...io.section import line_summary
 from ..catalog import CaseEntry, Catalog, Folder, shown_path
 from ..messages import OpenCaseRequested
 
@@ -38,12 +39,19 @@ def preview(path: Path) -> Text:
         out.append(f"{case.description}\n")
     out.append(f"{shown_path(path)}\n\n", style="dim")
     out.append("line      ", style="bold")
-    out.append(f"{ln.spans} span{'s' if ln.spans > 1 else ''} x {ln.span_length:g} m, sag {ln.sag:g} m, "
-               f"height {ln.height:g} m, tower of interest {ln.tower_of_interest}\n")
+    out.append(f"{line_summary(ln)}, tower of interest {ln.tower_of_interest}\n")
     out.append("          ", style="bold")
-    out.append(f"supports {', '.join(ln.supports)}\n")
+    if ln.is_section:  # issue 17: the towers, not one support word per tower
+        src = f" from {ln.towers_file}" if ln.towers_file else ""
+        turns = [f"{t.name} {t.angle:+g} deg" for t in ln.towers if t.angle]
+        out.append(f"{ln.n_towers} towers{src}, H0 {ln.tension / 1e3:g} kN"
+                   + (f", angles {', '.join(turns)}" if turns else "") + "\n")
+    else:
+        out.append(f"supports {', '.join(ln.supports)}\n")
     out.append("wind      ", style="bold")
     out.append(f"{w.type}, V_ref {w.v_ref:g} m/s, I = {w.turbulence_intensity:g}")
+    if w.direction or w.profile_exponent:
+        out.append(f", direction {w.direction:g} deg, profile exponent {w.profile_exponent:g}")
     if w.downburst is not None:
         db = w.downburst
         out.append(f"\n          D_j {db.jet_diameter:g} m, R {db.distance:g} m, angle {db.angle:g} deg"

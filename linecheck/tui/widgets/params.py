@@ -3,6 +3,11 @@
 Every row comes from :data:`linecheck.core.case.SCHEMA`; a new value is checked by
 :func:`linecheck.core.case.with_value`, i.e. the same validation and the same
 messages as the CLI's case loader.
+
+A section case (issue 17) also shows its tower table (one row per tower, a cell per
+[[line.towers]] key and the derived span to the next tower); ``enter``/``e`` on a cell edits it:
+the whole table goes through :func:`linecheck.core.case.with_values` (``line.towers``, the
+case then holds its towers inline), so a bad cell gets the CLI's one-line message.
 """
 
 from __future__ import annotations
@@ -16,15 +21,18 @@ from textual.binding import Binding
 from textual.containers import Vertical
 from textual.widgets import DataTable, Input, Static
 
-from ...core.case import Case, FieldSpec, with_value
+from ...core.case import Case, FieldSpec, field_spec, with_value, with_values
 from ...core.errors import CaseError
+from ...io.section import COLUMN_UNITS, section_summary, tower_rows
 from ..catalog import shown_path
-from ..formatting import fields_for, get_value, iter_fields, parse_value, value_text
+from ..formatting import (TOWER_KEYS, case_differences, fields_for, get_value, iter_fields, parse_value, tower_dicts,
+                          tower_key, value_text)
 from ..messages import ParameterChanged, ParameterRejected
 
 COLUMNS = ("", "parameter", "value", "unit", "description")
 # the parameter column fits the longest key (wind.downburst.translation_direction)
 WIDTHS = (1, max(len(k) for k, _ in iter_fields()), 22, 6, None)
+TOWER_COLUMNS = ("mark", *TOWER_KEYS, "span")
 
 
 class ParameterEditor(Vertical):
@@ -42,20 +50,30 @@ class ParameterEditor(Vertical):
         self.editing: str | None = None
         self.pending: Case | None = None  # validated copy for the text being typed
         self.specs: dict[str, FieldSpec] = dict(iter_fields())
+        self.tower_cell: tuple[int, str] | None = None  # (0-based tower, column) being edited
 
     def compose(self) -> ComposeResult:
         yield Static("No case open: pick one in the Cases tab (key 1).", id="params-title")
         table: DataTable = DataTable(id="params-table", cursor_type="row", zebra_stripes=True)
         yield table
+        with Vertical(id="towers-box"):
+            yield Static("", id="towers-title")
+            yield DataTable(id="towers-table", cursor_type="cell", zebra_stripes=True)
         with Vertical(id="edit-bar"):
             yield Static("", id="edit-label")
             yield Input(id="edit-input", placeholder="new value; empty = default")
             yield Static("", id="edit-message")
 
     def on_mount(self) -> None:
-        table = self.query_one(DataTable)
+        table = self.query_one("#params-table", DataTable)
         for c, w in zip(COLUMNS, WIDTHS):
             table.add_column(c, key=c or "mark", width=w)
+        towers = self.query_one("#towers-table", DataTable)
+        for c in TOWER_COLUMNS:
+            unit = COLUMN_UNITS.get(c, "")
+            label = "" if c == "mark" else (f"{c} ({unit})" if unit else c)
+            towers.add_column(label, key=c)
+        self.query_one("#towers-box").display = False
         self.query_one("#edit-bar").display = False
 
     # ------------------------------------------------------------------ showing
@@ -64,14 +82,56 @@ class ParameterEditor(Vertical):
         if self.editing is not None:
             self.stop_editing()
         self.case, self.original = case, original
-        table = self.query_one(DataTable)
+        table = self.query_one("#params-table", DataTable)
         row = table.cursor_row
         table.clear()
-        for key, spec in fields_for(case.wind.type):
+        for key, spec in fields_for(case.wind.type, case.line.is_section):
             table.add_row(*self._cells(key, spec), key=key)
         if table.row_count:
             table.move_cursor(row=min(max(row, 0), table.row_count - 1))
+        self._show_towers()
         self._update_title()
+
+    def _show_towers(self) -> None:
+        """Fill the tower table of a section case (hidden for the equal-span form)."""
+        box = self.query_one("#towers-box")
+        case = self.case
+        if case is None or not case.line.is_section:
+            box.display = False
+            return
+        box.display = True
+        table = self.query_one("#towers-table", DataTable)
+        cursor = table.cursor_coordinate
+        table.clear()
+        old = self.original.line.towers if self.original is not None and self.original.line.is_section else ()
+        for r, t in zip(tower_rows(case.line), case.line.towers):
+            before = old[r.index - 1] if r.index - 1 < len(old) else None
+            cells: list[Any] = []
+            for col in TOWER_KEYS:
+                v = getattr(t, col)
+                text = Text(value_text(v))
+                if v is None:
+                    used = r.insulator_used if col == "insulator_length" else None
+                    text = Text(f"({value_text(used)})" if used is not None else "", style="dim")
+                if before is not None and getattr(before, col) != v or before is None:
+                    text.stylize("bold yellow")
+                cells.append(text)
+            changed = before != t
+            mark = Text("*", style="bold yellow") if changed else ""
+            span = Text(value_text(r.span) if r.span is not None else "", style="dim")
+            toi = r.index == case.line.tower_of_interest
+            if toi:
+                cells[0].stylize("bold underline")
+            label = Text(f"{r.index}" + (" ToI" if toi else ""), style="bold" if toi else "dim")
+            table.add_row(mark, *cells, span, key=str(r.index - 1), label=label)
+        if table.row_count:
+            table.cursor_coordinate = cursor if cursor.row < table.row_count else table.cursor_coordinate
+        src = f" (from {case.line.towers_file})" if case.line.towers_file else " (inline)"
+        title = Text("towers: ", style="bold")
+        title.append(f"{section_summary(case.line)}, H0 {case.line.tension:g} N{src}")
+        title.append("   enter edits the highlighted cell; ToI tower of interest, * edited, () line default",
+                     style="dim")
+        self.query_one("#towers-title", Static).update(title)
 
     def _cells(self, key: str, spec: FieldSpec) -> tuple[Any, ...]:
         v = get_value(self.case, key)
@@ -87,7 +147,7 @@ class ParameterEditor(Vertical):
         c = self.case
         if c is None:
             return
-        n = len([k for k in self.specs if get_value(c, k) != get_value(self.original, k)])
+        n = len(case_differences(self.original, c)) if self.original is not None else 0
         src = f"  {shown_path(c.source)}" if c.source else ""
         t = Text(f"{c.name}", style="bold")
         t.append(src, style="dim")
@@ -106,7 +166,11 @@ class ParameterEditor(Vertical):
 
     # ------------------------------------------------------------------ editing
     def action_edit(self) -> None:
-        table = self.query_one(DataTable)
+        towers = self.query_one("#towers-table", DataTable)
+        if self.case is not None and towers.has_focus and towers.row_count:
+            self._edit_tower_at(towers.cursor_coordinate)
+            return
+        table = self.query_one("#params-table", DataTable)
         if self.case is None or not table.row_count:
             return
         key = table.coordinate_to_cell_key(table.cursor_coordinate).row_key.value
@@ -118,11 +182,36 @@ class ParameterEditor(Vertical):
         if event.row_key.value is not None:
             self.start_editing(event.row_key.value)
 
+    @on(DataTable.CellSelected, "#towers-table")
+    def _cell_selected(self, event: DataTable.CellSelected) -> None:
+        event.stop()
+        self._edit_tower_at(event.coordinate)
+
+    def _edit_tower_at(self, coordinate) -> None:
+        table = self.query_one("#towers-table", DataTable)
+        keys = table.coordinate_to_cell_key(coordinate)
+        column = keys.column_key.value
+        if column not in TOWER_KEYS:
+            self.notify("span is derived from the stations: edit a station", timeout=3)
+            return
+        self.start_tower_edit(int(keys.row_key.value), column)
+
+    def start_tower_edit(self, k: int, column: str) -> None:
+        """Open the edit bar on cell ``column`` of tower ``k`` (0-based) of a section case."""
+        if self.case is None or not self.case.line.is_section or column not in TOWER_KEYS:
+            return
+        self.tower_cell = (k, column)
+        self._open_bar(tower_key(k, column), field_spec("line.towers", column),
+                       getattr(self.case.line.towers[k], column))
+
     def start_editing(self, key: str) -> None:
         """Open the edit bar on ``key`` (a dotted case key such as ``wind.v_ref``)."""
         if self.case is None or key not in self.specs:
             return
-        spec = self.specs[key]
+        self.tower_cell = None
+        self._open_bar(key, self.specs[key], get_value(self.case, key))
+
+    def _open_bar(self, key: str, spec: FieldSpec, value: Any) -> None:
         self.editing = key
         unit = f" [{spec.unit}]" if spec.unit not in ("", "-") else ""
         label = Text(f"{key}{unit}", style="bold")
@@ -131,7 +220,7 @@ class ParameterEditor(Vertical):
         bar = self.query_one("#edit-bar")
         bar.display = True
         inp = self.query_one("#edit-input", Input)
-        inp.value = value_text(get_value(self.case, key))
+        inp.value = value_text(value)
         inp.cursor_position = len(inp.value)
         inp.focus()
         self.validate(inp.value)
@@ -141,11 +230,13 @@ class ParameterEditor(Vertical):
         """Check ``text`` for the key being edited; show and return the message (None when valid)."""
         if self.editing is None or self.case is None:
             return None
-        spec = self.specs[self.editing]
         msg_box = self.query_one("#edit-message", Static)
         inp = self.query_one("#edit-input", Input)
         try:
-            self.pending = with_value(self.case, self.editing, parse_value(spec, text))
+            if self.tower_cell is not None:
+                self.pending = self._with_tower_value(text)
+            else:
+                self.pending = with_value(self.case, self.editing, parse_value(self.specs[self.editing], text))
         except CaseError as err:
             self.pending = None
             inp.add_class("-invalid")
@@ -154,6 +245,17 @@ class ParameterEditor(Vertical):
         inp.remove_class("-invalid")
         msg_box.update(Text("valid - enter applies, esc cancels", style="green"))
         return None
+
+    def _with_tower_value(self, text: str) -> Case:
+        """The case with the edited tower cell (empty text: the key's default), validated."""
+        k, column = self.tower_cell
+        rows = tower_dicts(self.case)
+        value = parse_value(field_spec("line.towers", column), text)
+        if value is None:
+            rows[k].pop(column, None)
+        else:
+            rows[k][column] = value
+        return with_values(self.case, {"line.towers_file": None, "line.towers": rows})
 
     @on(Input.Changed, "#edit-input")
     def _changed(self, event: Input.Changed) -> None:
@@ -172,13 +274,17 @@ class ParameterEditor(Vertical):
             self.app.bell()
             return
         new = self.pending
-        value = get_value(new, key)
+        cell = self.tower_cell
+        value = get_value(new, key) if cell is None else getattr(new.line.towers[cell[0]], cell[1])
         self.stop_editing()
         self.case = new
-        table = self.query_one(DataTable)
-        for k, spec in fields_for(new.wind.type):  # a change can alter derived values (e.g. presets)
-            for col, cell in zip(COLUMNS, self._cells(k, spec)):
-                table.update_cell(k, col or "mark", cell)
+        table = self.query_one("#params-table", DataTable)
+        for k, spec in fields_for(new.wind.type, new.line.is_section):  # an edit can alter derived values
+            for col, c in zip(COLUMNS, self._cells(k, spec)):
+                table.update_cell(k, col or "mark", c)
+        if cell is not None:
+            self._show_towers()
+            self.query_one("#towers-table", DataTable).focus()
         self._update_title()
         self.post_message(ParameterChanged(new, key, value))
 
@@ -186,9 +292,11 @@ class ParameterEditor(Vertical):
         self.stop_editing()
 
     def stop_editing(self) -> None:
+        tower = self.tower_cell is not None
         self.editing = None
         self.pending = None
+        self.tower_cell = None
         self.query_one("#edit-bar").display = False
         self.query_one("#edit-message", Static).update("")
-        self.query_one(DataTable).focus()
+        self.query_one("#towers-table" if tower else "#params-table", DataTable).focus()
         self.refresh_bindings()

@@ -415,7 +415,8 @@ class Tower:
     """Tower ``index`` (1-based): support type and its typed reaction blocks.
 
     ``section`` (section form only, issue 17): the tower's ``name``, ``station``, ``ground``,
-    ``height``, ``angle`` [deg], ``heading`` [deg] (its frame's x axis from the global x: the
+    ``height``, ``angle`` [deg], ``insulator_length`` [m] (in force; null at strain towers),
+    ``heading`` [deg] (its frame's x axis from the global x: the
     reactions are in that frame) and ``global``: the still-air and step-1 mean reactions in the
     global frame (x along the first span, y to its left, z down)."""
 
@@ -459,7 +460,7 @@ def models_of(reactions: dict[str, dict[str, ReactionResult]]) -> dict[str, dict
     return env
 
 
-SECTION_TOWER_KEYS = ("name", "station", "ground", "height", "angle", "heading", "global")
+SECTION_TOWER_KEYS = ("name", "station", "ground", "height", "angle", "insulator_length", "heading", "global")
 
 
 def section_tower(res: Any, k: int) -> dict[str, Any] | None:
@@ -474,7 +475,9 @@ def section_tower(res: Any, k: int) -> dict[str, Any] | None:
     big = int(np.argmax(np.abs(m.reactions_wind[:, k]).max(axis=1))) if m.time.size > 1 else 0
     return {
         "name": t.name, "station": float(system.stations[k]), "ground": t.ground, "height": t.height,
-        "angle": t.angle, "heading": float(np.degrees(system.tower_headings[k])),
+        "angle": t.angle,
+        "insulator_length": float(system.insulator_lengths[k]) if t.support == "suspension" else None,
+        "heading": float(np.degrees(system.tower_headings[k])),
         "global": {"still_air": {r: _f(still[c]) for c, r in enumerate(REACTIONS)},
                    "mean": {r: _f(total[big, c]) for c, r in enumerate(REACTIONS)}},
     }
@@ -735,6 +738,7 @@ def json_schema() -> dict[str, Any]:
                                "name": {"type": "string"}, "station": {"type": "number"},
                                "ground": {"type": "number"}, "height": {"type": "number"},
                                "angle": {"type": "number"}, "heading": {"type": "number"},
+                               "insulator_length": {"type": ["number", "null"]},
                                "global": {"type": "object", "description": "section form: still-air and "
                                           "step-1 mean reactions [N] in the global frame (x along the first span, "
                                           "y to its left, z down); the tower's reactions are in its own frame, "

@@ -59,6 +59,8 @@ from scipy.linalg import solve_banded
 
 from linecheck.core.system import LineSystem
 
+from .truss import truss_internal, truss_state
+
 _BAND = 5  # half band width in dofs: node k couples with node k+1 only
 
 
@@ -185,23 +187,12 @@ class _Model:
     # ------------------------------------------------------------------ element state
     def element_state(self, U: np.ndarray):
         """Axial forces [N] (n_elem,), unit vectors (n_elem, 3), lengths [m] (n_elem,)."""
-        Un = U.reshape(-1, 3)
-        dU = Un[self.b] - Un[self.a]
-        D = self.dX0 + dU
-        ell = np.sqrt(np.einsum("ij,ij->i", D, D))
-        # l - l0 without cancellation: (l^2 - l0^2)/(l + l0), l^2 - l0^2 = c0 + 2 dX0.dU + dU.dU
-        dl = (self.c0 + 2.0 * np.einsum("ij,ij->i", self.dX0, dU) + np.einsum("ij,ij->i", dU, dU)) / (ell + self.l0)
-        N = self.EA * dl / self.l0
-        return N, D / ell[:, None], ell
+        return truss_state(U.reshape(-1, 3), self.a, self.b, self.dX0, self.c0, self.l0, self.EA)
 
     def internal_force(self, U: np.ndarray) -> np.ndarray:
         """Internal nodal forces f_int [N], shape (3 nn,): node a gets -N e, node b +N e."""
         N, e, _ = self.element_state(U)
-        Ne = N[:, None] * e
-        f = np.zeros((self.nn, 3))
-        np.add.at(f, self.b, Ne)
-        np.add.at(f, self.a, -Ne)
-        return f.reshape(-1)
+        return truss_internal(N, e, self.a, self.b, self.nn)
 
     def tangent_banded(self, U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """f_int and the consistent tangent in LAPACK band storage (2*5+1, 3 nc)."""

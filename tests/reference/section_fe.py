@@ -57,6 +57,7 @@ from scipy.linalg import eigh
 from scipy.sparse.linalg import spsolve
 
 from . import irvine_inclined
+from .truss import truss_internal, truss_state
 
 GRAVITY = 9.81  # [m/s2] paper Eq. 8
 
@@ -290,21 +291,12 @@ class _Model:
         """Axial forces [N], unit vectors, current lengths [m] of all elements at displacements
         U (nn, 3) from X0.  Total Lagrangian in U so that round-off does not grow with the
         absolute coordinates: l - l0 = (c0 + 2 dX0.dU + dU.dU) / (l + l0), c0 = |dX0|^2 - l0^2."""
-        dU = U[self.b] - U[self.a]
-        D = self.dX0 + dU
-        ell = np.sqrt(np.einsum("ij,ij->i", D, D))
-        dl = (self.c0 + 2.0 * np.einsum("ij,ij->i", self.dX0, dU) + np.einsum("ij,ij->i", dU, dU)) / (ell + self.l0)
-        N = self.EA * dl / self.l0
-        return N, D / ell[:, None], ell
+        return truss_state(U, self.a, self.b, self.dX0, self.c0, self.l0, self.EA)
 
     def internal(self, U: np.ndarray) -> np.ndarray:
         """Internal nodal forces [N], (3 nn,): node a gets -N e, node b +N e."""
         N, e, _ = self.state(U)
-        Ne = N[:, None] * e
-        f = np.zeros((self.nn, 3))
-        np.add.at(f, self.b, Ne)
-        np.add.at(f, self.a, -Ne)
-        return f.reshape(-1)
+        return truss_internal(N, e, self.a, self.b, self.nn)
 
     def tangent(self, U: np.ndarray) -> sp.csc_matrix:
         """Consistent tangent on the free dofs (Crisfield 1991 Vol. 1 ch. 3)."""

@@ -34,6 +34,20 @@ CSV_COLUMNS = (
 )
 
 
+def _point_p_block(case: Any, s: Any) -> dict[str, Any]:
+    """JSON of point p: x (the equal-span form's abscissa; a section's station-like coordinate),
+    the nearest node; on a section (issue 17) also that node's plan position and height in the
+    global frame (x along the first span, y to its left)."""
+    block: dict[str, Any] = {"x": _f(s.point_p), "node": s.node + 1, "node_x": _f(s.node_x)}
+    if case.line.is_section:
+        from ..core.system import LineSystem
+
+        system = LineSystem(case.line)
+        xyz = system.node_xyz0[s.node]
+        block.update(node_xy=[_f(xyz[0]), _f(xyz[1])], node_height=_f(system.node_height[s.node]))
+    return block
+
+
 def series_csv(s: PointSeries) -> str:
     """CSV text of the series: one row per instant, SI units (columns in :data:`CSV_COLUMNS`)."""
     cols = np.column_stack([
@@ -62,7 +76,7 @@ def series_summary(case: Case, s: PointSeries) -> dict[str, Any]:
         "units": "SI",
         "realization": s.realization + 1,
         "seed": case.analysis.seed,
-        "point_p": {"x": _f(s.point_p), "node": s.node + 1, "node_x": _f(s.node_x)},
+        "point_p": _point_p_block(case, s),
         "v_ref": _f(s.v_ref),
         "turbulence_intensity": _f(s.intensity),
         "length_scale": _f(s.length_scale),

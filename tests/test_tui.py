@@ -764,3 +764,39 @@ async def test_section_invalid_tower_cell_shows_the_cli_message(section_case: Pa
         await pilot.press("escape")
         await pilot.pause()
         assert app.case is before
+
+
+async def test_section_towers_added_and_removed(section_case: Path) -> None:
+    """+ adds a suspension tower midway (station, ground, height interpolated), - removes the
+    highlighted one; the tower of interest keeps pointing at the same tower; removing an end
+    tower that would leave a suspension end is refused with the loader's one-line message."""
+    messages = Recorder()
+    app = LinecheckApp([section_case])
+    async with app.run_test(size=SIZE, message_hook=messages.append) as pilot:
+        await wait_for(pilot, lambda: app.case is not None, "the case", messages)
+        original = app.case
+        await pilot.press("2")
+        table = app.query_one("#towers-table", DataTable)
+        table.focus()
+        table.cursor_coordinate = (1, 0)  # T2 (station 310, ground 128.5, height 36) -> T3 (655, 141, 33)
+        await pilot.press("plus")
+        await wait_for(pilot, lambda: app.case.line.spans == 13, "the added tower", messages)
+        added = app.case.line.towers[2]
+        assert (added.name, added.station, added.ground, added.height, added.support) == \
+            ("T2a", 482.5, 134.75, 34.5, "suspension")
+        assert app.case.line.tower_of_interest == 8 and app.case.line.towers[7].name == "T7"
+        assert table.row_count == 14 and of_type(messages, msg.ParameterChanged)[-1].key == "line.towers"
+        assert app.edited
+        # remove it again: the original table (inline now) and tower of interest
+        table.cursor_coordinate = (2, 0)
+        await pilot.press("minus")
+        await wait_for(pilot, lambda: app.case.line.spans == 12, "the removed tower", messages)
+        assert app.case.line.towers == original.line.towers and app.case.line.tower_of_interest == 7
+        # removing the first tower would make T2 (suspension) an end: refused, nothing changes
+        before = app.case
+        table.cursor_coordinate = (0, 0)
+        await pilot.press("minus")
+        await wait_for(pilot, lambda: of_type(messages, msg.ParameterRejected), "the refusal", messages)
+        rejected = of_type(messages, msg.ParameterRejected)[-1]
+        assert "line.towers[1].support" in rejected.message and "end tower" in rejected.message
+        assert "\n" not in rejected.message and app.case is before

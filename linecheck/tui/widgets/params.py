@@ -5,7 +5,8 @@ Every row comes from :data:`linecheck.core.case.SCHEMA`; a new value is checked 
 messages as the CLI's case loader.
 
 A section case (issue 17) also shows its tower table (one row per tower, a cell per
-[[line.towers]] key and the derived span to the next tower); ``enter``/``e`` on a cell edits it:
+[[line.towers]] key and the derived span to the next tower); ``+``/``insert`` adds a tower after
+the highlighted one, ``-``/``delete`` removes it; ``enter``/``e`` on a cell edits it:
 the whole table goes through :func:`linecheck.core.case.with_values` (``line.towers``, the
 case then holds its towers inline), so a bad cell gets the CLI's one-line message.
 """
@@ -41,6 +42,8 @@ class ParameterEditor(Vertical):
     BINDINGS = [
         Binding("e", "edit", "Edit"),
         Binding("escape", "stop_editing", "Cancel edit"),
+        Binding("insert,plus", "insert_tower", "Add tower"),
+        Binding("delete,minus", "delete_tower", "Remove tower"),
     ]
 
     def __init__(self, **kwargs) -> None:
@@ -175,6 +178,65 @@ class ParameterEditor(Vertical):
             return
         key = table.coordinate_to_cell_key(table.cursor_coordinate).row_key.value
         self.start_editing(key)
+
+    # ------------------------------------------------------------------ tower rows (issue 17)
+    def _tower_cursor(self) -> int | None:
+        """0-based tower under the cursor of a focused tower table, else None."""
+        towers = self.query_one("#towers-table", DataTable)
+        if self.case is None or not self.case.line.is_section or not towers.has_focus or not towers.row_count:
+            return None
+        return int(towers.cursor_coordinate.row)
+
+    def action_insert_tower(self) -> None:
+        """Add a suspension tower midway between the highlighted tower and the next (before the
+        last tower when the last is highlighted): station, ground and height interpolated."""
+        k = self._tower_cursor()
+        if k is None:
+            return
+        rows = tower_dicts(self.case)
+        a = min(k, len(rows) - 2)  # insert between a and a + 1
+        lo, hi = rows[a], rows[a + 1]
+        new = {"name": f"{lo.get('name', f'T{a + 1}')}a", "support": "suspension"}
+        for col in ("station", "ground", "height"):
+            new[col] = 0.5 * (float(lo.get(col, 0.0)) + float(hi.get(col, 0.0)))
+        rows.insert(a + 1, new)
+        toi = self.case.line.tower_of_interest
+        self._apply_towers(rows, toi + 1 if a + 1 < toi else toi, f"added {new['name']} at {new['station']:g} m")
+
+    def action_delete_tower(self) -> None:
+        """Remove the highlighted tower (the loader's checks apply: e.g. a new end tower must be
+        a strain tower without angle)."""
+        k = self._tower_cursor()
+        if k is None:
+            return
+        rows = tower_dicts(self.case)
+        if len(rows) <= 2:
+            self.notify("a section needs at least two towers", severity="warning", timeout=4)
+            return
+        gone = rows.pop(k)
+        toi = self.case.line.tower_of_interest
+        if k < toi - 1:
+            toi -= 1
+        toi = min(toi, len(rows))
+        self._apply_towers(rows, toi, f"removed {gone.get('name', f'T{k + 1}')}")
+
+    def _apply_towers(self, rows: list[dict[str, Any]], toi: int, what: str) -> None:
+        """Validate a new tower table (CaseError: the CLI's one-line message, nothing changes)."""
+        try:
+            new = with_values(self.case, {"line.towers_file": None, "line.towers": rows, "line.tower_of_interest": toi})
+        except CaseError as err:
+            self.post_message(ParameterRejected("line.towers", what, str(err)))
+            self.notify(str(err), severity="error", timeout=8)
+            self.app.bell()
+            return
+        self.case = new
+        table = self.query_one("#params-table", DataTable)
+        for key, spec in fields_for(new.wind.type, new.line.is_section):
+            for col, c in zip(COLUMNS, self._cells(key, spec)):
+                table.update_cell(key, col or "mark", c)
+        self._show_towers()
+        self._update_title()
+        self.post_message(ParameterChanged(new, "line.towers", what))
 
     @on(DataTable.RowSelected, "#params-table")
     def _row_selected(self, event: DataTable.RowSelected) -> None:

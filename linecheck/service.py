@@ -21,7 +21,7 @@ from .core.case import Case
 from .core.damping import aerodynamic_damping, stiffness_proportional
 from .core.dynamics import DynamicResponse, integrate
 from .core.errors import Cancelled
-from .core.model import build_model
+from .core.model import build_model, build_models
 from .core.results import Statistics, compute_statistics
 from .core.static import MeanStates, drag_intensity, solve_mean_states
 from .core.system import LineSystem
@@ -496,7 +496,7 @@ def run_case(
             raise Cancelled("run cancelled")
 
     # ---- linear models at the mean states (paper Eqs 7-9, 13)
-    models = [build_model(system, mean.state(k)) for k in range(mean.time.size)]
+    models = build_models(system, [mean.state(k) for k in range(mean.time.size)])  # one vectorised pass
     vn_states = to_global_nodes(system, st.wind.normal)  # (n_k, n_nodes)
     damping = damping_matrices(case, st, models)
     # complex modes with eigenvectors: the burn-in tells significant modes apart with them

@@ -25,6 +25,7 @@ directly at pinned nodes: R = G u + D f_pinned.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from collections.abc import Sequence
 from functools import cached_property
 
 import numpy as np
@@ -140,13 +141,20 @@ def band_to_sparse(ab: np.ndarray):
 
 
 def _cable_blocks(nodes: np.ndarray, tension: np.ndarray, ea: float) -> np.ndarray:
-    """3x3 element stiffness blocks k = EA/L e e^T + T/L (I - e e^T) (paper Eq. 7), shape (n_el, 3, 3)."""
-    seg = np.diff(nodes, axis=0)
-    Le = np.linalg.norm(seg, axis=1)
-    e = seg / Le[:, None]
-    eet = e[:, :, None] * e[:, None, :]
-    eye = np.eye(3)[None]
-    return (ea / Le)[:, None, None] * eet + (tension / Le)[:, None, None] * (eye - eet)
+    """3x3 element stiffness blocks k = EA/L e e^T + T/L (I - e e^T) (paper Eq. 7).
+
+    Args:
+        nodes: [m] node coordinates, shape (..., n_nodes, 3) (leading axes: mean states).
+        tension: [N] element tensions, shape (..., n_el).
+
+    Returns: [N/m] shape (..., n_el, 3, 3).
+    """
+    seg = np.diff(nodes, axis=-2)
+    Le = np.linalg.norm(seg, axis=-1)
+    e = seg / Le[..., None]
+    eet = e[..., :, None] * e[..., None, :]
+    eye = np.eye(3)
+    return (ea / Le)[..., None, None] * eet + (tension / Le)[..., None, None] * (eye - eet)
 
 
 def build_model(system: LineSystem, state: StaticState) -> LinearModel:
@@ -233,6 +241,100 @@ def build_model(system: LineSystem, state: StaticState) -> LinearModel:
                     G[3 * j:3 * j + 3, c:c + 3] += flip[:, None] * kb[e]
     return LinearModel(system, dm, ab, mass, trib, G, np.array(axes).reshape(-1, 3),
                        np.array(axial_dof, dtype=int), K_axial)
+
+
+def build_models(system: LineSystem, states: Sequence[StaticState]) -> list[LinearModel]:
+    """:func:`build_model` for many mean states of one system in one vectorised pass.
+
+    The element blocks (paper Eq. 7) of all states are computed as one stacked array
+    (n_k, n_el, 3, 3) and scattered into a stacked band (n_k, BANDWIDTH + 1, n_dof) with a
+    leading state axis; the insulator blocks of all states and towers are batched the same
+    way.  Every floating-point operation is the one :func:`build_model` does, in the same
+    order, so each model is bit-identical to building it alone (tests/test_build_models.py).
+    What does not depend on the state (DOF map, lumped mass, tributary lengths, axial DOFs)
+    is computed once and shared, read-only, by all models.  Each model keeps its own dense
+    reaction map G, as :func:`build_model` does (memory n_k x 3 n_towers x n_dof).
+
+    Args:
+        system: the line section.
+        states: the mean states, length n_k.
+
+    Returns: the linear models, ``[build_model(system, s) for s in states]``.
+    """
+    states = list(states)
+    if not states:
+        return []
+    line = system.line
+    dm = dof_map(system)
+    n_dof = dm.n_dof
+    n_k = len(states)
+    nodes = np.stack([s.nodes for s in states])  # (n_k, n_nodes, 3)
+    tension = np.stack([s.element_tension for s in states])  # (n_k, n_el)
+    kb = _cable_blocks(nodes, tension, line.ea)  # (n_k, n_el, 3, 3)
+    n_el = kb.shape[1]
+    u = BANDWIDTH
+    nd = dm.node_dof
+    ia, ib = np.triu_indices(3)
+    ab = np.zeros((n_k, BANDWIDTH + 1, n_dof))
+    diag_rows = (u + ia - ib)[None, :]  # upper triangle of a diagonal 3x3 block
+    # no DOF repeats within one scatter, so a fancy-indexed += adds exactly as np.add.at
+    left, right = nd[:-1], nd[1:]
+    for ends, mask in ((left, left >= 0), (right, right >= 0)):  # same order as build_model
+        ab[:, diag_rows, ends[mask][:, None] + ib[None, :]] += kb[:, mask][:, :, ia, ib]
+    both = (left >= 0) & (right >= 0)  # element between two free nodes: -k off the diagonal
+    a, b = np.meshgrid(np.arange(3), np.arange(3), indexing="ij")
+    rows = (u + a - 3 - b).ravel()[None, :]  # right node = left + 3
+    cols = right[both][:, None] + b.ravel()[None, :]
+    ab[:, rows, cols] += -kb[:, both].reshape(n_k, -1, 9)
+
+    # insulators (issue 4): axially stiff, geometric stiffness R_res/v transversely
+    susp = np.flatnonzero(system.suspension)
+    v = system.insulator_lengths[susp]  # (n_s,)
+    ea_cable_el = line.ea / float(system.element_unstretched_lengths.min())
+    k_ax = INSULATOR_AXIAL_FACTOR * ea_cable_el
+    d = np.stack([s.displacement for s in states])[:, susp]  # (n_k, n_s, 3)
+    axes = np.stack([d[..., 0], d[..., 1], d[..., 2] - v], axis=-1) / v[:, None]  # fixed point -> attachment
+    # |axis| by the dot product np.linalg.norm uses for one vector (bit-identical to build_model)
+    flat = axes.reshape(-1, 3)
+    axes /= np.sqrt(np.array([x.dot(x) for x in flat])).reshape(n_k, susp.size, 1)
+    P = axes[..., :, None] * axes[..., None, :]  # (n_k, n_s, 3, 3)
+    fins = np.stack([s.insulator_force for s in states])[:, susp]  # (n_k, n_s)
+    ins_blocks = k_ax * P + (fins / v)[..., None, None] * (np.eye(3) - P)
+    r = nd[system.tower_nodes[susp]]  # first DOF of every attachment node
+    ins_cols = r[:, None] + ib[None, :]
+    ab[:, diag_rows, ins_cols] += ins_blocks[:, :, ia, ib]
+    K_axial = np.zeros_like(ab)
+    K_axial[:, diag_rows, ins_cols] += (k_ax * P)[:, :, ia, ib]
+
+    # lumped mass (paper Eq. 8) by tributary unstretched length: state-independent
+    Le_u = system.element_unstretched_lengths
+    trib = np.zeros(system.n_nodes)
+    trib[:-1] += 0.5 * Le_u
+    trib[1:] += 0.5 * Le_u
+    m_node = line.weight * trib / GRAVITY
+    mass = np.repeat(m_node[dm.free_nodes], 3)
+
+    # reaction map: suspension towers k_ins u_node, strain towers -(K_rf u) (as build_model)
+    flip = np.array([1.0, 1.0, -1.0])[:, None]  # R_z is positive downward
+    G = np.zeros((n_k, 3 * system.n_towers, n_dof))
+    i3 = np.arange(3)
+    G[:, (3 * susp)[:, None, None] + i3[:, None], (r[:, None, None] + i3)] = flip * ins_blocks
+    strain_rows, strain_cols, strain_el = [], [], []
+    for j in np.flatnonzero(~system.suspension):
+        node = system.tower_nodes[j]
+        for e, other in ((node - 1, node - 1), (node, node + 1)):
+            if 0 <= e < n_el and nd[other] >= 0:
+                strain_rows.append(3 * j)
+                strain_cols.append(nd[other])
+                strain_el.append(e)
+    if strain_el:
+        rr = np.array(strain_rows)[:, None, None] + i3[:, None]
+        cc = np.array(strain_cols)[:, None, None] + i3
+        G[:, rr, cc] += flip * kb[:, strain_el]
+    axial_dof = np.array(r, dtype=int)
+    for x in (dm.free_nodes, dm.node_dof, mass, trib, axial_dof):
+        x.flags.writeable = False  # shared by all the models
+    return [LinearModel(system, dm, ab[k], mass, trib, G[k], axes[k], axial_dof, K_axial[k]) for k in range(n_k)]
 
 
 def project_axial(model: LinearModel, ab: np.ndarray) -> np.ndarray:

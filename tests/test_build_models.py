@@ -75,3 +75,52 @@ def test_build_models_shares_only_state_independent_arrays(downburst_six):
     assert many[0].mass is many[1].mass and not many[0].mass.flags.writeable
     assert not np.shares_memory(many[0].G, many[1].G)
     assert build_models(st.system, []) == []
+
+
+def stepper_fields_identical(a, b) -> bool:
+    fields = ("T", "chat", "dm", "cu", "cv", "ycoef", "axial", "nz", "GT")
+    if not all(same_bits(getattr(a, f), getattr(b, f)) for f in fields) or (a.rest is None) != (b.rest is None):
+        return False
+    if a.rest is None:
+        return True
+    return same_bits(a.rest.indptr, b.rest.indptr) and same_bits(a.rest.indices, b.rest.indices) and \
+        same_bits(a.rest.data, b.rest.data)
+
+
+@pytest.mark.parametrize("which,damping,zeta", [
+    ("downburst_six", "paper", 0.0),  # the paper's case: transverse damping only
+    ("downburst_six", "quasi-steady", 0.005),  # full 3x3 node blocks and a structural remainder
+    ("section_states", "paper", 0.0),  # oblique node normals and insulator axes
+    ("section_states", "quasi-steady", 0.002),
+])
+def test_damping_and_steppers_stacked_bit_identical(which, damping, zeta, request):
+    """Step 2 of issue 20: damping matrices, node bases (batched eigh), rotated bands and the
+    Newmark operators of all states at once equal those built state by state, bit for bit."""
+    import dataclasses
+
+    from linecheck.core.damping import (aerodynamic_damping, aerodynamic_damping_stack, stiffness_proportional,
+                                        stiffness_proportional_stack)
+    from linecheck.core.dynamics import Newmark, _rotated_stack, _Stepper
+
+    case, st, states = request.getfixturevalue(which)
+    case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, damping=damping,
+                                                                  structural_damping=zeta))
+    models = build_models(st.system, states)
+    vn_all = service.to_global_nodes(st.system, st.wind.normal)
+    vn0 = vn_all[np.argmax(np.abs(vn_all).sum(axis=1))]  # the strongest mean wind of the case
+    vn = np.stack([(0.5 + 0.1 * k) * vn0 for k in range(len(states))])  # a different wind per state
+    nodes = np.stack([s.nodes for s in states])
+    w1 = 2.5  # [rad/s] any calibration frequency: the same one on both sides
+    one = np.stack([aerodynamic_damping(case, m, vn[k], nodes[k]) for k, m in enumerate(models)])
+    many = aerodynamic_damping_stack(case, models, vn, nodes)
+    if zeta > 0:
+        one = one + np.stack([stiffness_proportional(m, zeta, w1) for m in models])
+        many = many + stiffness_proportional_stack(models, zeta, w1)
+    assert same_bits(one, many)
+    assert not np.array_equal(one[0], one[-1])
+    nm = Newmark(case.analysis.time_step)
+    T, Kr, Cr = _rotated_stack(models, many)
+    for k, m in enumerate(models):
+        ref = _Stepper.build(m, one[k], nm)
+        assert stepper_fields_identical(ref, _Stepper.from_bases(m, T[k], Kr[k], Cr[k], nm)), f"state {k}"
+        assert (ref.rest is not None) == (zeta > 0)

@@ -357,6 +357,28 @@ def project_axial(model: LinearModel, ab: np.ndarray) -> np.ndarray:
     return blocks_to_band(D, E, ab.shape[0] - 1)
 
 
+def project_axial_stack(axial_dof: np.ndarray, axes: np.ndarray, ab: np.ndarray) -> np.ndarray:
+    """:func:`project_axial` for a stack of band matrices of one system, vectorised over the
+    stack (the mean states of :func:`build_models`); bit-identical to one at a time.
+
+    Args:
+        axial_dof: first DOF of every suspension attachment node, shape (n_s,) (shared).
+        axes: [-] unit insulator axes of every matrix, shape (n_k, n_s, 3).
+        ab: upper band storage, shape (n_k, BANDWIDTH + 1, n_dof).
+    """
+    if axial_dof.size == 0:
+        return ab.copy()
+    D, E = band_blocks(ab)
+    k = axial_dof // 3
+    P = np.eye(3) - axes[..., :, None] * axes[..., None, :]  # (n_k, n_s, 3, 3)
+    D[:, k] = P @ D[:, k] @ P
+    left = k > 0
+    E[:, k[left] - 1] = E[:, k[left] - 1] @ P[:, left]
+    right = k < D.shape[1] - 1
+    E[:, k[right]] = P[:, right] @ E[:, k[right]]
+    return blocks_to_band(D, E, ab.shape[-2] - 1)
+
+
 @dataclass(frozen=True)
 class Condensed:
     """The model with the insulator-axial directions condensed out (exact for massless,
@@ -425,31 +447,34 @@ def band_blocks(ab: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
     With three DOFs per node and two-node elements the band is exactly block tridiagonal.
 
+    ``ab`` may carry leading axes (a stack of matrices, e.g. one per mean state), shape
+    (..., BANDWIDTH + 1, n_dof); the blocks then carry the same leading axes.
+
     Returns:
-        D: diagonal blocks A[node i, node i], shape (n_nodes, 3, 3);
-        E: coupling blocks A[node i, node i+1], shape (n_nodes - 1, 3, 3).
+        D: diagonal blocks A[node i, node i], shape (..., n_nodes, 3, 3);
+        E: coupling blocks A[node i, node i+1], shape (..., n_nodes - 1, 3, 3).
     """
-    u = ab.shape[0] - 1
-    n_nodes = ab.shape[1] // 3
+    u = ab.shape[-2] - 1
+    n_nodes = ab.shape[-1] // 3
     a = np.arange(3)[:, None]
     b = np.arange(3)[None, :]
     first = 3 * np.arange(n_nodes)[:, None, None]
     lo, hi = np.minimum(a, b), np.maximum(a, b)
-    D = ab[u + lo - hi, first + hi]  # A[3i+lo, 3i+hi] (upper triangle, symmetric)
-    E = ab[u - 3 + a - b, first[:-1] + 3 + b]  # A[3i+a, 3i+3+b]
+    D = ab[..., u + lo - hi, first + hi]  # A[3i+lo, 3i+hi] (upper triangle, symmetric)
+    E = ab[..., u - 3 + a - b, first[:-1] + 3 + b]  # A[3i+a, 3i+3+b]
     return D, E
 
 
 def blocks_to_band(D: np.ndarray, E: np.ndarray, u: int = BANDWIDTH) -> np.ndarray:
-    """Inverse of :func:`band_blocks` (upper band storage, shape (u + 1, 3 n_nodes))."""
-    n_nodes = D.shape[0]
-    ab = np.zeros((u + 1, 3 * n_nodes))
+    """Inverse of :func:`band_blocks` (upper band storage, shape (..., u + 1, 3 n_nodes))."""
+    n_nodes = D.shape[-3]
+    ab = np.zeros(D.shape[:-3] + (u + 1, 3 * n_nodes))
     first = 3 * np.arange(n_nodes)
     for a in range(3):
         for b in range(3):
             if b >= a:
-                ab[u + a - b, first + b] = D[:, a, b]
-            ab[u - 3 + a - b, first[:-1] + 3 + b] = E[:, a, b]
+                ab[..., u + a - b, first + b] = D[..., a, b]
+            ab[..., u - 3 + a - b, first[:-1] + 3 + b] = E[..., a, b]
     return ab
 
 
@@ -457,12 +482,16 @@ def rotate_band(ab: np.ndarray, T: np.ndarray) -> np.ndarray:
     """T^T A T for a node-major symmetric band matrix and a block-diagonal rotation.
 
     Args:
-        ab: upper band storage, shape (BANDWIDTH + 1, 3 n_nodes).
+        ab: upper band storage, shape (..., BANDWIDTH + 1, 3 n_nodes) (leading axes: a stack
+            of matrices, e.g. the mean states, each rotated by its own bases).
         T: [-] per-node orthonormal bases (columns: local axes in global coordinates),
-            shape (n_nodes, 3, 3).
+            shape (..., n_nodes, 3, 3).
+
+    Every 3x3 product is the same (BLAS) product whatever the leading axes, so a stack gives
+    bit for bit the matrices rotated one at a time (tests/test_build_models.py).
     """
     D, E = band_blocks(ab)
-    Tt = T.transpose(0, 2, 1)
+    Tt = np.swapaxes(T, -1, -2)
     Dr = Tt @ D @ T
-    Er = Tt[:-1] @ E @ T[1:]
-    return blocks_to_band(0.5 * (Dr + Dr.transpose(0, 2, 1)), Er, ab.shape[0] - 1)
+    Er = Tt[..., :-1, :, :] @ E @ T[..., 1:, :, :]
+    return blocks_to_band(0.5 * (Dr + np.swapaxes(Dr, -1, -2)), Er, ab.shape[-2] - 1)

@@ -15,7 +15,10 @@ across the n_k mean states against the one-state-at-a-time code they replace:
   functions patched back in (before) vs as shipped (after).
 
 Both sides give bit-identical results (tests/test_build_models.py); the script checks the
-realization's reactions are equal.
+realization's reactions are equal.  With ``--baseline REV`` (default: fe644a7, the last
+commit before this work) the package as it was at REV is also extracted (``git archive``)
+and imported under another name, and its ``run_case`` is timed in the same loop: the
+speed-up of the whole realization over the code before issue 20, whatever else changed.
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ def main() -> None:
     ap.add_argument("--case", default="cases/paper/case05-six.toml")
     ap.add_argument("--repeat", type=int, default=5, help="interleaved runs per variant (best is reported)")
     ap.add_argument("--threads", type=int, default=1, help="BLAS threads")
+    ap.add_argument("--baseline", default="fe644a7", help="git revision timed as the baseline ('' = none)")
     args = ap.parse_args()
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ[var] = str(args.threads)
@@ -108,12 +112,38 @@ def main() -> None:
     def run_after():
         return service.run_case(case, realizations=[0])
 
+    base_run = None
+    if args.baseline:
+        import importlib
+        import io
+        import subprocess
+        import tarfile
+        import tempfile
+
+        import atexit
+        import shutil
+
+        tmp = Path(tempfile.mkdtemp(prefix="lc-baseline-"))
+        atexit.register(shutil.rmtree, tmp, True)
+        tar = subprocess.run(["git", "-C", str(root), "archive", args.baseline, "linecheck"],
+                             capture_output=True, check=True).stdout
+        tarfile.open(fileobj=io.BytesIO(tar)).extractall(tmp, filter="data")
+        (tmp / "linecheck").rename(tmp / "linecheck_baseline")  # its imports are relative
+        sys.path.insert(0, str(tmp))
+        base_service = importlib.import_module("linecheck_baseline.service")
+        base_case = importlib.import_module("linecheck_baseline.core.case").load_case(root / args.case)
+
+        def base_run():
+            return base_service.run_case(base_case, realizations=[0])
+
     phases = [
         ("models (build_model x n_k)", models_before, lambda: build_models(system, states)),
         ("damping matrices", damping_before, lambda: service.damping_matrices(case, st, models)),
         ("steppers (bases, rotations, dpbtrf)", steppers_before, steppers_after),
         ("one realization (run_case)", run_before, run_after),
     ]
+    if base_run is not None:
+        phases.append((f"one realization, code at {args.baseline}", base_run, run_after))
     best = {name: [float("inf"), float("inf")] for name, _, _ in phases}
     out = {}
     for _ in range(args.repeat):
@@ -124,13 +154,16 @@ def main() -> None:
                 best[name][i] = min(best[name][i], time.perf_counter() - t0)
     r0, r1 = out["one realization (run_case)", 0], out["one realization (run_case)", 1]
     identical = all(np.array_equal(getattr(r0, f), getattr(r1, f)) for f in ("mean", "background", "resonant"))
+    if base_run is not None:
+        rb = out[phases[-1][0], 0]
+        identical &= all(np.array_equal(getattr(rb, f), getattr(r1, f)) for f in ("mean", "background", "resonant"))
     print(f"{case.name}: {mean.time.size} mean states, {system.n_spans} spans, "
           f"{models[0].dofs.n_dof} DOFs, best of {args.repeat}, {args.threads} BLAS thread(s)")
     print(f"{'phase':<40}{'before s':>10}{'after s':>10}{'speed-up':>10}")
     for name, _, _ in phases:
         b, a = best[name]
         print(f"{name:<40}{b:10.3f}{a:10.3f}{b / a:10.2f}")
-    print(f"realization reactions bit-identical before/after: {identical}")
+    print(f"realization reactions bit-identical before/after{' and to the baseline' if base_run else ''}: {identical}")
 
 
 if __name__ == "__main__":

@@ -124,3 +124,12 @@ def test_damping_and_steppers_stacked_bit_identical(which, damping, zeta, reques
         ref = _Stepper.build(m, one[k], nm)
         assert stepper_fields_identical(ref, _Stepper.from_bases(m, T[k], Kr[k], Cr[k], nm)), f"state {k}"
         assert (ref.rest is not None) == (zeta > 0)
+
+
+def test_build_models_without_suspension_towers():
+    """A single span (two strain towers): no insulator blocks, G from the cable elements only."""
+    case = load_case(CASES / "paper" / "case05-single.toml")
+    st = service.static_analysis(case)
+    states = [st.mean.state(k) for k in range(0, st.mean.time.size, 10)]
+    assert not st.system.suspension.any()
+    assert_models_identical([build_model(st.system, s) for s in states], build_models(st.system, states))

@@ -253,7 +253,8 @@ def build_models(system: LineSystem, states: Sequence[StaticState]) -> list[Line
     order, so each model is bit-identical to building it alone (tests/test_build_models.py).
     What does not depend on the state (DOF map, lumped mass, tributary lengths, axial DOFs)
     is computed once and shared, read-only, by all models.  Each model keeps its own dense
-    reaction map G, as :func:`build_model` does (memory n_k x 3 n_towers x n_dof).
+    reaction map G, as :func:`build_model` does (allocated state by state; 3 n_towers x n_dof
+    each, the dominant memory of a long section's downburst models).
 
     Args:
         system: the line section.
@@ -316,9 +317,9 @@ def build_models(system: LineSystem, states: Sequence[StaticState]) -> list[Line
 
     # reaction map: suspension towers k_ins u_node, strain towers -(K_rf u) (as build_model)
     flip = np.array([1.0, 1.0, -1.0])[:, None]  # R_z is positive downward
-    G = np.zeros((n_k, 3 * system.n_towers, n_dof))
     i3 = np.arange(3)
-    G[:, (3 * susp)[:, None, None] + i3[:, None], (r[:, None, None] + i3)] = flip * ins_blocks
+    susp_rows, susp_cols = (3 * susp)[:, None, None] + i3[:, None], r[:, None, None] + i3
+    susp_vals = flip * ins_blocks  # (n_k, n_s, 3, 3)
     strain_rows, strain_cols, strain_el = [], [], []
     for j in np.flatnonzero(~system.suspension):
         node = system.tower_nodes[j]
@@ -327,10 +328,15 @@ def build_models(system: LineSystem, states: Sequence[StaticState]) -> list[Line
                 strain_rows.append(3 * j)
                 strain_cols.append(nd[other])
                 strain_el.append(e)
-    if strain_el:
-        rr = np.array(strain_rows)[:, None, None] + i3[:, None]
-        cc = np.array(strain_cols)[:, None, None] + i3
-        G[:, rr, cc] += flip * kb[:, strain_el]
+    rr = np.array(strain_rows, dtype=int)[:, None, None] + i3[:, None]
+    cc = np.array(strain_cols, dtype=int)[:, None, None] + i3
+    strain_vals = flip * kb[:, strain_el]  # (n_k, n_blocks, 3, 3)
+    G = []  # one dense map per state, allocated state by state (no (n_k, 3 n_towers, n_dof) stack)
+    for k in range(n_k):
+        Gk = np.zeros((3 * system.n_towers, n_dof))
+        Gk[susp_rows, susp_cols] = susp_vals[k]
+        Gk[rr, cc] += strain_vals[k]
+        G.append(Gk)
     axial_dof = np.array(r, dtype=int)
     for x in (dm.free_nodes, dm.node_dof, mass, trib, axial_dof):
         x.flags.writeable = False  # shared by all the models

@@ -18,10 +18,11 @@ import numpy as np
 
 from .core import budget
 from .core.case import Case
-from .core.damping import aerodynamic_damping, stiffness_proportional
+from .core.damping import (aerodynamic_damping, aerodynamic_damping_stack, stiffness_proportional,
+                           stiffness_proportional_stack)
 from .core.dynamics import DynamicResponse, integrate
 from .core.errors import Cancelled
-from .core.model import build_model
+from .core.model import build_model, build_models
 from .core.results import Statistics, compute_statistics
 from .core.static import MeanStates, drag_intensity, solve_mean_states
 from .core.system import LineSystem
@@ -230,13 +231,13 @@ def damping_matrices(case: Case, st: StaticResult, models: list, states: list[in
     system, mean = st.system, st.mean
     states = list(range(len(models))) if states is None else list(states)
     vn = to_global_nodes(system, st.wind.normal)  # (n_k, n_nodes)
-    C = np.stack([aerodynamic_damping(case, m, vn[k], mean.nodes[k]) for m, k in zip(models, states)])
+    C = aerodynamic_damping_stack(case, models, vn[states], mean.nodes[states])  # all states in one pass
     zs = case.analysis.structural_ratio
     if zs > 0:
         k_ref = reference_state_index(case, mean)
         ref = models[states.index(k_ref)] if k_ref in states else build_model(system, mean.state(k_ref))
         w1 = 2 * np.pi * float(natural_modes(ref, 1).frequencies_hz[0])
-        C = C + np.stack([stiffness_proportional(m, zs, w1) for m in models])
+        C = C + stiffness_proportional_stack(models, zs, w1)
     return C
 
 
@@ -496,7 +497,7 @@ def run_case(
             raise Cancelled("run cancelled")
 
     # ---- linear models at the mean states (paper Eqs 7-9, 13)
-    models = [build_model(system, mean.state(k)) for k in range(mean.time.size)]
+    models = build_models(system, [mean.state(k) for k in range(mean.time.size)])  # one vectorised pass
     vn_states = to_global_nodes(system, st.wind.normal)  # (n_k, n_nodes)
     damping = damping_matrices(case, st, models)
     # complex modes with eigenvectors: the burn-in tells significant modes apart with them

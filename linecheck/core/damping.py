@@ -34,25 +34,26 @@ from __future__ import annotations
 import numpy as np
 
 from .case import Case
-from .model import BANDWIDTH, LinearModel, project_axial
+from .model import BANDWIDTH, LinearModel, project_axial, project_axial_stack
 
 
 def _add_node_blocks(ab: np.ndarray, first_dof: np.ndarray, blocks: np.ndarray) -> None:
     """Add symmetric 3x3 blocks on the diagonal of an upper band matrix."""
-    u = ab.shape[0] - 1
+    u = ab.shape[-2] - 1
     for a in range(3):
         for b in range(a, 3):
-            ab[u - (b - a), first_dof + b] += blocks[:, a, b]
+            ab[..., u - (b - a), first_dof + b] += blocks[..., a, b]
 
 
 def node_tangents(model: LinearModel, nodes: np.ndarray) -> np.ndarray:
-    """Unit conductor tangent at every global node (mean of the adjacent chords), (n_nodes, 3)."""
-    seg = np.diff(nodes, axis=0)
-    seg /= np.linalg.norm(seg, axis=1)[:, None]
+    """Unit conductor tangent at every global node (mean of the adjacent chords), (..., n_nodes, 3)
+    for node coordinates [m] of shape (..., n_nodes, 3) (leading axes: mean states)."""
+    seg = np.diff(nodes, axis=-2)
+    seg /= np.linalg.norm(seg, axis=-1)[..., None]
     t = np.zeros_like(nodes)
-    t[:-1] += seg
-    t[1:] += seg
-    return t / np.linalg.norm(t, axis=1)[:, None]
+    t[..., :-1, :] += seg
+    t[..., 1:, :] += seg
+    return t / np.linalg.norm(t, axis=-1)[..., None]
 
 
 def aerodynamic_damping(case: Case, model: LinearModel, vn_nodes: np.ndarray, nodes: np.ndarray | None = None) -> np.ndarray:
@@ -104,3 +105,58 @@ def stiffness_proportional(model: LinearModel, ratio: float, omega1: float) -> n
     if ratio <= 0.0:
         return np.zeros_like(model.K_band)
     return (2.0 * ratio / omega1) * project_axial(model, model.K_band - model.K_axial_band)
+
+
+def aerodynamic_damping_stack(case: Case, models: list[LinearModel], vn_nodes: np.ndarray,
+                              nodes: np.ndarray | None = None) -> np.ndarray:
+    """:func:`aerodynamic_damping` of many mean states of one system in one vectorised pass
+    (issue 20), bit-identical to calling it state by state.
+
+    Args:
+        models: the linear models of the states (one system, e.g. from
+            :func:`~linecheck.core.model.build_models`), length n_k.
+        vn_nodes: [m/s] running-mean normal speed at every global node, shape (n_k, n_nodes).
+        nodes: [m] deformed node coordinates, shape (n_k, n_nodes, 3) (``"quasi-steady"``).
+
+    Returns: [N s/m] upper band storage, shape (n_k, BANDWIDTH + 1, n_dof).
+    """
+    model = models[0]
+    line = case.line
+    coef = case.wind.air_density * line.drag_coefficient * line.diameter  # rho C_d D (Eq. 13)
+    free = model.dofs.free_nodes
+    n_k = len(models)
+    ab = np.zeros((n_k, BANDWIDTH + 1, model.dofs.n_dof))
+    c = coef * model.tributary[free] * np.abs(np.asarray(vn_nodes)[:, free])  # (n_k, n_free)
+    first = model.dofs.node_dof[free]
+    system = model.system
+    axes = np.stack([m.axes for m in models])  # (n_k, n_s, 3)
+    if case.analysis.damping == "paper":
+        if system.straight_level:
+            ab[:, BANDWIDTH, first + 1] = c  # Eq. 9: transverse DOF only
+        else:  # along each node's transverse direction b (issue 17): c b b^T
+            b = system.node_normals[free]
+            _add_node_blocks(ab, first, c[..., None, None] * b[:, :, None] * b[:, None, :])
+        return project_axial_stack(model.axial_dof, axes, ab)  # a rigid insulator carries the axial part
+    if nodes is None:
+        raise ValueError("quasi-steady damping needs the mean-state node coordinates")
+    e = node_tangents(model, np.asarray(nodes))[:, free]  # (n_k, n_free, 3)
+    P = np.eye(3) - e[..., :, None] * e[..., None, :]
+    if system.straight_level:
+        w = P[..., :, 1]  # the wind (+y) projected normal to the axis
+    else:  # the node's transverse load direction b projected normal to the axis (issue 17)
+        w = np.einsum("nab,nb->na", P.reshape(-1, 3, 3),
+                      np.tile(system.node_normals[free], (n_k, 1))).reshape(P.shape[:-1])
+    w = w / np.linalg.norm(w, axis=-1)[..., None]
+    ww = w[..., :, None] * w[..., None, :]
+    blocks = c[..., None, None] * (ww + 0.5 * (P - ww))
+    _add_node_blocks(ab, first, blocks)
+    return project_axial_stack(model.axial_dof, axes, ab)  # a rigid insulator carries the axial part
+
+
+def stiffness_proportional_stack(models: list[LinearModel], ratio: float, omega1: float) -> np.ndarray:
+    """:func:`stiffness_proportional` of many mean states in one pass, shape (n_k, BANDWIDTH + 1, n_dof)."""
+    K = np.stack([m.K_band for m in models])
+    if ratio <= 0.0:
+        return np.zeros_like(K)
+    Kc = K - np.stack([m.K_axial_band for m in models])
+    return (2.0 * ratio / omega1) * project_axial_stack(models[0].axial_dof, np.stack([m.axes for m in models]), Kc)

@@ -225,8 +225,15 @@ def integrate(
     report = max(1, n_steps // 100)
     st: _Stepper | None = None
     V = A = None
+    # bases and rotated bands of all mean states in vectorised chunks (issue 20); the
+    # reference scheme (model_at) builds one operator per step instead
+    stacked = _StackedBases(models, damping, np.asarray(state_of_step)[starts]) if model_at is None else None
     for s0, s1 in zip(starts, ends):
-        new = _Stepper.build(*model_of(int(s0)), nm, load_dirs)
+        if stacked is None:
+            new = _Stepper.build(*model_of(int(s0)), nm, load_dirs)
+        else:
+            k = int(state_of_step[s0])
+            new = _Stepper.from_bases(models[k], *stacked.get(k), nm, load_dirs)
         if st is None:
             U = st_rotate(U, None, new)
             V = np.zeros_like(U)
@@ -335,6 +342,64 @@ def node_bases(model: LinearModel, c_band: np.ndarray) -> np.ndarray:
     return T
 
 
+def node_bases_stack(models: list[LinearModel], c_bands: np.ndarray) -> np.ndarray:
+    """:func:`node_bases` of many mean states of one system in one vectorised pass (issue 20):
+    the eigen-decompositions of all states' 3x3 node blocks in one batched LAPACK call;
+    bit-identical to calling it state by state.
+
+    Args:
+        models: linear models of the states (one system: same DOF map), length n_k.
+        c_bands: [N s/m] their damping bands, shape (n_k, BANDWIDTH + 1, n_dof).
+
+    Returns: [-] bases, shape (n_k, n_nodes, 3, 3).
+    """
+    D, _ = band_blocks(c_bands)  # (n_k, n_nodes, 3, 3)
+    _, T = np.linalg.eigh(D)
+    axial_dof = models[0].axial_dof
+    if axial_dof.size:
+        n_k, n_s = len(models), axial_dof.size
+        k = axial_dof // 3
+        axes = np.stack([m.axes for m in models]).reshape(-1, 3)  # (n_k n_s, 3): as node_bases, flattened
+        a = axes / np.linalg.norm(axes, axis=1)[:, None]
+        h = np.where(np.abs(a[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+        t1 = np.cross(a, h)
+        t1 /= np.linalg.norm(t1, axis=1)[:, None]
+        t2 = np.cross(a, t1)
+        Q = np.stack([t1, t2], axis=2)  # (n_k n_s, 3, 2) orthonormal basis of the plane
+        _, W = np.linalg.eigh(np.einsum("sai,sab,sbj->sij", Q, D[:, k].reshape(-1, 3, 3), Q))
+        T[:, k] = np.concatenate([np.einsum("sai,sij->saj", Q, W), a[:, :, None]], axis=2).reshape(n_k, n_s, 3, 3)
+    return T
+
+
+def _rotated_stack(models: list[LinearModel], c_bands: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Node bases T and rotated bands T^T K T, T^T C T of many states at once, each of shape
+    (n_k, ...) (what :meth:`_Stepper.build` computes state by state; bit-identical)."""
+    T = node_bases_stack(models, c_bands)
+    return T, rotate_band(np.stack([m.K_band for m in models]), T), rotate_band(c_bands, T)
+
+
+class _StackedBases:
+    """The node bases and rotated bands of the mean states, computed in chunks of states in
+    one vectorised pass each (:func:`_rotated_stack`), in the order the steps need them;
+    only one chunk is held (memory bounded for long sections)."""
+
+    def __init__(self, models: list[LinearModel], damping: np.ndarray, order: np.ndarray) -> None:
+        self.models, self.damping = models, damping
+        self.order = list(dict.fromkeys(int(k) for k in order))  # distinct states, first use first
+        self.pos = {k: i for i, k in enumerate(self.order)}
+        n_dof = models[0].mass.size
+        self.chunk = max(1, min(len(self.order), 4_000_000 // max(30 * n_dof, 1)))  # ~32 MB of blocks
+        self.held: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+
+    def get(self, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(T, K~, C~) of mean state k."""
+        if k not in self.held:
+            ks = self.order[self.pos[k]:self.pos[k] + self.chunk]
+            T, Kr, Cr = _rotated_stack([self.models[i] for i in ks], self.damping[ks])
+            self.held = {i: (T[n], Kr[n], Cr[n]) for n, i in enumerate(ks)}
+        return self.held[k]
+
+
 @dataclass(frozen=True)
 class _Stepper:
     """One mean state's Newmark operator in the node bases of :func:`node_bases`.
@@ -361,8 +426,13 @@ class _Stepper:
     @staticmethod
     def build(model: LinearModel, c_band: np.ndarray, nm: Newmark, load_dirs: np.ndarray | None = None) -> "_Stepper":
         T = node_bases(model, c_band)
-        Kr = rotate_band(model.K_band, T)
-        Cr = rotate_band(c_band, T)
+        return _Stepper.from_bases(model, T, rotate_band(model.K_band, T), rotate_band(c_band, T), nm, load_dirs)
+
+    @staticmethod
+    def from_bases(model: LinearModel, T: np.ndarray, Kr: np.ndarray, Cr: np.ndarray, nm: Newmark,
+                   load_dirs: np.ndarray | None = None) -> "_Stepper":
+        """The operator from the node bases T (n_nodes, 3, 3) and the rotated stiffness and
+        damping bands K~ = T^T K T, C~ = T^T C T (:func:`_rotated_stack` for many states)."""
         axial = model.axial_dof + 2  # (t1, t2, a): the axis is the third local coordinate
         dm = model.mass.copy()
         dm[axial] = 0.0  # rigid insulator: no inertia along its axis (model.M_band)
@@ -379,7 +449,13 @@ class _Stepper:
         used = off.copy()
         used[-1] = dc
         chat = _factor(Kr, nm.a0 * dm, "effective stiffness", band_add=nm.a1 * used)
-        Gr = np.einsum("rna,naj->rnj", model.G.reshape(model.G.shape[0], -1, 3), T).reshape(model.G.shape)
+        # G T node by node, only over the nodes G touches (a few per tower): the same einsum on
+        # those nodes, so bit-identical to the full product (whose other columns are zero)
+        G3 = model.G.reshape(model.G.shape[0], -1, 3)
+        touched = np.flatnonzero(np.any(G3 != 0.0, axis=(0, 2)))
+        Gr = np.zeros(G3.shape)
+        Gr[:, touched] = np.einsum("rna,naj->rnj", G3[:, touched], T[touched])
+        Gr = Gr.reshape(model.G.shape)
         nz = np.flatnonzero(np.any(Gr != 0.0, axis=0))
         return _Stepper(T, chat, dm, nm.a0 * dm + nm.a1 * dc, nm.a2 * dm + dc, rest, nm.a1, 2.0 / nm.dt,
                         np.ascontiguousarray(T[:, 1, :] if load_dirs is None else np.einsum("naj,na->nj", T, load_dirs)),

@@ -25,6 +25,7 @@ directly at pinned nodes: R = G u + D f_pinned.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from collections.abc import Sequence
 from functools import cached_property
 
 import numpy as np
@@ -140,13 +141,20 @@ def band_to_sparse(ab: np.ndarray):
 
 
 def _cable_blocks(nodes: np.ndarray, tension: np.ndarray, ea: float) -> np.ndarray:
-    """3x3 element stiffness blocks k = EA/L e e^T + T/L (I - e e^T) (paper Eq. 7), shape (n_el, 3, 3)."""
-    seg = np.diff(nodes, axis=0)
-    Le = np.linalg.norm(seg, axis=1)
-    e = seg / Le[:, None]
-    eet = e[:, :, None] * e[:, None, :]
-    eye = np.eye(3)[None]
-    return (ea / Le)[:, None, None] * eet + (tension / Le)[:, None, None] * (eye - eet)
+    """3x3 element stiffness blocks k = EA/L e e^T + T/L (I - e e^T) (paper Eq. 7).
+
+    Args:
+        nodes: [m] node coordinates, shape (..., n_nodes, 3) (leading axes: mean states).
+        tension: [N] element tensions, shape (..., n_el).
+
+    Returns: [N/m] shape (..., n_el, 3, 3).
+    """
+    seg = np.diff(nodes, axis=-2)
+    Le = np.linalg.norm(seg, axis=-1)
+    e = seg / Le[..., None]
+    eet = e[..., :, None] * e[..., None, :]
+    eye = np.eye(3)
+    return (ea / Le)[..., None, None] * eet + (tension / Le)[..., None, None] * (eye - eet)
 
 
 def build_model(system: LineSystem, state: StaticState) -> LinearModel:
@@ -235,6 +243,106 @@ def build_model(system: LineSystem, state: StaticState) -> LinearModel:
                        np.array(axial_dof, dtype=int), K_axial)
 
 
+def build_models(system: LineSystem, states: Sequence[StaticState]) -> list[LinearModel]:
+    """:func:`build_model` for many mean states of one system in one vectorised pass.
+
+    The element blocks (paper Eq. 7) of all states are computed as one stacked array
+    (n_k, n_el, 3, 3) and scattered into a stacked band (n_k, BANDWIDTH + 1, n_dof) with a
+    leading state axis; the insulator blocks of all states and towers are batched the same
+    way.  Every floating-point operation is the one :func:`build_model` does, in the same
+    order, so each model is bit-identical to building it alone (tests/test_build_models.py).
+    What does not depend on the state (DOF map, lumped mass, tributary lengths, axial DOFs)
+    is computed once and shared, read-only, by all models.  Each model keeps its own dense
+    reaction map G, as :func:`build_model` does (allocated state by state; 3 n_towers x n_dof
+    each, the dominant memory of a long section's downburst models).
+
+    Args:
+        system: the line section.
+        states: the mean states, length n_k.
+
+    Returns: the linear models, ``[build_model(system, s) for s in states]``.
+    """
+    states = list(states)
+    if not states:
+        return []
+    line = system.line
+    dm = dof_map(system)
+    n_dof = dm.n_dof
+    n_k = len(states)
+    nodes = np.stack([s.nodes for s in states])  # (n_k, n_nodes, 3)
+    tension = np.stack([s.element_tension for s in states])  # (n_k, n_el)
+    kb = _cable_blocks(nodes, tension, line.ea)  # (n_k, n_el, 3, 3)
+    n_el = kb.shape[1]
+    u = BANDWIDTH
+    nd = dm.node_dof
+    ia, ib = np.triu_indices(3)
+    ab = np.zeros((n_k, BANDWIDTH + 1, n_dof))
+    diag_rows = (u + ia - ib)[None, :]  # upper triangle of a diagonal 3x3 block
+    # no DOF repeats within one scatter, so a fancy-indexed += adds exactly as np.add.at
+    left, right = nd[:-1], nd[1:]
+    for ends, mask in ((left, left >= 0), (right, right >= 0)):  # same order as build_model
+        ab[:, diag_rows, ends[mask][:, None] + ib[None, :]] += kb[:, mask][:, :, ia, ib]
+    both = (left >= 0) & (right >= 0)  # element between two free nodes: -k off the diagonal
+    a, b = np.meshgrid(np.arange(3), np.arange(3), indexing="ij")
+    rows = (u + a - 3 - b).ravel()[None, :]  # right node = left + 3
+    cols = right[both][:, None] + b.ravel()[None, :]
+    ab[:, rows, cols] += -kb[:, both].reshape(n_k, -1, 9)
+
+    # insulators (issue 4): axially stiff, geometric stiffness R_res/v transversely
+    susp = np.flatnonzero(system.suspension)
+    v = system.insulator_lengths[susp]  # (n_s,)
+    ea_cable_el = line.ea / float(system.element_unstretched_lengths.min())
+    k_ax = INSULATOR_AXIAL_FACTOR * ea_cable_el
+    d = np.stack([s.displacement for s in states])[:, susp]  # (n_k, n_s, 3)
+    axes = np.stack([d[..., 0], d[..., 1], d[..., 2] - v], axis=-1) / v[:, None]  # fixed point -> attachment
+    # |axis| by the dot product np.linalg.norm uses for one vector (bit-identical to build_model)
+    flat = axes.reshape(-1, 3)
+    axes /= np.sqrt(np.array([x.dot(x) for x in flat])).reshape(n_k, susp.size, 1)
+    P = axes[..., :, None] * axes[..., None, :]  # (n_k, n_s, 3, 3)
+    fins = np.stack([s.insulator_force for s in states])[:, susp]  # (n_k, n_s)
+    ins_blocks = k_ax * P + (fins / v)[..., None, None] * (np.eye(3) - P)
+    r = nd[system.tower_nodes[susp]]  # first DOF of every attachment node
+    ins_cols = r[:, None] + ib[None, :]
+    ab[:, diag_rows, ins_cols] += ins_blocks[:, :, ia, ib]
+    K_axial = np.zeros_like(ab)
+    K_axial[:, diag_rows, ins_cols] += (k_ax * P)[:, :, ia, ib]
+
+    # lumped mass (paper Eq. 8) by tributary unstretched length: state-independent
+    Le_u = system.element_unstretched_lengths
+    trib = np.zeros(system.n_nodes)
+    trib[:-1] += 0.5 * Le_u
+    trib[1:] += 0.5 * Le_u
+    m_node = line.weight * trib / GRAVITY
+    mass = np.repeat(m_node[dm.free_nodes], 3)
+
+    # reaction map: suspension towers k_ins u_node, strain towers -(K_rf u) (as build_model)
+    flip = np.array([1.0, 1.0, -1.0])[:, None]  # R_z is positive downward
+    i3 = np.arange(3)
+    susp_rows, susp_cols = (3 * susp)[:, None, None] + i3[:, None], r[:, None, None] + i3
+    susp_vals = flip * ins_blocks  # (n_k, n_s, 3, 3)
+    strain_rows, strain_cols, strain_el = [], [], []
+    for j in np.flatnonzero(~system.suspension):
+        node = system.tower_nodes[j]
+        for e, other in ((node - 1, node - 1), (node, node + 1)):
+            if 0 <= e < n_el and nd[other] >= 0:
+                strain_rows.append(3 * j)
+                strain_cols.append(nd[other])
+                strain_el.append(e)
+    rr = np.array(strain_rows, dtype=int)[:, None, None] + i3[:, None]
+    cc = np.array(strain_cols, dtype=int)[:, None, None] + i3
+    strain_vals = flip * kb[:, strain_el]  # (n_k, n_blocks, 3, 3)
+    G = []  # one dense map per state, allocated state by state (no (n_k, 3 n_towers, n_dof) stack)
+    for k in range(n_k):
+        Gk = np.zeros((3 * system.n_towers, n_dof))
+        Gk[susp_rows, susp_cols] = susp_vals[k]
+        Gk[rr, cc] += strain_vals[k]
+        G.append(Gk)
+    axial_dof = np.array(r, dtype=int)
+    for x in (dm.free_nodes, dm.node_dof, mass, trib, axial_dof):
+        x.flags.writeable = False  # shared by all the models
+    return [LinearModel(system, dm, ab[k], mass, trib, G[k], axes[k], axial_dof, K_axial[k]) for k in range(n_k)]
+
+
 def project_axial(model: LinearModel, ab: np.ndarray) -> np.ndarray:
     """P^T A P for a symmetric upper-band matrix A, P = I - a a^T at every suspension
     attachment node (identity elsewhere): removes the components along the insulator axes.
@@ -253,6 +361,28 @@ def project_axial(model: LinearModel, ab: np.ndarray) -> np.ndarray:
     right = k < D.shape[0] - 1
     E[k[right]] = P[right] @ E[k[right]]
     return blocks_to_band(D, E, ab.shape[0] - 1)
+
+
+def project_axial_stack(axial_dof: np.ndarray, axes: np.ndarray, ab: np.ndarray) -> np.ndarray:
+    """:func:`project_axial` for a stack of band matrices of one system, vectorised over the
+    stack (the mean states of :func:`build_models`); bit-identical to one at a time.
+
+    Args:
+        axial_dof: first DOF of every suspension attachment node, shape (n_s,) (shared).
+        axes: [-] unit insulator axes of every matrix, shape (n_k, n_s, 3).
+        ab: upper band storage, shape (n_k, BANDWIDTH + 1, n_dof).
+    """
+    if axial_dof.size == 0:
+        return ab.copy()
+    D, E = band_blocks(ab)
+    k = axial_dof // 3
+    P = np.eye(3) - axes[..., :, None] * axes[..., None, :]  # (n_k, n_s, 3, 3)
+    D[:, k] = P @ D[:, k] @ P
+    left = k > 0
+    E[:, k[left] - 1] = E[:, k[left] - 1] @ P[:, left]
+    right = k < D.shape[1] - 1
+    E[:, k[right]] = P[:, right] @ E[:, k[right]]
+    return blocks_to_band(D, E, ab.shape[-2] - 1)
 
 
 @dataclass(frozen=True)
@@ -323,31 +453,34 @@ def band_blocks(ab: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
     With three DOFs per node and two-node elements the band is exactly block tridiagonal.
 
+    ``ab`` may carry leading axes (a stack of matrices, e.g. one per mean state), shape
+    (..., BANDWIDTH + 1, n_dof); the blocks then carry the same leading axes.
+
     Returns:
-        D: diagonal blocks A[node i, node i], shape (n_nodes, 3, 3);
-        E: coupling blocks A[node i, node i+1], shape (n_nodes - 1, 3, 3).
+        D: diagonal blocks A[node i, node i], shape (..., n_nodes, 3, 3);
+        E: coupling blocks A[node i, node i+1], shape (..., n_nodes - 1, 3, 3).
     """
-    u = ab.shape[0] - 1
-    n_nodes = ab.shape[1] // 3
+    u = ab.shape[-2] - 1
+    n_nodes = ab.shape[-1] // 3
     a = np.arange(3)[:, None]
     b = np.arange(3)[None, :]
     first = 3 * np.arange(n_nodes)[:, None, None]
     lo, hi = np.minimum(a, b), np.maximum(a, b)
-    D = ab[u + lo - hi, first + hi]  # A[3i+lo, 3i+hi] (upper triangle, symmetric)
-    E = ab[u - 3 + a - b, first[:-1] + 3 + b]  # A[3i+a, 3i+3+b]
+    D = ab[..., u + lo - hi, first + hi]  # A[3i+lo, 3i+hi] (upper triangle, symmetric)
+    E = ab[..., u - 3 + a - b, first[:-1] + 3 + b]  # A[3i+a, 3i+3+b]
     return D, E
 
 
 def blocks_to_band(D: np.ndarray, E: np.ndarray, u: int = BANDWIDTH) -> np.ndarray:
-    """Inverse of :func:`band_blocks` (upper band storage, shape (u + 1, 3 n_nodes))."""
-    n_nodes = D.shape[0]
-    ab = np.zeros((u + 1, 3 * n_nodes))
+    """Inverse of :func:`band_blocks` (upper band storage, shape (..., u + 1, 3 n_nodes))."""
+    n_nodes = D.shape[-3]
+    ab = np.zeros(D.shape[:-3] + (u + 1, 3 * n_nodes))
     first = 3 * np.arange(n_nodes)
     for a in range(3):
         for b in range(3):
             if b >= a:
-                ab[u + a - b, first + b] = D[:, a, b]
-            ab[u - 3 + a - b, first[:-1] + 3 + b] = E[:, a, b]
+                ab[..., u + a - b, first + b] = D[..., a, b]
+            ab[..., u - 3 + a - b, first[:-1] + 3 + b] = E[..., a, b]
     return ab
 
 
@@ -355,12 +488,16 @@ def rotate_band(ab: np.ndarray, T: np.ndarray) -> np.ndarray:
     """T^T A T for a node-major symmetric band matrix and a block-diagonal rotation.
 
     Args:
-        ab: upper band storage, shape (BANDWIDTH + 1, 3 n_nodes).
+        ab: upper band storage, shape (..., BANDWIDTH + 1, 3 n_nodes) (leading axes: a stack
+            of matrices, e.g. the mean states, each rotated by its own bases).
         T: [-] per-node orthonormal bases (columns: local axes in global coordinates),
-            shape (n_nodes, 3, 3).
+            shape (..., n_nodes, 3, 3).
+
+    Every 3x3 product is the same (BLAS) product whatever the leading axes, so a stack gives
+    bit for bit the matrices rotated one at a time (tests/test_build_models.py).
     """
     D, E = band_blocks(ab)
-    Tt = T.transpose(0, 2, 1)
+    Tt = np.swapaxes(T, -1, -2)
     Dr = Tt @ D @ T
-    Er = Tt[:-1] @ E @ T[1:]
-    return blocks_to_band(0.5 * (Dr + Dr.transpose(0, 2, 1)), Er, ab.shape[0] - 1)
+    Er = Tt[..., :-1, :, :] @ E @ T[..., 1:, :, :]
+    return blocks_to_band(0.5 * (Dr + np.swapaxes(Dr, -1, -2)), Er, ab.shape[-2] - 1)

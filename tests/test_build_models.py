@@ -1,0 +1,135 @@
+"""Issue 20: the mean-state models of a downburst built in one vectorised pass.
+
+:func:`build_models` must give, for every mean state, exactly (bit for bit) the model that
+:func:`build_model` gives for that state alone: the paper's six-span downburst (level,
+straight, strain ends and suspension towers) and the 12-span section example (unequal,
+inclined spans, angle-strain and angle-suspension towers, so that every element block
+and insulator axis is oblique).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from linecheck import service
+from linecheck.core.case import load_case
+from linecheck.core.model import build_model, build_models
+from linecheck.core.static import solve_static_batch
+
+from .conftest import CASES
+
+MODEL_ARRAYS = ("K_band", "mass", "tributary", "G", "axes", "axial_dof", "K_axial_band")
+
+
+def same_bits(x: np.ndarray, y: np.ndarray) -> bool:
+    """Equal shape, dtype and bytes (stricter than np.array_equal: -0.0 != 0.0 here)."""
+    x, y = np.asarray(x), np.asarray(y)
+    return x.shape == y.shape and x.dtype == y.dtype and np.ascontiguousarray(x).tobytes() == \
+        np.ascontiguousarray(y).tobytes()
+
+
+@pytest.fixture(scope="module")
+def downburst_six():
+    case = load_case(CASES / "paper" / "case05-six.toml")
+    st = service.static_analysis(case)
+    return case, st, [st.mean.state(k) for k in range(st.mean.time.size)]
+
+
+@pytest.fixture(scope="module")
+def section_states():
+    """Seven states of the section: the mean wind scaled 0.2..1.3, the synoptic state, still air."""
+    case = load_case(CASES / "examples" / "section-12span.toml")
+    st = service.static_analysis(case)
+    gy = st.mean.gy[0]
+    scaled = solve_static_batch(st.system, np.stack([f * gy for f in (0.2, 0.5, 0.8, 1.0, 1.3)]),
+                                labels=[f"x{f}" for f in range(5)])
+    return case, st, scaled + [st.mean.state(0), st.mean.still_air]
+
+
+def assert_models_identical(one, many) -> None:
+    assert len(one) == len(many)
+    for k, (a, b) in enumerate(zip(one, many)):
+        for name in MODEL_ARRAYS:
+            assert same_bits(getattr(a, name), getattr(b, name)), f"state {k}: {name} differs"
+        assert a.dofs.n_dof == b.dofs.n_dof
+        assert same_bits(a.dofs.free_nodes, b.dofs.free_nodes)
+        assert same_bits(a.dofs.node_dof, b.dofs.node_dof)
+
+
+@pytest.mark.parametrize("which", ["downburst_six", "section_states"])
+def test_build_models_bit_identical_to_one_by_one(which, request):
+    _, st, states = request.getfixturevalue(which)
+    assert len(states) > 1
+    one = [build_model(st.system, s) for s in states]
+    many = build_models(st.system, states)
+    assert_models_identical(one, many)
+    # the states differ, so the comparison is not vacuous
+    assert not np.array_equal(many[0].K_band, many[-1].K_band)
+    assert not np.array_equal(many[0].G, many[-1].G)
+
+
+def test_build_models_shares_only_state_independent_arrays(downburst_six):
+    _, st, states = downburst_six
+    many = build_models(st.system, states[:3])
+    assert many[0].mass is many[1].mass and not many[0].mass.flags.writeable
+    assert not np.shares_memory(many[0].G, many[1].G)
+    assert build_models(st.system, []) == []
+
+
+def stepper_fields_identical(a, b) -> bool:
+    fields = ("T", "chat", "dm", "cu", "cv", "ycoef", "axial", "nz", "GT")
+    if not all(same_bits(getattr(a, f), getattr(b, f)) for f in fields) or (a.rest is None) != (b.rest is None):
+        return False
+    if a.rest is None:
+        return True
+    return same_bits(a.rest.indptr, b.rest.indptr) and same_bits(a.rest.indices, b.rest.indices) and \
+        same_bits(a.rest.data, b.rest.data)
+
+
+@pytest.mark.parametrize("which,damping,zeta", [
+    ("downburst_six", "paper", 0.0),  # the paper's case: transverse damping only
+    ("downburst_six", "quasi-steady", 0.005),  # full 3x3 node blocks and a structural remainder
+    ("section_states", "paper", 0.0),  # oblique node normals and insulator axes
+    ("section_states", "quasi-steady", 0.002),
+])
+def test_damping_and_steppers_stacked_bit_identical(which, damping, zeta, request):
+    """Step 2 of issue 20: damping matrices, node bases (batched eigh), rotated bands and the
+    Newmark operators of all states at once equal those built state by state, bit for bit."""
+    import dataclasses
+
+    from linecheck.core.damping import (aerodynamic_damping, aerodynamic_damping_stack, stiffness_proportional,
+                                        stiffness_proportional_stack)
+    from linecheck.core.dynamics import Newmark, _rotated_stack, _Stepper
+
+    case, st, states = request.getfixturevalue(which)
+    case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, damping=damping,
+                                                                  structural_damping=zeta))
+    models = build_models(st.system, states)
+    vn_all = service.to_global_nodes(st.system, st.wind.normal)
+    vn0 = vn_all[np.argmax(np.abs(vn_all).sum(axis=1))]  # the strongest mean wind of the case
+    vn = np.stack([(0.5 + 0.1 * k) * vn0 for k in range(len(states))])  # a different wind per state
+    nodes = np.stack([s.nodes for s in states])
+    w1 = 2.5  # [rad/s] any calibration frequency: the same one on both sides
+    one = np.stack([aerodynamic_damping(case, m, vn[k], nodes[k]) for k, m in enumerate(models)])
+    many = aerodynamic_damping_stack(case, models, vn, nodes)
+    if zeta > 0:
+        one = one + np.stack([stiffness_proportional(m, zeta, w1) for m in models])
+        many = many + stiffness_proportional_stack(models, zeta, w1)
+    assert same_bits(one, many)
+    assert not np.array_equal(one[0], one[-1])
+    nm = Newmark(case.analysis.time_step)
+    T, Kr, Cr = _rotated_stack(models, many)
+    for k, m in enumerate(models):
+        ref = _Stepper.build(m, one[k], nm)
+        assert stepper_fields_identical(ref, _Stepper.from_bases(m, T[k], Kr[k], Cr[k], nm)), f"state {k}"
+        assert (ref.rest is not None) == (zeta > 0)
+
+
+def test_build_models_without_suspension_towers():
+    """A single span (two strain towers): no insulator blocks, G from the cable elements only."""
+    case = load_case(CASES / "paper" / "case05-single.toml")
+    st = service.static_analysis(case)
+    states = [st.mean.state(k) for k in range(0, st.mean.time.size, 10)]
+    assert not st.system.suspension.any()
+    assert_models_identical([build_model(st.system, s) for s in states], build_models(st.system, states))

@@ -81,7 +81,9 @@ def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     series = case.wind.type == "downburst"
     tens = ", ".join(f"{h / 1e3:.2f}" for h in (m.tension.max(axis=0) if series else m.tension[0]))
     console.print(f"span tensions H (kN{', largest over the event' if series else ''}): {tens}   "
-                  f"still air: {m.still_air.tension[0] / 1e3:.2f}   nominal T0: {res.system.tension_nominal / 1e3:.2f}")
+                  f"still air: {m.still_air.tension[0] / 1e3:.2f}   "
+                  + (f"H0 at clipping-in: {res.system.tension_nominal / 1e3:.2f}" if res.system.is_section
+                     else f"nominal T0: {res.system.tension_nominal / 1e3:.2f}"))
     if case.wind.type == "downburst":
         console.print(f"[dim]{m.time.size} mean states over t = {m.time[0]:.0f} to {m.time[-1]:.0f} s; "
                       "rows show the instant of peak wind-induced Ry at each tower.[/]")

@@ -222,8 +222,12 @@ def _still_air_and_step1(cur: Cursor, doc: RunDocument) -> None:
             cur.put(cur.row, 2, "kN", "lc_text")
             cur.put(cur.row, 3, kn(still.reactions[r]), fmt=KN3)
             cur.row += 1
-        for label, v, unit, fmt in (("sag S", still.sag, "m", "0.00"),
-                                    ("nominal tension T0 = W Lx² / 8S", kn(still.tension_nominal), "kN", KN3)):
+        rows = (("sag S", still.sag, "m", "0.00"),
+                ("nominal tension T0 = W Lx² / 8S", kn(still.tension_nominal), "kN", KN3))
+        if _is_section_doc(doc):  # a section: H0 at clipping-in, the parabolic sag of Eq. 17's L_x (issue 17)
+            rows = (("sag W Lx² / 8 H0 (span Lx of Eq. 17)", still.sag, "m", "0.00"),
+                    ("tension H0 at clipping-in", kn(still.tension_nominal), "kN", KN3))
+        for label, v, unit, fmt in rows:
             cur.put(cur.row, 1, label, "lc_text")
             cur.put(cur.row, 2, unit, "lc_text")
             cur.put(cur.row, 3, v, fmt=fmt)

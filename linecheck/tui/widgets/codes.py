@@ -18,16 +18,19 @@ PEAK_NOTE = ("linecheck peak: mean over realizations of the wind-induced dynamic
              "Unverified codes are shown, not judged (docs/codes.md).")
 
 
-def codes_rows(codes: dict[str, CodeCheck]) -> list[tuple[str, ...]]:
-    """Table rows (text, kN) of a typed ``codes`` block."""
+def codes_rows(codes: dict[str, CodeCheck], names: dict[int, str] | None = None) -> list[tuple[str, ...]]:
+    """Table rows (text, kN) of a typed ``codes`` block; ``names``: tower labels by 1-based index
+    (a section's ``towers[].name``, issue 17), shown as "7 T7"."""
     def kn(x):
         return "-" if x is None else f"{x / 1e3:.3f}"
 
+    names = names or {}
     rows = []
     for name, block in codes.items():
         for t in block.towers:
+            label = f"{t.index} {names[t.index]}" if t.index in names else str(t.index)
             for r, v in t.reactions.items():
-                rows.append((name, "yes" if block.verified else "no", str(t.index), r, kn(v.code_load),
+                rows.append((name, "yes" if block.verified else "no", label, r, kn(v.code_load),
                              kn(v.linecheck_peak), "-" if v.ratio is None else f"{v.ratio:.3f}", v.verdict))
     return rows
 
@@ -55,7 +58,8 @@ class CodesView(Vertical):
             notes.update("")
             return
         title.update(Text(f"{doc.case}: conductor wind load on Ry, design codes vs linecheck", style="bold"))
-        for row in codes_rows(codes):
+        names = {t.index: t.section["name"] for t in doc.towers if t.section and "name" in t.section}
+        for row in codes_rows(codes, names):
             table.add_row(*row)
         n = Text(PEAK_NOTE + "\n", style="dim")
         for name, block in codes.items():

@@ -160,7 +160,10 @@ linearisation gap".
 def render() -> str:
     out = [HEADER]
     for section, specs in SCHEMA.items():
-        out.append(f"## {'[' + section + ']' if section else 'Top level'}\n")
+        if section == "line.towers":  # an array of tables: one per tower (or one CSV row, towers_file)
+            out.append("## [[line.towers]] (one table per tower, in line order; or one row of `towers_file`)\n")
+        else:
+            out.append(f"## {'[' + section + ']' if section else 'Top level'}\n")
         out.append("| key | type | unit | default | allowed | meaning |")
         out.append("| --- | --- | --- | --- | --- | --- |")
         for s in specs:

@@ -104,6 +104,8 @@ def test_straight_section_does_not_move_in_still_air():
     st = still_air_state(system)
     assert np.abs(st.displacement).max() < 1e-8
     assert np.abs(st.reactions[:, 1]).max() < 1e-8
+    # ... and the whole conductor stays on the clipped-in catenaries (node by node)
+    assert np.abs(st.nodes - system.clip_in_nodes).max() < 1e-7
     # each suspension tower carries the weight of the conductor between the low points around it
     assert np.all(st.reactions[1:-1, 2] > 0)
     assert st.reactions[:, 2].sum() == pytest.approx(W * system.unstretched_lengths.sum(), rel=1e-10)

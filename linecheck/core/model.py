@@ -401,10 +401,18 @@ class Condensed:
     C: np.ndarray
 
 
+#: above this many DOFs :func:`condensed` works with sparse matrices (O(n) instead of the dense
+#: O(n^3) products; equal to the dense path to rounding, tests/test_sections_core.py); below it
+#: the dense path keeps every existing result bit for bit
+SPARSE_CONDENSATION_DOF = 600
+
+
 def condensed(model: LinearModel, damping_band: np.ndarray | None = None) -> Condensed:
     """Static condensation of the axial directions at suspension nodes (Guyan 1965; exact
     here because those directions carry no mass and no damping)."""
     n = model.mass.size
+    if n > SPARSE_CONDENSATION_DOF:
+        return _condensed_sparse(model, damping_band)
     K = model.K_dense
     keep = np.ones(n, dtype=bool)
     Tt = np.eye(n)
@@ -429,6 +437,54 @@ def condensed(model: LinearModel, damping_band: np.ndarray | None = None) -> Con
     M = band_to_dense(model.M_band)
     C = np.zeros_like(K) if damping_band is None else band_to_dense(damping_band)
     return Condensed(S, S.T @ K @ S, S.T @ M @ S, S.T @ C @ S)
+
+
+def _condensed_sparse(model: LinearModel, damping_band: np.ndarray | None) -> Condensed:
+    """:func:`condensed` with sparse K, M, C, T and S (the same algebra): each axial direction
+    couples only to its node's neighbours, and the axial DOFs of different towers are never
+    coupled (K_aa is diagonal), so S = T - A K_aa^-1 K_at stays sparse; the products are then
+    O(n) and only the condensed matrices are made dense (issue 20: long sections)."""
+    from scipy.sparse import coo_matrix, diags
+
+    n = model.mass.size
+    Ks = band_to_sparse(model.K_band)
+    keep = np.ones(n, dtype=bool)
+    rows, cols, vals = [], [], []
+    a_rows, a_cols, a_vals = [], [], []
+    plain = np.ones(n, dtype=bool)
+    for j, (first, a) in enumerate(zip(model.axial_dof, model.axes)):
+        basis = np.linalg.svd(np.eye(3) - np.outer(a, a))[0][:, :2]  # as the dense path
+        plain[first:first + 3] = False
+        keep[first + 2] = False
+        for c in range(2):
+            rows += [first, first + 1, first + 2]
+            cols += [first + c] * 3
+            vals += list(basis[:, c])
+        a_rows += [first, first + 1, first + 2]
+        a_cols += [j] * 3
+        a_vals += list(a)
+    idx = np.flatnonzero(plain)
+    rows += list(idx)
+    cols += list(idx)
+    vals += [1.0] * idx.size
+    col_of = np.cumsum(keep) - 1  # full column (first + c) -> condensed column
+    T = coo_matrix((vals, (rows, col_of[np.asarray(cols, dtype=int)])), shape=(n, int(keep.sum()))).tocsr()
+    if a_rows:
+        Ax = coo_matrix((a_vals, (a_rows, a_cols)), shape=(n, len(model.axial_dof))).tocsr()
+        Kaa = (Ax.T @ Ks @ Ax).toarray()
+        Kat = Ax.T @ Ks @ T
+        if np.count_nonzero(Kaa - np.diag(np.diag(Kaa))):  # pragma: no cover - adjacent axial DOFs
+            S = T - Ax @ coo_matrix(np.linalg.solve(Kaa, Kat.toarray())).tocsr()
+        else:
+            S = T - Ax @ (diags(1.0 / np.diag(Kaa)) @ Kat)
+    else:
+        S = T
+    S = S.tocsr()
+    St = S.T.tocsr()
+    M = band_to_sparse(model.M_band)
+    out = [(St @ A @ S).toarray() for A in (Ks, M)]
+    C = np.zeros_like(out[0]) if damping_band is None else (St @ band_to_sparse(damping_band) @ S).toarray()
+    return Condensed(S.toarray(), out[0], out[1], C)
 
 
 def reaction_matrix_direct(system: LineSystem) -> np.ndarray:

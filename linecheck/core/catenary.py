@@ -142,14 +142,19 @@ def solve_spans(chord: np.ndarray, p: np.ndarray, Lu: np.ndarray, EA: float, N0:
     eye = np.eye(3)
     N0 = np.array(N0, dtype=float)
     scale = np.linalg.norm(chord, axis=-1)
-    for _ in range(60):
+
+    def evaluate(N0: np.ndarray):
+        """Element chords seg (..., n_spans, ne, 3), |N| at the Gauss points and the flexibility F."""
         N = N0[..., None, None, :] - P_g  # (..., n_spans, ne, g, 3)
         nn = np.linalg.norm(N, axis=-1, keepdims=True)
         t = N / nn
-        seg = (w * t).sum(axis=-2) + (h[:, None, None] * N0[..., None, :] - intP) / EA  # (..., n_spans, ne, 3)
-        res = chord - seg.sum(axis=-2)
+        seg = (w * t).sum(axis=-2) + (h[:, None, None] * N0[..., None, :] - intP) / EA
         F = (w[..., None] * (eye - t[..., :, None] * t[..., None, :]) / nn[..., None]).sum(axis=(-3, -4))
-        F = F + (Lu / EA)[:, None, None] * eye
+        return seg, nn, F + (Lu / EA)[:, None, None] * eye
+
+    for _ in range(60):
+        seg, _nn, F = evaluate(N0)
+        res = chord - seg.sum(axis=-2)
         step = np.linalg.solve(F, res[..., None])[..., 0]
         big = np.linalg.norm(step, axis=-1, keepdims=True) / np.maximum(np.linalg.norm(N0, axis=-1, keepdims=True), 1e-300)
         step = np.where(big > 0.5, step * (0.5 / np.maximum(big, 1e-300)), step)  # cap |dN_0| at |N_0|/2
@@ -158,12 +163,7 @@ def solve_spans(chord: np.ndarray, p: np.ndarray, Lu: np.ndarray, EA: float, N0:
             break
     else:
         raise ConvergenceError(f"{what}: the elastic-cable span iteration did not converge (loads too large?)")
-    N = N0[..., None, None, :] - P_g
-    nn = np.linalg.norm(N, axis=-1, keepdims=True)
-    t = N / nn
-    seg = (w * t).sum(axis=-2) + (h[:, None, None] * N0[..., None, :] - intP) / EA
-    F = (w[..., None] * (eye - t[..., :, None] * t[..., None, :]) / nn[..., None]).sum(axis=(-3, -4))
-    F = F + (Lu / EA)[:, None, None] * eye
+    seg, nn, F = evaluate(N0)  # at the converged N_0
     r = np.concatenate([np.zeros_like(seg[..., :1, :]), np.cumsum(seg, axis=-2)], axis=-2)
     # element tension at the mid-point: Gauss points are symmetric, take the mean of the two inner ones
     mid = 0.5 * (nn[..., 1, 0] + nn[..., 2, 0])

@@ -619,14 +619,12 @@ class _TowerCtx(_Ctx):
         return CaseError(message, file=self.file, key=dotted, line=_tower_line(self.text, self.k, key))
 
 
-def _read_towers_csv(path: Path, shown: str, ctx: _Ctx) -> list[tuple[dict[str, Any], int]]:
+def _read_towers_csv(path: Path) -> list[tuple[dict[str, Any], int]]:
     """Rows of a tower CSV as raw dicts (numbers parsed) with their 1-based file row numbers."""
     import csv
     import io
 
-    text = read_text_file(path, "a CSV tower table", MAX_CASE_BYTES)
-    lines = [ln for ln in io.StringIO(text)]
-    rows = list(csv.reader(lines))
+    rows = list(csv.reader(io.StringIO(read_text_file(path, "a CSV tower table", MAX_CASE_BYTES))))
     # skip blank and comment lines, remembering file row numbers
     numbered = [(i + 1, r) for i, r in enumerate(rows) if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
     if not numbered:
@@ -691,7 +689,7 @@ def _section_line(line_d: dict[str, Any], towers_data: Any, ctx: _Ctx, base_dir:
         if not path.exists():
             raise ctx.error("line", "towers_file", f"value {_fmt(line_d['towers_file'])}: file {path} does not exist "
                             "(expected a CSV tower table, see docs/case-files.md)")
-        for k, (d, row_no) in enumerate(_read_towers_csv(path, line_d["towers_file"], ctx)):
+        for k, (d, row_no) in enumerate(_read_towers_csv(path)):
             raw.append((d, _TowerCtx(ctx, k, str(path), row_no)))
     elif towers_data is None:
         raise ctx.error("line", "towers", "missing: give one [[line.towers]] table per tower or towers_file = \"section.csv\"")

@@ -445,7 +445,7 @@ def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: n
             f_i += per_q * (v[i] * v[i] - sig2)
         loads[:, i, :] = f_i[:, free]
         # loads at pinned nodes go straight into their supports (R_y; a section: along the node normal)
-        if system.straight_level:
+        if system.straight_in_plan:
             direct[:, i, 3 * np.flatnonzero(~system.suspension) + 1] = f_i[:, pinned]
         else:
             b = system.node_normals[pinned]
@@ -532,7 +532,7 @@ def run_case(
     resp = integrate(models, damping, state_of_step, loads, dt, direct=direct,
                      model_at=_interpolated_models(case, st, bracket, weights) if interpolate_states else None,
                      second_order=second, second_order_start=int(np.argmax(keep)), progress=cb, cancel=cancel,
-                     load_dirs=None if system.straight_level else system.node_normals[models[0].dofs.free_nodes])
+                     load_dirs=None if system.straight_in_plan else system.node_normals[models[0].dofs.free_nodes])
     # every reaction from here on in its tower's own frame (issue 17; a straight line: the global frame)
     resp = DynamicResponse(system.to_tower_frames(resp.fluctuating), system.to_tower_frames(resp.background))
 

@@ -75,7 +75,7 @@ def aerodynamic_damping(case: Case, model: LinearModel, vn_nodes: np.ndarray, no
     first = model.dofs.node_dof[free]
     system = model.system
     if case.analysis.damping == "paper":
-        if system.straight_level:
+        if system.straight_in_plan:
             ab[BANDWIDTH, first + 1] = c  # Eq. 9: transverse DOF only
         else:  # along each node's transverse direction b (issue 17): c b b^T
             b = system.node_normals[free]
@@ -85,7 +85,7 @@ def aerodynamic_damping(case: Case, model: LinearModel, vn_nodes: np.ndarray, no
         raise ValueError("quasi-steady damping needs the mean-state node coordinates")
     e = node_tangents(model, nodes)[free]  # (n_free, 3)
     P = np.eye(3)[None] - e[:, :, None] * e[:, None, :]
-    if system.straight_level:
+    if system.straight_in_plan:
         w = P[:, :, 1]  # the wind (+y) projected normal to the axis
     else:  # the node's transverse load direction b projected normal to the axis (issue 17)
         w = np.einsum("nab,nb->na", P, system.node_normals[free])
@@ -131,7 +131,7 @@ def aerodynamic_damping_stack(case: Case, models: list[LinearModel], vn_nodes: n
     system = model.system
     axes = np.stack([m.axes for m in models])  # (n_k, n_s, 3)
     if case.analysis.damping == "paper":
-        if system.straight_level:
+        if system.straight_in_plan:
             ab[:, BANDWIDTH, first + 1] = c  # Eq. 9: transverse DOF only
         else:  # along each node's transverse direction b (issue 17): c b b^T
             b = system.node_normals[free]
@@ -141,7 +141,7 @@ def aerodynamic_damping_stack(case: Case, models: list[LinearModel], vn_nodes: n
         raise ValueError("quasi-steady damping needs the mean-state node coordinates")
     e = node_tangents(model, np.asarray(nodes))[:, free]  # (n_k, n_free, 3)
     P = np.eye(3) - e[..., :, None] * e[..., None, :]
-    if system.straight_level:
+    if system.straight_in_plan:
         w = P[..., :, 1]  # the wind (+y) projected normal to the axis
     else:  # the node's transverse load direction b projected normal to the axis (issue 17)
         w = np.einsum("nab,nb->na", P.reshape(-1, 3, 3),

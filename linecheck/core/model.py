@@ -495,7 +495,7 @@ def reaction_matrix_direct(system: LineSystem) -> np.ndarray:
     """
     D = np.zeros((3 * system.n_towers, system.n_nodes))
     for j in np.flatnonzero(~system.suspension):
-        if system.straight_level:
+        if system.straight_in_plan:
             D[3 * j + 1, system.tower_nodes[j]] = 1.0
         else:
             b = system.node_normals[system.tower_nodes[j]]

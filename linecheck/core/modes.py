@@ -52,4 +52,4 @@ def natural_modes(model: LinearModel, n_modes: int = 20) -> Modes:
     free = model.dofs.free_nodes
     shapes[:, free, :] = phi.T.reshape(n, free.size, 3)
     system = model.system
-    return Modes(freq, shapes, None if system.straight_level else system.node_frames)
+    return Modes(freq, shapes, None if system.straight_in_plan else system.node_frames)

@@ -282,7 +282,7 @@ def tower_rows(model: LinearModel, A: np.ndarray, tower: int) -> np.ndarray:
     (issue 17: x along its mean heading, y turned +90 deg, z down; a straight line: as is)."""
     rows = A[3 * tower:3 * tower + 3]
     system = model.system
-    if system.straight_level:
+    if system.straight_in_plan:
         return rows
     psi = system.tower_headings[tower]
     Q = np.array([[np.cos(psi), np.sin(psi), 0.0], [-np.sin(psi), np.cos(psi), 0.0], [0.0, 0.0, 1.0]])
@@ -295,7 +295,7 @@ def load_rows(model: LinearModel, A: np.ndarray) -> np.ndarray:
     free = model.dofs.free_nodes
     ydof = model.dofs.node_dof[free] + 1
     system = model.system
-    if system.straight_level:
+    if system.straight_in_plan:
         return A[ydof]
     b = system.node_normals[free]
     first = model.dofs.node_dof[free]
@@ -599,7 +599,7 @@ def random_vibration(
 
     def direct(omega: np.ndarray) -> np.ndarray:  # (3, n_free, n_f)
         X = dynamic_solve(blocks, omega, rhs)  # (n_free, 3 dofs, 3 reactions, n_f)
-        if system.straight_level:
+        if system.straight_in_plan:
             return X[:, 1].transpose(1, 0, 2)  # y DOF of every free node
         b = system.node_normals[free]  # along every node's load direction (issue 17)
         return np.einsum("ncrf,nc->rnf", X, b)

@@ -591,8 +591,11 @@ class MeanStates:
 
 
 def still_air_state(system: LineSystem) -> StaticState:
-    """Equilibrium under self-weight only (reference for wind-induced values)."""
-    return solve_static(system, np.zeros((system.n_spans, system.ne + 1)), label="still-air state")
+    """Equilibrium under self-weight only (reference for wind-induced values).
+
+    Solved once per :class:`LineSystem` (:attr:`LineSystem.still_air`): a section's wind is
+    evaluated on it too (node heights), so step 1 does not solve it again."""
+    return system.still_air
 
 
 def solve_mean_states(

@@ -188,9 +188,9 @@ class LineSystem:
         return out
 
     @property
-    def straight_level(self) -> bool:
+    def straight_in_plan(self) -> bool:
         """True when the frames of every tower and node are the global axes (no rotation needed):
-        the equal-span form, or a section without angles."""
+        the equal-span form, or a section without angle towers (inclined spans allowed)."""
         return not self.is_section or not np.any(self.tower_angles)
 
     def to_tower_frames(self, R: np.ndarray) -> np.ndarray:
@@ -199,7 +199,7 @@ class LineSystem:
 
         R'_x = R_x cos psi + R_y sin psi, R'_y = -R_x sin psi + R_y cos psi, R'_z = R_z.  Returns
         ``R`` itself (no copy) when every tower frame is the global frame."""
-        if self.straight_level:
+        if self.straight_in_plan:
             return R
         c, s = np.cos(self.tower_headings), np.sin(self.tower_headings)
         out = np.array(R, dtype=float, copy=True)
@@ -209,7 +209,7 @@ class LineSystem:
 
     def from_tower_frames(self, R: np.ndarray) -> np.ndarray:
         """Inverse of :meth:`to_tower_frames`."""
-        if self.straight_level:
+        if self.straight_in_plan:
             return R
         c, s = np.cos(self.tower_headings), np.sin(self.tower_headings)
         out = np.array(R, dtype=float, copy=True)
@@ -277,6 +277,15 @@ class LineSystem:
         return nodes
 
     @cached_property
+    def still_air(self):
+        """The still-air equilibrium under weight (a :class:`~linecheck.core.static.StaticState`),
+        solved once per system and shared read-only: the reference of every wind-induced value
+        and, on a section, the shape the wind is evaluated on."""
+        from .static import solve_static  # the step-1 solver needs no wind geometry
+
+        return solve_static(self, np.zeros((self.n_spans, self.ne + 1)), label="still-air state")
+
+    @cached_property
     def node_xyz0(self) -> np.ndarray:
         """[m] still-air position of every global FE node (x, y, z), (n_nodes, 3).
 
@@ -285,9 +294,7 @@ class LineSystem:
         conductor point: from the still-air shape"; at angle towers the insulators have swung;
         on a straight section it is the clipped-in shape, :attr:`clip_in_nodes`)."""
         if self.is_section:
-            from .static import still_air_state  # the step-1 solver needs no wind geometry
-
-            return still_air_state(self).nodes
+            return self.still_air.nodes
         out = np.zeros((self.n_nodes, 3))
         out[:, 0] = self.node_x0
         return out

@@ -70,6 +70,12 @@ def _solve(c: np.ndarray, b: np.ndarray) -> np.ndarray:
     return x
 
 
+#: above this many DOFs step 3 solves the banded stiffness every step instead of applying the
+#: dense static transfer matrix (O(n) instead of O(n^2) per step; issue 20); the two agree to
+#: rounding (tests), and smaller systems keep the transfer matrix (bit-identical to before)
+BACKGROUND_SOLVE_DOF = 600
+
+
 @dataclass(frozen=True)
 class DynamicResponse:
     """Reaction histories of steps 2 and 3 (wind-induced fluctuating parts).
@@ -177,7 +183,24 @@ def integrate(
             """Second-order reactions of global displacements U (..., n_dof) under the state of step n."""
             return second_order_reactions(second_order[int(state_of_step[n])], U.reshape(-1, n_dof)).reshape(
                 U.shape[:-1] + (n_r,))
-    if model_at is None:
+    if model_at is None and n_dof > BACKGROUND_SOLVE_DOF:
+        # a long line (issue 20): the dense static transfer (n_free x n_r) would cost O(n^2) per
+        # step; solve K u_B = P l by the banded Cholesky instead (dpbtrs: column by column, so a
+        # realization's bits do not depend on what else is solved) and take G u_B sparsely
+        rows = max(1, 2_000_000 // n_dof)  # right-hand sides per solve: ~16 MB
+        for k in np.unique(state_of_step):
+            c = _factor(models[k].K_band, np.zeros(n_dof), f"stiffness of mean state {k + 1}")
+            sparse_g = _sparse_rows(models[k].G)
+            all_steps = np.flatnonzero(state_of_step == k)
+            per = max(1, rows // max(n_real, 1))
+            for i0 in range(0, all_steps.size, per):
+                steps = all_steps[i0:i0 + per]
+                UB = _solve(c, loads_full(loads[steps].reshape(-1, n_free)).T).T  # (m, n_dof), global
+                R_B[steps] = _sparse_reactions(UB, *sparse_g).reshape(steps.size, n_real, n_r)
+                sk = steps >= second_order_start
+                if second_order is not None and sk.any():  # the quasi-static displacements themselves
+                    R_B[steps[sk]] += so(int(steps[sk][0]), UB.reshape(steps.size, n_real, n_dof)[sk])
+    elif model_at is None:
         for k in np.unique(state_of_step):
             c = _factor(models[k].K_band, np.zeros(n_dof), f"stiffness of mean state {k + 1}")
             # static transfer from the y-loads to the reactions, (G K^-1 P)^T = (K^-1 G^T)[y]
@@ -422,6 +445,7 @@ class _Stepper:
     axial: np.ndarray  # rotated coordinates along the insulator axes, (n_susp,)
     nz: np.ndarray  # coordinates that enter the reactions, (n_nz,)
     GT: np.ndarray  # [N/m] (G T)^T rows nz, (n_nz, n_r)
+    cols: np.ndarray  # per row of GT the column range [c0, c1) of its non-zeros (its tower), (n_nz, 2)
 
     @staticmethod
     def build(model: LinearModel, c_band: np.ndarray, nm: Newmark, load_dirs: np.ndarray | None = None) -> "_Stepper":
@@ -456,19 +480,38 @@ class _Stepper:
         Gr = np.zeros(G3.shape)
         Gr[:, touched] = np.einsum("rna,naj->rnj", G3[:, touched], T[touched])
         Gr = Gr.reshape(model.G.shape)
-        nz = np.flatnonzero(np.any(Gr != 0.0, axis=0))
+        nz, GT, cols = _sparse_rows(Gr)
         return _Stepper(T, chat, dm, nm.a0 * dm + nm.a1 * dc, nm.a2 * dm + dc, rest, nm.a1, 2.0 / nm.dt,
                         np.ascontiguousarray(T[:, 1, :] if load_dirs is None else np.einsum("naj,na->nj", T, load_dirs)),
-                        axial, nz, np.ascontiguousarray(Gr.T[nz]))
+                        axial, nz, GT, cols)
 
     def reactions(self, U: np.ndarray) -> np.ndarray:
-        """[N] G u for rotated vectors U (..., n_dof) -> (..., n_r), accumulated coordinate
-        by coordinate in a fixed order: elementwise only, so every realization's reactions
-        are bit-identical whatever else shares the array (no BLAS blocking)."""
-        out = np.zeros(U.shape[:-1] + (self.GT.shape[1],))
-        for d, g in zip(self.nz, self.GT):
-            out += U[..., d, None] * g
-        return out
+        """[N] G u for rotated vectors U (..., n_dof) -> (..., n_r) (:func:`_sparse_reactions`)."""
+        return _sparse_reactions(U, self.nz, self.GT, self.cols)
+
+
+def _sparse_rows(G: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The coordinates a reaction map G (n_r, n_dof) touches, (n_nz,); its rows there, G^T
+    (n_nz, n_r); and per such row the column range [c0, c1) of its non-zeros (the reactions of
+    the tower(s) next to that coordinate), (n_nz, 2)."""
+    nz = np.flatnonzero(np.any(G != 0.0, axis=0))
+    GT = np.ascontiguousarray(G.T[nz])
+    on = GT != 0.0
+    c0 = np.argmax(on, axis=1)
+    c1 = GT.shape[1] - np.argmax(on[:, ::-1], axis=1)
+    return nz, GT, np.stack([c0, c1], axis=1)
+
+
+def _sparse_reactions(U: np.ndarray, nz: np.ndarray, GT: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """[N] G u for vectors U (..., n_dof) -> (..., n_r), accumulated coordinate by coordinate in
+    a fixed order: elementwise only, so every realization's reactions are bit-identical whatever
+    else shares the array (no BLAS blocking).  Each coordinate updates only the columns where
+    its row is non-zero (issue 20: O(n) instead of O(n^2) on a long line); the skipped terms are
+    exact zeros, so the sums are the same bits as over every column."""
+    out = np.zeros(U.shape[:-1] + (GT.shape[1],))
+    for d, g, (a, b) in zip(nz, GT, cols):
+        out[..., a:b] += U[..., d, None] * g[a:b]
+    return out
 
 
 def st_rotate(X: np.ndarray, old: _Stepper | None, new: _Stepper) -> np.ndarray:

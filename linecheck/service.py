@@ -219,14 +219,15 @@ def reference_state_index(case: Case, mean: MeanStates) -> int:
     return int(np.argmax(np.abs(mean.reactions_wind[:, j, :]).max(axis=1)))
 
 
-def damping_matrices(case: Case, st: StaticResult, models: list, states: list[int] | None = None) -> np.ndarray:
+def damping_matrices(case: Case, st: StaticResult, models: list, states: list[int] | None = None,
+                     omega1: float | None = None) -> np.ndarray:
     """Damping of mean states [N s/m], upper band storage, shape (len(models), 6, n_dof).
 
     ``models[i]`` is the model of mean state ``states[i]`` (default: all states in order).
     Aerodynamic (``analysis.damping``) plus stiffness-proportional structural damping
-    calibrated at the lowest mode of the reference mean state (docs/method.md, damping).
+    calibrated at the lowest mode of the reference mean state (docs/method.md, damping), or
+    at ``omega1`` [rad/s] when given (a window of a long line keeps the whole line's).
     """
-    from .core.modes import natural_modes
 
     system, mean = st.system, st.mean
     states = list(range(len(models))) if states is None else list(states)
@@ -234,11 +235,20 @@ def damping_matrices(case: Case, st: StaticResult, models: list, states: list[in
     C = aerodynamic_damping_stack(case, models, vn[states], mean.nodes[states])  # all states in one pass
     zs = case.analysis.structural_ratio
     if zs > 0:
-        k_ref = reference_state_index(case, mean)
-        ref = models[states.index(k_ref)] if k_ref in states else build_model(system, mean.state(k_ref))
-        w1 = 2 * np.pi * float(natural_modes(ref, 1).frequencies_hz[0])
-        C = C + stiffness_proportional_stack(models, zs, w1)
+        if omega1 is None:
+            k_ref = reference_state_index(case, mean)
+            ref = models[states.index(k_ref)] if k_ref in states else build_model(system, mean.state(k_ref))
+            omega1 = structural_omega1(ref)
+        C = C + stiffness_proportional_stack(models, zs, omega1)
     return C
+
+
+def structural_omega1(ref) -> float:
+    """[rad/s] the lowest natural circular frequency of the reference state's model ``ref``, at
+    which the structural damping is calibrated (dense up to 600 DOFs, sparse above)."""
+    from .core.modes import lowest_frequency_hz
+
+    return 2 * np.pi * lowest_frequency_hz(ref)
 
 
 BURN_IN_DECAY = np.log(100.0)  # transient amplitude down to 1 %: t = ln(100) / (zeta omega)
@@ -275,15 +285,15 @@ class SynopticModel:
     modes: object
 
 
-def synoptic_model(case: Case, st: StaticResult, *, vectors: bool = True) -> SynopticModel:
+def synoptic_model(case: Case, st: StaticResult, *, vectors: bool = True, omega1: float | None = None) -> SynopticModel:
     """Model, damping, load per unit turbulence (Eq. 5) and complex modes of the synoptic state
     (with eigenvectors when ``vectors``: the burn-in and the modal superposition of the
-    frequency-domain check need them)."""
+    frequency-domain check need them); ``omega1`` [rad/s]: see :func:`damping_matrices`."""
     from .core.spectral import complex_modes
 
     system = st.system
     model = build_model(system, st.mean.state(0))
-    damping = damping_matrices(case, st, [model])[0]
+    damping = damping_matrices(case, st, [model], omega1=omega1)[0]
     vn = to_global_nodes(system, st.wind.normal)[0]
     line, wind = case.line, case.wind
     a = wind.air_density * line.drag_coefficient * line.diameter * model.tributary * vn  # Eq. 5 per unit v
@@ -332,6 +342,110 @@ def burn_in(case: Case, sm: SynopticModel) -> BurnIn:
     else:
         used, src = min(required, BURN_IN_MAX_FACTOR * duration), "derived from the least-damped significant mode"
     return BurnIn(float(used), required, f1, z1, bool(used >= required), src)
+
+
+# ---- long lines: the synoptic burn-in and the frequency-domain check on windows (issue 20)
+CHECK_WINDOW_MIN_SPANS = budget.WINDOW_SPANS  # lines with more spans (20): burn-in and check on windows around the tower of interest
+CHECK_WINDOW_HALVES = (6, 8, 10, 12, 16, 20, 24, 32, 48, 64, 96, 128)  # spans each side, tried in turn
+BURN_IN_WINDOW_HALF = 8  # the burn-in of a long line: the modes of the 16-span window
+CHECK_WINDOW_RTOL = 0.005  # accept a window when the estimate moved by less than this from the previous one
+
+
+@dataclass(frozen=True)
+class CheckWindow:
+    """The part of a long line on which the frequency-domain check ran (issue 20).
+
+    Attributes:
+        spans: spans of the window; first_tower: 0-based index (in the whole line) of its
+            first tower; estimated_error: [-] per reaction (R_x, R_y, R_z), the relative change
+            of the estimate (largest of the dynamic peak and the fluctuating r.m.s.) from the
+            previous, smaller window -- the run-time error estimate of the reduction, shape (3,);
+        windows: spans of every window tried, in order.
+    """
+
+    spans: int
+    first_tower: int
+    estimated_error: np.ndarray
+    windows: tuple[int, ...]
+
+
+def windowed(case: Case) -> bool:
+    """True when the synoptic burn-in and check of ``case`` run on windows (a line of more than
+    :data:`CHECK_WINDOW_MIN_SPANS` spans; docs/method.md "Long lines")."""
+    return case.wind.type == "synoptic" and case.line.spans > CHECK_WINDOW_MIN_SPANS
+
+
+def window_case(case: Case, system: LineSystem, half: int) -> tuple[Case, int, bool] | None:
+    """The sub-line of ``half`` spans each side of the tower of interest (clipped at the strain
+    towers that bound its strain section), cut at strain towers, with everything else as in
+    ``case``; the index of its first tower in the whole line; and whether it is exact (the whole
+    strain section: strain towers are pinned, so the rest of the line does not move it).  None
+    when the window is the whole line.
+
+    The cut ends hold the conductor at its clipped-in clamp points (a strain tower); a section
+    window is re-framed on its own first span (stations from 0, the wind direction turned by
+    that span's heading, the reference height pinned to the whole line's), so every node keeps
+    its height, its plan position relative to the tower of interest and its wind."""
+    from .core.wind.mean import reference_height
+
+    line, wind = case.line, case.wind
+    j = line.tower_of_interest - 1
+    strain = [i for i, sp in enumerate(line.supports) if sp == "strain"]  # the two ends at least
+    lo, hi = max(i for i in strain if i < max(j, 1)), min(i for i in strain if i > min(j, line.n_towers - 2))
+    if j in (0, line.n_towers - 1):  # an end tower: its one strain section
+        lo, hi = (0, hi) if j == 0 else (lo, j)
+    a, b = max(lo, j - half), min(hi, j + half)
+    if a == 0 and b == line.n_towers - 1:
+        return None
+    sup = ("strain",) + tuple(line.supports[a + 1:b]) + ("strain",)
+    if wind.span_speeds is not None:
+        wind = dataclasses.replace(wind, span_speeds=tuple(wind.span_speeds[a:b]))
+    if line.is_section:
+        s0 = line.towers[a].station
+        tw = [dataclasses.replace(t, station=t.station - s0) for t in line.towers[a:b + 1]]
+        for k in (0, -1):
+            tw[k] = dataclasses.replace(tw[k], support="strain", angle=0.0, insulator_length=None)
+        new = dataclasses.replace(line, spans=b - a, supports=sup, tower_of_interest=j - a + 1, towers=tuple(tw))
+        d = wind.direction + float(np.degrees(system.span_headings[a]))  # global frame: x along the first span
+        wind = dataclasses.replace(wind, direction=(d + 180.0) % 360.0 - 180.0, reference_height=reference_height(case))
+    else:
+        new = dataclasses.replace(line, spans=b - a, supports=sup, tower_of_interest=j - a + 1)
+    return dataclasses.replace(case, line=new, wind=wind), a, (a, b) == (lo, hi)
+
+
+def _window_models(case: Case, st: StaticResult, half: int, cache: dict | None):
+    """(window case, its static result, its synoptic model, first tower, exact) of ``half``, or
+    None for the whole line (:func:`window_case`); memoised in ``cache``."""
+    cache = {} if cache is None else cache
+    if half in cache:
+        return cache[half]
+    w = window_case(case, st.system, half)
+    out = None
+    if w is not None:
+        wc, a, exact = w
+        wst = _static_analysis(wc)
+        if "omega1" not in cache:  # structural damping: calibrated on the whole line, as the time domain
+            cache["omega1"] = (structural_omega1(build_model(st.system, st.mean.state(0)))
+                               if case.analysis.structural_ratio > 0 else None)
+        out = (wc, wst, synoptic_model(wc, wst, omega1=cache["omega1"]), a, exact)
+    cache[half] = out
+    return out
+
+
+def synoptic_burn_in(case: Case, st: StaticResult, sm: SynopticModel | None = None,
+                     cache: dict | None = None) -> BurnIn:
+    """:func:`burn_in` of a synoptic case; a long line's (:func:`windowed`) from the modes of the
+    window of :data:`BURN_IN_WINDOW_HALF` spans each side of the tower of interest (the modes
+    that matter there), never from a dense eigenproblem of the whole line."""
+    if windowed(case):
+        w = _window_models(case, st, BURN_IN_WINDOW_HALF, cache)
+        if w is not None:
+            wc, _, wsm, _, _ = w
+            b = burn_in(wc, wsm)
+            if case.analysis.burn_in is None and case.analysis.damping != "paper":
+                b = dataclasses.replace(b, source=f"{b.source}, in the {wc.line.spans}-span window around the tower of interest")
+            return b
+    return burn_in(case, sm if sm is not None else synoptic_model(case, st))
 
 
 def _state_of_step(mean_times: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -502,8 +616,10 @@ def run_case(
     damping = damping_matrices(case, st, models)
     # complex modes with eigenvectors: the burn-in tells significant modes apart with them
     # (issue 10) and the frequency-domain check sums them (modal superposition)
-    sm = synoptic_model(case, st) if wind.type == "synoptic" else None
-    burn = burn_in(case, sm) if sm is not None else BurnIn(
+    synoptic = wind.type == "synoptic"
+    windows: dict = {}  # long lines: window models shared by the burn-in and the check (issue 20)
+    sm = synoptic_model(case, st) if synoptic and not windowed(case) else None
+    burn = synoptic_burn_in(case, st, sm, windows) if synoptic else BurnIn(
         0.0, 0.0, float("nan"), float("nan"), True, "none: a downburst starts from a weak running mean")
     if burn.seconds > 0:  # the derived burn-in lengthens the record: check the budget again
         check_budget(case, "run", warn=None if warned else warn, realizations=int(real.size),
@@ -513,29 +629,6 @@ def run_case(
     state_of_step, bracket, weights = _state_of_step(mean.time, t)
     check_cancel()
 
-    # ---- fluctuating load F_w = rho C_d D L_e V_m v (paper Eq. 5), normal components
-    if progress is not None:
-        progress("wind", 0, 1)
-    vn, vl = record_mean_wind(case, st, t)
-    v = fluctuating_velocity(case, system, t, list(real))  # (n_real, n_steps, n_nodes), along-wind
-    loads, direct = fluctuating_loads(case, system, models[0], t, v, vn, vl)
-    if progress is not None:
-        progress("wind", 1, 1)
-    check_cancel()
-    del v
-    second = None
-    if case.analysis.tension == "second-order":
-        from .core.second_order import second_order_operator
-
-        second = [second_order_operator(m, mean.state(k)) for k, m in enumerate(models)]
-    cb = None if progress is None else (lambda d, n: progress("steps 2-3: dynamics", d, n))
-    resp = integrate(models, damping, state_of_step, loads, dt, direct=direct,
-                     model_at=_interpolated_models(case, st, bracket, weights) if interpolate_states else None,
-                     second_order=second, second_order_start=int(np.argmax(keep)), progress=cb, cancel=cancel,
-                     load_dirs=None if system.straight_in_plan else system.node_normals[models[0].dofs.free_nodes])
-    # every reaction from here on in its tower's own frame (issue 17; a straight line: the global frame)
-    resp = DynamicResponse(system.to_tower_frames(resp.fluctuating), system.to_tower_frames(resp.background))
-
     # ---- mean M(t): step-1 reactions interpolated to the record grid (wind-induced)
     rw = system.to_tower_frames(mean.reactions_wind)  # (n_k, n_towers, 3)
     if mean.time.size == 1:
@@ -544,17 +637,59 @@ def run_case(
         flat = rw.reshape(rw.shape[0], -1)
         M = np.stack([np.interp(t, mean.time, flat[:, i]) for i in range(flat.shape[1])], axis=1).reshape(
             (t.size,) + rw.shape[1:])
-    Bk, Rk = resp.background[:, keep], resp.resonant[:, keep]
     gL = case.g_yp * system.eq17_lengths if system.is_section else case.g_yp_L  # Eq. 17 per tower (issue 17)
-    stats = compute_statistics(M[keep], Bk, Rk, system.to_tower_frames(mean.still_air.reactions), gL,
-                               window=peak_window_steps(case))
     j = case.line.tower_of_interest - 1
-    spectral = spectral_analysis(case, static=st, synoptic=sm) if sm is not None and spectral_check else None
+    vn, vl = record_mean_wind(case, st, t)
+    second = None
+    if case.analysis.tension == "second-order":
+        from .core.second_order import second_order_operator
+
+        second = [second_order_operator(m, mean.state(k)) for k, m in enumerate(models)]
+    load_dirs = None if system.straight_in_plan else system.node_normals[models[0].dofs.free_nodes]
+    model_at = _interpolated_models(case, st, bracket, weights) if interpolate_states else None
+
+    # ---- realizations in chunks that fit in memory (issue 20: long lines): every realization's
+    # turbulence, Newmark columns and statistics are its own, so chunking changes no bit
+    chunk = budget.realization_chunk(case, t.size)
+    parts_stats, parts_B, parts_R = [], [], []
+    n_chunks = -(-real.size // chunk)
+    for ci in range(n_chunks):
+        rc = real[ci * chunk:(ci + 1) * chunk]
+        # ---- fluctuating load F_w = rho C_d D L_e V_m v (paper Eq. 5), normal components
+        if progress is not None:
+            progress("wind", ci, n_chunks)
+        v = fluctuating_velocity(case, system, t, list(rc))  # (n_real, n_steps, n_nodes), along-wind
+        loads, direct = fluctuating_loads(case, system, models[0], t, v, vn, vl)
+        if progress is not None:
+            progress("wind", ci + 1, n_chunks)
+        check_cancel()
+        del v
+        cb = None if progress is None else (
+            lambda d, n, ci=ci: progress("steps 2-3: dynamics", ci * n + d, n_chunks * n))
+        resp = integrate(models, damping, state_of_step, loads, dt, direct=direct, model_at=model_at,
+                         second_order=second, second_order_start=int(np.argmax(keep)), progress=cb, cancel=cancel,
+                         load_dirs=load_dirs)
+        del loads, direct
+        # every reaction from here on in its tower's own frame (issue 17; a straight line: the global frame)
+        resp = DynamicResponse(system.to_tower_frames(resp.fluctuating), system.to_tower_frames(resp.background))
+        Bk, Rk = resp.background[:, keep], resp.resonant[:, keep]
+        del resp
+        parts_stats.append(compute_statistics(M[keep], Bk, Rk, system.to_tower_frames(mean.still_air.reactions), gL,
+                                              window=peak_window_steps(case)))
+        parts_B.append(Bk[:, :, j, :].copy())
+        parts_R.append(Rk[:, :, j, :].copy())
+        del Bk, Rk
+    stats = parts_stats[0] if n_chunks == 1 else Statistics.concatenate(parts_stats)
+    spectral = (spectral_analysis(case, static=st, synoptic=sm, windows=windows)
+                if synoptic and spectral_check else None)
     return RunResult(
         case=case, system=system, static=st, realizations=real, time=t[keep], mean=M[keep],
-        background=Bk[:, :, j, :].copy(), resonant=Rk[:, :, j, :].copy(), stats=stats,
+        background=parts_B[0] if n_chunks == 1 else np.concatenate(parts_B),
+        resonant=parts_R[0] if n_chunks == 1 else np.concatenate(parts_R), stats=stats,
         spectral=spectral, burn_in=burn,
     )
+
+
 
 
 @dataclass(frozen=True)
@@ -731,7 +866,7 @@ def record_grid(case: Case, st: StaticResult | None = None) -> tuple[np.ndarray,
     dt = case.analysis.time_step
     burn = 0.0
     if case.wind.type == "synoptic":
-        burn = burn_in(case, synoptic_model(case, st)).seconds
+        burn = synoptic_burn_in(case, st).seconds
     if burn > 0:
         t = t[0] - dt * np.round(burn / dt) + dt * np.arange(t.size + int(np.round(burn / dt)))
     return t, float(burn)
@@ -844,7 +979,9 @@ class SpectralResult:
 
     ``exact``: estimate 1 (linear random vibration of the step-1 model), reactions
     (R_x, R_y, R_z) at the tower of interest; ``davenport``: estimate 2 for the
-    transverse reaction (closed form) and whether it is within 15 % of estimate 1.
+    transverse reaction (closed form) and whether it is within 15 % of estimate 1;
+    ``window``: for a long line, the window estimate 1 ran on and its estimated error
+    (None: the whole line).
     """
 
     case: Case
@@ -852,14 +989,22 @@ class SpectralResult:
     davenport: "DavenportEstimate"
     davenport_applicable: bool
     davenport_note: str
+    window: CheckWindow | None = None
 
 
 DAVENPORT_TOLERANCE = 0.15  # issue 5: estimate 2 shown only where within 15 % of estimate 1
 
 
 def spectral_analysis(case: Case, *, static: StaticResult | None = None,
-                      synoptic: SynopticModel | None = None, warn: Warn | None = None) -> SpectralResult:
-    """Frequency-domain estimates for a synoptic case (same model and damping as the time domain)."""
+                      synoptic: SynopticModel | None = None, warn: Warn | None = None,
+                      windows: dict | None = None) -> SpectralResult:
+    """Frequency-domain estimates for a synoptic case (same model and damping as the time domain).
+
+    A long line (:func:`windowed`) gets estimate 1 on windows of ``CHECK_WINDOW_HALVES`` spans
+    each side of the tower of interest, widened until the estimate moves by less than
+    :data:`CHECK_WINDOW_RTOL` (the last change is reported as the estimated error) or the
+    window is the whole line; the mean reaction is always the whole line's step 1.
+    ``windows``: memo of the window models shared with :func:`synoptic_burn_in`."""
     from .core.errors import CaseError
     from .core.spectral import davenport_gust_factor, random_vibration
     from .core.wind.turbulence import length_scale
@@ -871,7 +1016,6 @@ def spectral_analysis(case: Case, *, static: StaticResult | None = None,
         check_budget(case, "spectral", warn=warn)
     st = static if static is not None else _static_analysis(case)
     mean = st.mean
-    sm = synoptic if synoptic is not None else synoptic_model(case, st)  # same model as the time domain
     line, wind = case.line, case.wind
     t = record_time(case)
     j = case.line.tower_of_interest - 1
@@ -881,17 +1025,45 @@ def spectral_analysis(case: Case, *, static: StaticResult | None = None,
 
     tol = ZERO_MEAN_RTOL * float(np.abs(rw[0]).max())
     L_u = length_scale(case)
-    exact = random_vibration(
-        sm.model, sm.damping, sm.load_per_v, mean_r, j, modes=sm.modes, sigma=wind.turbulence_intensity * wind.v_ref, length_scale=L_u,
-        v_mean=wind.v_ref, coherence_decay=wind.coherence_decay, duration=float(t[-1] - t[0]),
-        band=(1e-5, 0.5 / case.analysis.time_step), zero_mean_tol=tol,
-    )
+
+    def estimate(m: SynopticModel, tower: int):
+        return random_vibration(
+            m.model, m.damping, m.load_per_v, mean_r, tower, modes=m.modes, sigma=wind.turbulence_intensity * wind.v_ref,
+            length_scale=L_u, v_mean=wind.v_ref, coherence_decay=wind.coherence_decay, duration=float(t[-1] - t[0]),
+            band=(1e-5, 0.5 / case.analysis.time_step), zero_mean_tol=tol,
+        )
+
+    window = None
+    if not windowed(case):
+        exact = estimate(synoptic if synoptic is not None else synoptic_model(case, st), j)  # the time domain's model
+    else:
+        windows = {} if windows is None else windows
+        prev, tried = None, []
+        for half in CHECK_WINDOW_HALVES:
+            w = _window_models(case, st, half, windows)
+            if w is None:  # the window reached the whole line: the exact estimate
+                exact = estimate(synoptic if synoptic is not None else synoptic_model(case, st), j)
+                window = None
+                break
+            wc, _, wsm, a, whole_section = w
+            exact = estimate(wsm, j - a)
+            tried.append(wc.line.spans)
+            if whole_section:  # the strain section of the tower of interest: exact
+                window = CheckWindow(wc.line.spans, a, np.zeros(3), tuple(tried))
+                break
+            if prev is not None:
+                err = np.maximum(_relative_change(exact.peak_dynamic, prev.peak_dynamic),
+                                 _relative_change(exact.rms_fluctuating, prev.rms_fluctuating))
+                window = CheckWindow(wc.line.spans, a, err, tuple(tried))
+                if float(err.max()) <= CHECK_WINDOW_RTOL:
+                    break
+            prev = exact
     reason = closed_form_not_applicable(case, st.system)
     if reason:
         from .core.spectral import DavenportEstimate
 
         nan = float("nan")
-        return SpectralResult(case, exact, DavenportEstimate(*([nan] * 9)), False, f"not applicable: {reason}")
+        return SpectralResult(case, exact, DavenportEstimate(*([nan] * 9)), False, f"not applicable: {reason}", window)
     H = float(mean.tension[0].mean())
     mu = line.mass_per_length
     span = st.system.common_span_length  # the closed form is for equal spans
@@ -911,7 +1083,13 @@ def spectral_analysis(case: Case, *, static: StaticResult | None = None,
         note = (f"within {100 * diff:.0f} % of the exact estimate" if ok else
                 f"differs by {100 * diff:.0f} % from the exact estimate (> 15 %): the closed form's uniform "
                 "influence line and single mode do not represent this system; use estimate 1")
-    return SpectralResult(case, exact, dav, ok, note)
+    return SpectralResult(case, exact, dav, ok, note, window)
+
+
+def _relative_change(new: np.ndarray, old: np.ndarray) -> np.ndarray:
+    """|new - old| / |new| per component, a component below 1e-6 of the largest scaled by the largest [-]."""
+    scale = np.maximum(np.abs(new), 1e-6 * float(np.abs(new).max()) + 1e-300)
+    return np.abs(new - old) / scale
 
 
 def closed_form_not_applicable(case: Case, system: LineSystem) -> str:

@@ -183,8 +183,9 @@ def test_huge_realization_override_exits_2_with_the_estimate_before_computing(mo
     r = cli("run", str(PAPER / "case01-single.toml"), "-n", "1000000000")
     out = " ".join(r.output.split())
     assert r.exit_code == 2, out
-    # 1e9 realizations x 12001 steps x 11 nodes x 8 bytes x 4 arrays = 4.2e15 bytes
-    assert "run needs about 4.22 PB of memory" in out and "--max-memory" in out
+    # realizations run in memory-sized chunks (issue 20), but the result keeps B and R at the
+    # tower of interest of every one: 1e9 x 12001 steps x 6 doubles x 8 bytes = 5.76e14 bytes
+    assert "run needs about 577 TB of memory" in out and "--max-memory" in out
 
 
 def test_overrides_are_validated_like_the_file():
@@ -236,9 +237,13 @@ def test_parse_size():
 def test_with_values_keeps_large_legal_case_refused_by_the_guard_not_the_schema():
     case = with_values(load_case(PAPER / "case09-single.toml"), {"analysis.realizations": 10000})
     est = budget.estimate(case)
-    # 4 arrays x 8 bytes x 1e4 x 12001 x 11 nodes + 8 x 8 x 12001 x 11 + 100 MB + one state of
+    # realizations in chunks of 1 GB / (12001 steps x 8 bytes x (3 x 11 nodes + 24 x 2 towers)) = 128
+    # (issue 20): 4 arrays x 8 bytes x 128 x 12001 x 11 nodes + 8 x 8 x 12001 x 11, what the result
+    # keeps of all 1e4 (6 doubles per step, 45 statistics per tower), + 100 MB + one state of
     # 27 DOF (33 less the 6 of the two pinned strain towers) + 7 dense 27 x 27 matrices
-    expect = 4 * 8 * 1e4 * 12001 * 11 + 8 * 8 * 12001 * 11 + 100e6 + (20 * 8 * 27 + 3e3) + 7 * 27**2 * 8
+    assert budget.realization_chunk(case, 12001) == 128
+    expect = (4 * 8 * 128 * 12001 * 11 + 8 * 8 * 12001 * 11 + 6 * 8 * 1e4 * 12001 + 45 * 8 * 1e4 * 2
+              + 100e6 + (20 * 8 * 27 + 3e3) + 7 * 27**2 * 8)
     assert est.memory == pytest.approx(expect, rel=1e-12)
 
 

@@ -52,6 +52,7 @@ T_STATE = 5e-5  # per mean state x DOF (Newton iterations of step 1)
 T_DENSE = 1.5e-9  # per DOF^3 (dense eigensolvers of the condensed model)
 T_SPECTRAL = 2e-9  # per frequency-grid point x node^2 (random-vibration quadrature)
 SPECTRAL_POINTS = 2000  # frequency-grid points of the spectral check (order of magnitude)
+WINDOW_SPANS = 20  # lines longer than this: burn-in and check on windows of about this many spans
 
 
 @dataclass(frozen=True)
@@ -149,6 +150,20 @@ def record_steps(case: Case, burn_in: float = 0.0) -> int:
     return int(math.floor((t1 - t0 + burn_in) / dt + 1e-9)) + 1
 
 
+RUN_CHUNK_BYTES = 1.0e9  # [bytes] realizations of one run are integrated in chunks of about this size
+
+
+def realization_chunk(case: Case, n_steps: int) -> int:
+    """Realizations integrated together [-] (``service.run_case``): all of them unless their
+    whole-record arrays (turbulence, loads and work arrays per node, reaction histories per
+    tower: about 3 n_nodes + 24 n_towers doubles per step and realization) exceed
+    :data:`RUN_CHUNK_BYTES` (issue 20)."""
+    line = case.line
+    n_nodes = line.spans * line.elements_per_span + 1
+    per = float(n_steps) * F8 * (3 * n_nodes + 24 * (line.spans + 1))
+    return max(1, int(RUN_CHUNK_BYTES // per))
+
+
 def _dense(n_dof: int) -> tuple[float, float]:
     return DENSE_ARRAYS * n_dof**2 * F8, T_DENSE * float(n_dof) ** 3
 
@@ -176,19 +191,28 @@ def estimate(case: Case, job: str = "run", *, realizations: int | None = None, b
         parts["mean states"] = n_k * (STATE_BYTES_PER_DOF * n_dof + STATE_OVERHEAD)
         secs += n_k * (T_STATE0 + T_STATE * n_dof)
     # dense condensation: synoptic runs (burn-in, spectral), modes, structural-damping calibration
-    dense_needed = job in ("modes", "spectral") or (job == "run" and (synoptic or a.structural_ratio > 0))
+    # (above 600 DOFs the calibration is sparse); a long synoptic line's burn-in and check run on
+    # windows of at most about WINDOW_SPANS spans (issue 20, service.CHECK_WINDOW_*)
+    windowed = synoptic and case.line.spans > WINDOW_SPANS and job != "modes"
+    n_dense = min(n_dof, 3 * (WINDOW_SPANS * case.line.elements_per_span - 1)) if windowed else n_dof
+    dense_needed = job in ("modes", "spectral") or (job == "run" and (synoptic or (a.structural_ratio > 0 and n_dof <= 600)))
     if dense_needed:
-        mem, t = _dense(n_dof)
+        mem, t = _dense(n_dense)
         parts["dense matrices"] = mem
-        secs += t
+        secs += t * (3.0 if windowed else 1.0)  # two or three windows
     if job == "run":
-        parts["time histories"] = REC_ARRAYS * F8 * float(n_real) * n_steps * n_nodes + STEP_ARRAYS * F8 * n_steps * n_nodes
+        held = min(n_real, realization_chunk(case, n_steps))  # realizations in memory at once
+        # the chunk's whole-record arrays, plus what the result keeps of every realization: B and R
+        # at the tower of interest (6 doubles per step) and 15 statistics per tower and reaction
+        parts["time histories"] = (REC_ARRAYS * F8 * float(held) * n_steps * n_nodes + STEP_ARRAYS * F8 * n_steps * n_nodes
+                                   + 6 * F8 * float(n_real) * n_steps + 45 * F8 * float(n_real) * (case.line.spans + 1))
         secs += n_steps * T_STEP + float(n_real) * n_steps * (T_NEWMARK * n_dof + T_SYNTH * n_nodes)
     if job == "wind":
         parts["time histories"] = STEP_ARRAYS * F8 * n_steps * n_nodes
         secs += n_steps * T_SYNTH * n_nodes
     if job == "spectral" or (job == "run" and synoptic and spectral_check):
-        secs += T_SPECTRAL * SPECTRAL_POINTS * float(n_nodes) ** 2
+        n_check = n_dense // 3 if windowed else n_nodes
+        secs += T_SPECTRAL * SPECTRAL_POINTS * float(n_check) ** 2 * (3.0 if windowed else 1.0)
     memory = sum(parts.values())
     dominant = max(parts, key=parts.get)
     return Estimate(job, memory, secs, n_steps, n_nodes, n_dof, n_real, n_k, dominant)

@@ -53,3 +53,24 @@ def natural_modes(model: LinearModel, n_modes: int = 20) -> Modes:
     shapes[:, free, :] = phi.T.reshape(n, free.size, 3)
     system = model.system
     return Modes(freq, shapes, None if system.straight_in_plan else system.node_frames)
+
+
+def lowest_frequency_hz(model: LinearModel) -> float:
+    """[Hz] the lowest undamped natural frequency of ``model``.
+
+    Up to :data:`~linecheck.core.model.SPARSE_CONDENSATION_DOF` DOFs: :func:`natural_modes`
+    (dense).  Larger systems (issue 20: long lines): shift-invert Lanczos (ARPACK via
+    ``scipy.sparse.linalg.eigsh``; Ericsson & Ruhe 1980) on the sparse banded K and lumped M
+    about sigma = 0, O(n): the insulator-axial DOFs carry no mass, so M is only semi-definite,
+    which shift-invert allows, and their infinite eigenvalues map to 0 (the same lowest mode as
+    the condensed problem, whose condensation is exact for massless DOFs)."""
+    from .model import SPARSE_CONDENSATION_DOF, band_to_sparse
+
+    if model.mass.size <= SPARSE_CONDENSATION_DOF:
+        return float(natural_modes(model, 1).frequencies_hz[0])
+    from scipy.sparse.linalg import eigsh
+
+    K = band_to_sparse(model.K_band).tocsc()
+    M = band_to_sparse(model.M_band).tocsc()
+    w2 = eigsh(K, k=1, M=M, sigma=0.0, which="LM", v0=np.ones(K.shape[0]), tol=0.0, return_eigenvectors=False)
+    return float(np.sqrt(max(float(w2[0]), 0.0)) / (2 * np.pi))

@@ -392,6 +392,13 @@ def _spectral(cur: Cursor, doc: RunDocument, sp) -> None:
     cur.put(cur.row, 3, sp.band_hz[0], fmt="0.00E+00")
     cur.put(cur.row, 4, sp.band_hz[1], fmt="0.00")
     cur.row += 1
+    if sp.window is not None:  # a long line: estimate 1 on a window around the tower of interest (issue 20)
+        w = sp.window
+        cur.put(cur.row, 1, f"window: {w['spans']} spans from tower {w['first_tower']}; estimated error", "lc_text")
+        cur.put(cur.row, 2, "-", "lc_text")
+        for c, r in enumerate(("Rx", "Ry", "Rz")):
+            cur.put(cur.row, 3 + c, w["estimated_error"][r], fmt="0.00%")
+        cur.row += 1
     cur.row += 1
     cur.put(cur.row, 1, "Estimate 1: exact linear random vibration (frequency) vs time domain", "lc_label")
     align(cur.ws.cell(row=cur.row, column=1), horizontal="left")

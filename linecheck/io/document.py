@@ -302,7 +302,9 @@ class Davenport(_Block):
 @dataclass(frozen=True)
 class Spectral(_Block):
     """Frequency-domain check: record duration [s], band [Hz], exact linear random vibration per
-    reaction (``exact[R][key]``, N or -), the Davenport closed form, and the sanity check."""
+    reaction (``exact[R][key]``, N or -), the Davenport closed form, the sanity check, and for a
+    long line the window the check ran on (``window``: ``spans``, ``first_tower`` 1-based,
+    ``estimated_error`` per reaction [-], ``windows`` tried; absent for the whole line)."""
 
     duration: float | None
     band_hz: list[float | None]
@@ -311,18 +313,22 @@ class Spectral(_Block):
     davenport: Davenport
     not_applicable: dict[str, str]
     sanity_check: tuple[SanityItem, ...] | None = None
+    window: dict[str, Any] | None = None  # long lines (issue 20): spans, first_tower, estimated_error, windows
 
     def to_json(self) -> dict[str, Any]:
         d = super().to_json()
         if self.sanity_check is None:
             del d["sanity_check"]
+        if self.window is None:
+            del d["window"]
         return d
 
     @classmethod
     def from_json(cls, d: dict[str, Any]) -> Spectral:
         sc = d.get("sanity_check")
         return cls(d["duration"], d["band_hz"], d["n_frequencies"], d["exact"], Davenport.from_json(d["davenport"]),
-                   d["not_applicable"], None if sc is None else tuple(SanityItem.from_json(x) for x in sc))
+                   d["not_applicable"], None if sc is None else tuple(SanityItem.from_json(x) for x in sc),
+                   d.get("window"))
 
 
 @dataclass(frozen=True)

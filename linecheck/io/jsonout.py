@@ -280,10 +280,16 @@ def spectral_to_dict(sp: Any) -> dict[str, Any]:
         "Cont_R": _num(d.Cont_R) if sp.davenport_applicable else None,
         "GF_ASCE74": _num(d.GF_ASCE),
     }
-    return {"duration": _num(ex.duration), "band_hz": _num(list(ex.band)), "n_frequencies": ex.n_frequencies,
-            "exact": exact, "davenport": dav,
-            "not_applicable": {"Rx": "closed form ignores the longitudinal influence line",
-                               "Rz": "closed form ignores the vertical influence line"}}
+    out = {"duration": _num(ex.duration), "band_hz": _num(list(ex.band)), "n_frequencies": ex.n_frequencies,
+           "exact": exact, "davenport": dav,
+           "not_applicable": {"Rx": "closed form ignores the longitudinal influence line",
+                              "Rz": "closed form ignores the vertical influence line"}}
+    w = getattr(sp, "window", None)
+    if w is not None:  # a long line's check ran on a window (issue 20); absent for the whole line
+        out["window"] = {"spans": int(w.spans), "first_tower": int(w.first_tower) + 1,
+                         "estimated_error": {r: _num(w.estimated_error[c]) for c, r in enumerate(REACTIONS)},
+                         "windows": [int(x) for x in w.windows]}
+    return out
 
 
 def spectral_document(sp: Any) -> Any:
@@ -292,4 +298,4 @@ def spectral_document(sp: Any) -> Any:
 
     d = spectral_to_dict(sp)
     return Spectral(d["duration"], d["band_hz"], d["n_frequencies"], d["exact"], Davenport.from_json(d["davenport"]),
-                    d["not_applicable"])
+                    d["not_applicable"], None, d.get("window"))

@@ -179,3 +179,30 @@ def test_scan_paper_line_full_grid(tmp_path):
     ry, rx = res.critical("Ry"), res.critical("Rx")
     assert (ry.distance_over_dj, ry.angle) == pytest.approx((1.2, 0.0))
     assert (rx.distance_over_dj, rx.angle) == pytest.approx((1.4, 30.0))
+
+
+def test_scan_positions_share_the_unit_turbulence_bit_for_bit(monkeypatch):
+    """The unit turbulence depends on the nodes, V_ref, L_u, the seed and the record, not on where
+    the downburst is: a scan's positions reuse it from the per-process memo (issue 20), and the
+    velocity is the same bits as computed afresh with the memo off."""
+    from linecheck.batch.tasks import apply_changes, scan_changes
+    from linecheck.core.system import LineSystem
+    from linecheck.core.wind import turbulence as tb
+    from linecheck.service import record_time
+
+    case = load_case(CASES / "paper" / "case05-six.toml")
+    system = LineSystem(case.line)
+    t = record_time(case)
+    tb._memo.clear()
+    a = tb.fluctuating_velocity(case, system, t, [0, 1])
+    assert len(tb._memo) == 2
+    moved = apply_changes(case, scan_changes(900.0, 20.0, case.wind.downburst.jet_diameter))
+    b = tb.fluctuating_velocity(moved, system, t, [1])
+    assert len(tb._memo) == 2  # reused, not recomputed
+    assert not next(iter(tb._memo.values())).flags.writeable
+    monkeypatch.setattr(tb, "UNIT_FIELD_MEMO_BYTES", 0.0)
+    tb._memo.clear()
+    assert np.array_equal(a, tb.fluctuating_velocity(case, system, t, [0, 1]))
+    assert np.array_equal(b, tb.fluctuating_velocity(moved, system, t, [1]))
+    assert not np.array_equal(a[1], b[0])  # the running mean (the modulation) differs
+    assert len(tb._memo) == 0

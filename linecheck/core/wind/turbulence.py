@@ -43,6 +43,7 @@ Nothing here prints.
 from __future__ import annotations
 
 import math
+import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
@@ -413,6 +414,35 @@ def fluctuating_velocity(case: Case, system: LineSystem, time: np.ndarray, reali
     reals = list(realizations)
     out = np.empty((len(reals), n_steps, system.n_nodes))
     for i, r in enumerate(reals):
-        out[i] = unit_field(case, system, n_steps, dt, int(r))
+        out[i] = _unit_field_memo(case, system, n_steps, dt, int(r))
         out[i] *= a
     return out
+
+
+UNIT_FIELD_MEMO_BYTES = 256e6  # [bytes] unit fields kept per process for reuse (issue 20: scans)
+_memo: "dict[tuple, np.ndarray]" = {}
+_memo_lock = threading.Lock()
+
+
+def _unit_field_memo(case: Case, system: LineSystem, n_steps: int, dt: float, realization: int) -> np.ndarray:
+    """:func:`unit_field`, remembered per process (read-only, least recently used first out,
+    at most :data:`UNIT_FIELD_MEMO_BYTES`).  The unit field depends only on the node positions,
+    V_ref, L_u, the coherence decay, the seed, the realization and the record grid, not on the
+    running mean: a critical-downburst scan's positions share it (issue 20), and a repeated
+    run reuses it.  The same bits as computing it afresh (it is deterministic)."""
+    x = system.node_station if system.is_section else system.node_x0
+    key = (x.tobytes(), bool(system.is_section), float(case.wind.v_ref), float(length_scale(case)),
+           float(case.wind.coherence_decay), int(case.analysis.seed), realization, n_steps, dt)
+    with _memo_lock:
+        got = _memo.pop(key, None)
+        if got is not None:
+            _memo[key] = got  # most recently used last
+            return got
+    u = unit_field(case, system, n_steps, dt, realization)
+    if u.nbytes <= UNIT_FIELD_MEMO_BYTES / 4:
+        u.setflags(write=False)
+        with _memo_lock:
+            _memo[key] = u
+            while sum(v.nbytes for v in _memo.values()) > UNIT_FIELD_MEMO_BYTES:
+                _memo.pop(next(iter(_memo)))
+    return u

@@ -214,3 +214,20 @@ def test_realizations_in_chunks_are_bit_identical(monkeypatch, name, options):
     dyn = [x for x in seen if x[0] == "steps 2-3: dynamics"]
     assert dyn[-1][1] == dyn[-1][2] and all(a[1] <= b[1] for a, b in zip(dyn, dyn[1:]))  # one rising bar
     assert ("wind", 3, 3) in seen
+
+
+def test_window_text_is_shared_by_the_front_ends():
+    """CLI, TUI and the typed document give the same one-line account of the window; the whole
+    line gives none."""
+    from linecheck.io.document import Spectral
+    from linecheck.io.jsonout import spectral_to_dict
+
+    case = case_of("paper/case09-six.toml", realizations=1)
+    res = service.spectral_analysis(case)
+    whole = Spectral.from_json(spectral_to_dict(res))
+    assert whole.window_text() is None and "window" not in whole.to_json()
+    w = service.CheckWindow(16, 22, np.array([0.00424, 0.00019, 0.00031]), (12, 16))
+    doc = Spectral.from_json(spectral_to_dict(dataclasses.replace(res, window=w)))
+    assert doc.window_text() == ("long line: estimate 1 on the 16-span window from tower 23 (windows tried: "
+                                 "12, 16 spans); estimated error Rx 0.42 %, Ry 0.02 %, Rz 0.03 %")
+    assert Spectral.from_json(doc.to_json()) == doc

@@ -8,7 +8,7 @@ from rich.table import Table
 
 from .. import service
 from ..io.atomic import check_target
-from ..io.jsonout import spectral_to_dict, write_json
+from ..io.jsonout import spectral_document, spectral_to_dict, write_json
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .limits import warn as limits_warn
 
@@ -52,19 +52,12 @@ def spectral(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     console.print(spectral_table(doc, f"{case.name}: frequency-domain estimate 1 (exact linear random vibration), "
                                       f"tower {case.line.tower_of_interest}"))
     console.print(davenport_line(doc), highlight=False)
-    if doc.get("window"):
-        console.print(window_line(doc["window"]), highlight=False)
+    text = spectral_document(res).window_text()
+    if text:
+        console.print(text, highlight=False)
     if json_out is not None:
         write_json(json_out, doc)
         console.print(f"wrote {json_out}")
-
-
-def window_line(w: dict) -> str:
-    """One line on the window a long line's check ran on (issue 20)."""
-    err = w["estimated_error"]
-    return (f"long line: estimate 1 on the {w['spans']}-span window from tower {w['first_tower']} "
-            f"(windows tried: {', '.join(str(x) for x in w['windows'])} spans); estimated error "
-            + ", ".join(f"{r} {100 * (err[r] or 0.0):.2f} %" for r in ("Rx", "Ry", "Rz")))
 
 
 def print_sanity(doc: Any, *, explained: bool = False) -> None:
@@ -87,7 +80,7 @@ def print_sanity(doc: Any, *, explained: bool = False) -> None:
         f"[bold red]sanity check: {len(bad)} difference(s) larger than sampling error explains[/]")
     console.print(head + ": " + "; ".join(parts), highlight=False)
     if sp.window is not None:
-        console.print(window_line(sp.window), highlight=False)
+        console.print(sp.window_text(), highlight=False)
     if bad and not explained:
         console.print("[dim]A flagged resonant component usually means a lightly damped mode that the record "
                       "does not reach stationarity for (see docs/validation.md, damping).[/]")

@@ -323,6 +323,16 @@ class Spectral(_Block):
             del d["window"]
         return d
 
+    def window_text(self) -> str | None:
+        """One line on the window a long line's check ran on (issue 20), or None (whole line)."""
+        w = self.window
+        if w is None:
+            return None
+        err = w["estimated_error"]
+        return (f"long line: estimate 1 on the {w['spans']}-span window from tower {w['first_tower']} "
+                f"(windows tried: {', '.join(str(x) for x in w['windows'])} spans); estimated error "
+                + ", ".join(f"{r} {100 * (err[r] or 0.0):.2f} %" for r in ("Rx", "Ry", "Rz")))
+
     @classmethod
     def from_json(cls, d: dict[str, Any]) -> Spectral:
         sc = d.get("sanity_check")

@@ -336,6 +336,9 @@ def davenport_lines(doc: RunDocument) -> list[str]:
     else:
         out.append(f"closed form (Davenport/Castanheta), {d.reaction}: not shown - {d.note or 'not applicable'}")
     out += [f"closed form not applicable to {k}: {v}" for k, v in doc.spectral.not_applicable.items()]
+    window = doc.spectral.window_text()  # a long line's check ran on a window (issue 20)
+    if window:
+        out.append(window)
     return out
 
 

@@ -195,7 +195,8 @@ def estimate(case: Case, job: str = "run", *, realizations: int | None = None, b
     # windows of at most about WINDOW_SPANS spans (issue 20, service.CHECK_WINDOW_*)
     windowed = synoptic and case.line.spans > WINDOW_SPANS and job != "modes"
     n_dense = min(n_dof, 3 * (WINDOW_SPANS * case.line.elements_per_span - 1)) if windowed else n_dof
-    dense_needed = job in ("modes", "spectral") or (job == "run" and (synoptic or (a.structural_ratio > 0 and n_dof <= 600)))
+    dense_needed = (job == "spectral" or (job == "modes" and n_dof <= 600)  # above: sparse Lanczos
+                    or (job == "run" and (synoptic or (a.structural_ratio > 0 and n_dof <= 600))))
     if dense_needed:
         mem, t = _dense(n_dense)
         parts["dense matrices"] = mem

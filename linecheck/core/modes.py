@@ -39,7 +39,21 @@ class Modes:
 
 
 def natural_modes(model: LinearModel, n_modes: int = 20) -> Modes:
-    """The ``n_modes`` lowest undamped modes of ``model`` (dense symmetric eigensolver)."""
+    """The ``n_modes`` lowest undamped modes of ``model``.
+
+    Up to :data:`~linecheck.core.model.SPARSE_CONDENSATION_DOF` DOFs the dense symmetric
+    eigensolver of the condensed problem (module docstring).  Larger systems (issue 20: long
+    lines; the dense solver is O(n^3)): shift-invert Lanczos (ARPACK via
+    ``scipy.sparse.linalg.eigsh``; Ericsson & Ruhe 1980) on the sparse banded K and lumped M
+    about sigma = 0, O(n) per mode.  The insulator-axial DOFs carry no mass, so M is only
+    semi-definite, which shift-invert allows; their infinite eigenvalues map to 0, and the
+    modes are those of the condensed problem (whose condensation is exact for massless DOFs).
+    Its shapes are M-normalised with their largest component positive (the dense solver's
+    signs are LAPACK's)."""
+    from .model import SPARSE_CONDENSATION_DOF
+
+    if model.mass.size > SPARSE_CONDENSATION_DOF and n_modes < model.mass.size - len(model.axial_dof) - 1:
+        return _natural_modes_sparse(model, n_modes)
     c = condensed(model)
     m = np.diag(c.M)  # diagonal in the condensed coordinates (lumped mass)
     n = min(n_modes, m.size)
@@ -47,6 +61,12 @@ def natural_modes(model: LinearModel, n_modes: int = 20) -> Modes:
     A = c.K * s[:, None] * s[None, :]
     w2, psi = eigh(A, subset_by_index=[0, n - 1])
     phi = c.S @ (psi * s[:, None])  # back to the full DOFs, mass-normalised
+    return _modes(model, w2, phi)
+
+
+def _modes(model: LinearModel, w2: np.ndarray, phi: np.ndarray) -> Modes:
+    """:class:`Modes` from eigenvalues w2 [rad^2/s^2] (n,) and M-normalised free-DOF shapes (n_dof, n)."""
+    n = w2.size
     freq = np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi)
     shapes = np.zeros((n, model.system.n_nodes, 3))
     free = model.dofs.free_nodes
@@ -55,22 +75,24 @@ def natural_modes(model: LinearModel, n_modes: int = 20) -> Modes:
     return Modes(freq, shapes, None if system.straight_in_plan else system.node_frames)
 
 
-def lowest_frequency_hz(model: LinearModel) -> float:
-    """[Hz] the lowest undamped natural frequency of ``model``.
-
-    Up to :data:`~linecheck.core.model.SPARSE_CONDENSATION_DOF` DOFs: :func:`natural_modes`
-    (dense).  Larger systems (issue 20: long lines): shift-invert Lanczos (ARPACK via
-    ``scipy.sparse.linalg.eigsh``; Ericsson & Ruhe 1980) on the sparse banded K and lumped M
-    about sigma = 0, O(n): the insulator-axial DOFs carry no mass, so M is only semi-definite,
-    which shift-invert allows, and their infinite eigenvalues map to 0 (the same lowest mode as
-    the condensed problem, whose condensation is exact for massless DOFs)."""
-    from .model import SPARSE_CONDENSATION_DOF, band_to_sparse
-
-    if model.mass.size <= SPARSE_CONDENSATION_DOF:
-        return float(natural_modes(model, 1).frequencies_hz[0])
+def _natural_modes_sparse(model: LinearModel, n_modes: int) -> Modes:
+    """:func:`natural_modes` of a large system by shift-invert Lanczos (see there)."""
     from scipy.sparse.linalg import eigsh
+
+    from .model import band_to_sparse
 
     K = band_to_sparse(model.K_band).tocsc()
     M = band_to_sparse(model.M_band).tocsc()
-    w2 = eigsh(K, k=1, M=M, sigma=0.0, which="LM", v0=np.ones(K.shape[0]), tol=0.0, return_eigenvectors=False)
-    return float(np.sqrt(max(float(w2[0]), 0.0)) / (2 * np.pi))
+    w2, phi = eigsh(K, k=n_modes, M=M, sigma=0.0, which="LM", v0=np.ones(K.shape[0]), tol=0.0)
+    order = np.argsort(w2)
+    w2, phi = w2[order], phi[:, order]
+    phi = phi / np.sqrt(np.einsum("ik,ik->k", phi, M @ phi))  # M-normalised (M: the axially projected lumped mass)
+    big = np.argmax(np.abs(phi), axis=0)
+    phi = phi * np.sign(phi[big, np.arange(phi.shape[1])])
+    return _modes(model, w2, phi)
+
+
+def lowest_frequency_hz(model: LinearModel) -> float:
+    """[Hz] the lowest undamped natural frequency of ``model`` (:func:`natural_modes`: dense up
+    to 600 DOFs, shift-invert Lanczos above)."""
+    return float(natural_modes(model, 1).frequencies_hz[0])

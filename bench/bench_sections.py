@@ -6,7 +6,7 @@ Run from the repository root:
     .venv/bin/python bench/bench_sections.py --repeat 5 --realizations 4
 
 ``service.run_case`` (step 1, wind synthesis, steps 2-3; the frequency-domain check is off: its
-cost grows faster than the number of spans and is the speed issue's) of
+cost on long lines is the speed issue's, bench/bench_long.py) of
 
 - the baseline: paper case 9 on six equal spans (equal-span form, the paper's Appendix-A step 1),
 - the same six spans written as towers (section form: exact-span step 1, Markov coherence),

@@ -196,3 +196,19 @@ def test_unrefined_pole_gets_an_exclusion_zone():
     kappa = np.sqrt(spacing * f0 / (np.pi * z * f0) / spectral.EXCLUSION_RATIO)
     assert np.min(np.abs(pruned - f0)) >= kappa * z * f0
     assert pruned.size <= 300
+
+
+def test_structural_damping_product_without_dispatch_is_the_same_bits(monkeypatch):
+    """The step loop's C~_off (a1 u + v) calls scipy's CSR kernel directly (issue 20); a run with
+    quasi-steady damping (structural damping on: the remainder exists) gives the same bits as
+    with the public ``rest @ x`` product."""
+    from linecheck.core import dynamics
+
+    case = load_case(CASES / "examples" / "section-12span.toml")
+    case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, realizations=2, duration=60.0))
+    assert case.analysis.damping == "quasi-steady" and case.analysis.structural_ratio > 0
+    fast = service.run_case(case, spectral_check=False)
+    monkeypatch.setattr(dynamics, "_csr_matvecs", None)
+    slow = service.run_case(case, spectral_check=False)
+    assert np.array_equal(fast.background, slow.background)
+    assert np.array_equal(fast.resonant, slow.resonant)

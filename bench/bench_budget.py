@@ -10,6 +10,11 @@ calibrate the coefficients in budget.py from this table, never from a single run
 
 from __future__ import annotations
 
+import os
+
+# time fresh runs: a run synthesises its turbulence (the per-process memo serves scans; docs/wind.md)
+os.environ.setdefault("LINECHECK_UNIT_FIELD_MEMO", "0")
+
 import json
 import subprocess
 import sys

@@ -23,6 +23,11 @@ speed-up of the whole realization over the code before issue 20, whatever else c
 
 from __future__ import annotations
 
+import os
+
+# time fresh runs: a run synthesises its turbulence (the per-process memo serves scans; docs/wind.md)
+os.environ.setdefault("LINECHECK_UNIT_FIELD_MEMO", "0")
+
 import argparse
 import os
 import sys

@@ -12,6 +12,11 @@ with D_j/V_j and the cost of steps 2-3 with the record length, and R_x / g*_yp L
 
 from __future__ import annotations
 
+import os
+
+# time fresh runs: a run synthesises its turbulence (the per-process memo serves scans; docs/wind.md)
+os.environ.setdefault("LINECHECK_UNIT_FIELD_MEMO", "0")
+
 import argparse
 import os
 import sys

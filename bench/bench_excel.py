@@ -18,6 +18,11 @@ runs produce), for information: that size is the user's explicit choice.
 
 from __future__ import annotations
 
+import os
+
+# time fresh runs: a run synthesises its turbulence (the per-process memo serves scans; docs/wind.md)
+os.environ.setdefault("LINECHECK_UNIT_FIELD_MEMO", "0")
+
 import argparse
 import dataclasses
 import sys

@@ -13,6 +13,11 @@ in a fresh process, peak resident memory from ``ru_maxrss``).
 
 from __future__ import annotations
 
+import os
+
+# time fresh runs: a run synthesises its turbulence (the per-process memo serves scans; docs/wind.md)
+os.environ.setdefault("LINECHECK_UNIT_FIELD_MEMO", "0")
+
 import argparse
 import os
 import subprocess

@@ -53,6 +53,11 @@ and the script exits with status 2.
 
 from __future__ import annotations
 
+import os
+
+# time fresh runs: a run synthesises its turbulence (the per-process memo serves scans; docs/wind.md)
+os.environ.setdefault("LINECHECK_UNIT_FIELD_MEMO", "0")
+
 import argparse
 import dataclasses
 import json

@@ -21,6 +21,11 @@ no more per span than the six equal spans, and the time per span stays flat from
 
 from __future__ import annotations
 
+import os
+
+# time fresh runs: a run synthesises its turbulence (the per-process memo serves scans; docs/wind.md)
+os.environ.setdefault("LINECHECK_UNIT_FIELD_MEMO", "0")
+
 import argparse
 import dataclasses
 import os

@@ -12,6 +12,11 @@ same process, best of ``--repeat``; the table prints the ratio.
 
 from __future__ import annotations
 
+import os
+
+# time fresh runs: a run synthesises its turbulence (the per-process memo serves scans; docs/wind.md)
+os.environ.setdefault("LINECHECK_UNIT_FIELD_MEMO", "0")
+
 import argparse
 import sys
 import time

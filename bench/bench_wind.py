@@ -16,6 +16,11 @@ imported): on a shared machine multi-threaded OpenBLAS was up to 10x slower for 
 
 from __future__ import annotations
 
+import os
+
+# time fresh runs: a run synthesises its turbulence (the per-process memo serves scans; docs/wind.md)
+os.environ.setdefault("LINECHECK_UNIT_FIELD_MEMO", "0")
+
 import argparse
 import os
 import sys

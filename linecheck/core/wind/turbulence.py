@@ -43,6 +43,7 @@ Nothing here prints.
 from __future__ import annotations
 
 import math
+import os
 import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -419,7 +420,9 @@ def fluctuating_velocity(case: Case, system: LineSystem, time: np.ndarray, reali
     return out
 
 
-UNIT_FIELD_MEMO_BYTES = 256e6  # [bytes] unit fields kept per process for reuse (issue 20: scans)
+#: [bytes] unit fields kept per process for reuse (issue 20: scans); the environment variable
+#: LINECHECK_UNIT_FIELD_MEMO overrides it (0: off; the bench scripts time fresh runs with it)
+UNIT_FIELD_MEMO_BYTES = float(os.environ.get("LINECHECK_UNIT_FIELD_MEMO", "256e6"))
 _memo: "dict[tuple, np.ndarray]" = {}
 _memo_lock = threading.Lock()
 

@@ -245,10 +245,11 @@ def damping_matrices(case: Case, st: StaticResult, models: list, states: list[in
 
 def structural_omega1(ref) -> float:
     """[rad/s] the lowest natural circular frequency of the reference state's model ``ref``, at
-    which the structural damping is calibrated (dense up to 600 DOFs, sparse above)."""
-    from .core.modes import lowest_frequency_hz
+    which the structural damping is calibrated (:func:`~linecheck.core.modes.natural_modes`:
+    dense up to 600 DOFs, sparse Lanczos above)."""
+    from .core.modes import natural_modes
 
-    return 2 * np.pi * lowest_frequency_hz(ref)
+    return 2 * np.pi * float(natural_modes(ref, 1).frequencies_hz[0])
 
 
 BURN_IN_DECAY = np.log(100.0)  # transient amplitude down to 1 %: t = ln(100) / (zeta omega)
@@ -461,7 +462,6 @@ def _state_of_step(mean_times: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, n
 
 def _interpolated_models(case: Case, st: StaticResult, bracket: np.ndarray, weights: np.ndarray):
     """model_at(n) for the reference scheme: the step-1 state interpolated linearly in time."""
-    from .core.modes import natural_modes
     from .core.static import StaticState
 
     mean, system = st.mean, st.system
@@ -470,8 +470,7 @@ def _interpolated_models(case: Case, st: StaticResult, bracket: np.ndarray, weig
     zs = case.analysis.structural_ratio
     w1 = 1.0
     if zs > 0:  # calibrated once, at the reference state (as in damping_matrices)
-        w1 = 2 * np.pi * float(natural_modes(build_model(system, mean.state(reference_state_index(case, mean))), 1)
-                               .frequencies_hz[0])
+        w1 = structural_omega1(build_model(system, mean.state(reference_state_index(case, mean))))
 
     def model_at(n: int):
         k0 = int(bracket[n])
@@ -604,7 +603,7 @@ def run_case(
     system, mean = st.system, st.mean
     t = record_time(case)
     dt = case.analysis.time_step
-    line, wind = case.line, case.wind
+    wind = case.wind
 
     def check_cancel() -> None:
         if cancel is not None and cancel.is_set():
@@ -612,12 +611,14 @@ def run_case(
 
     # ---- linear models at the mean states (paper Eqs 7-9, 13)
     models = build_models(system, [mean.state(k) for k in range(mean.time.size)])  # one vectorised pass
-    vn_states = to_global_nodes(system, st.wind.normal)  # (n_k, n_nodes)
-    damping = damping_matrices(case, st, models)
-    # complex modes with eigenvectors: the burn-in tells significant modes apart with them
-    # (issue 10) and the frequency-domain check sums them (modal superposition)
     synoptic = wind.type == "synoptic"
     windows: dict = {}  # long lines: window models shared by the burn-in and the check (issue 20)
+    if synoptic and windowed(case) and case.analysis.structural_ratio > 0:
+        # the whole line's structural-damping calibration, computed once for it and its windows
+        windows["omega1"] = structural_omega1(models[reference_state_index(case, mean)])
+    damping = damping_matrices(case, st, models, omega1=windows.get("omega1"))
+    # complex modes with eigenvectors: the burn-in tells significant modes apart with them
+    # (issue 10) and the frequency-domain check sums them (modal superposition)
     sm = synoptic_model(case, st) if synoptic and not windowed(case) else None
     burn = synoptic_burn_in(case, st, sm, windows) if synoptic else BurnIn(
         0.0, 0.0, float("nan"), float("nan"), True, "none: a downburst starts from a weak running mean")
@@ -651,6 +652,7 @@ def run_case(
     # ---- realizations in chunks that fit in memory (issue 20: long lines): every realization's
     # turbulence, Newmark columns and statistics are its own, so chunking changes no bit
     chunk = budget.realization_chunk(case, t.size)
+    M_keep, still_air, window = M[keep], system.to_tower_frames(mean.still_air.reactions), peak_window_steps(case)
     parts_stats, parts_B, parts_R = [], [], []
     n_chunks = -(-real.size // chunk)
     for ci in range(n_chunks):
@@ -674,8 +676,7 @@ def run_case(
         resp = DynamicResponse(system.to_tower_frames(resp.fluctuating), system.to_tower_frames(resp.background))
         Bk, Rk = resp.background[:, keep], resp.resonant[:, keep]
         del resp
-        parts_stats.append(compute_statistics(M[keep], Bk, Rk, system.to_tower_frames(mean.still_air.reactions), gL,
-                                              window=peak_window_steps(case)))
+        parts_stats.append(compute_statistics(M_keep, Bk, Rk, still_air, gL, window=window))
         parts_B.append(Bk[:, :, j, :].copy())
         parts_R.append(Rk[:, :, j, :].copy())
         del Bk, Rk
@@ -683,7 +684,7 @@ def run_case(
     spectral = (spectral_analysis(case, static=st, synoptic=sm, windows=windows)
                 if synoptic and spectral_check else None)
     return RunResult(
-        case=case, system=system, static=st, realizations=real, time=t[keep], mean=M[keep],
+        case=case, system=system, static=st, realizations=real, time=t[keep], mean=M_keep,
         background=parts_B[0] if n_chunks == 1 else np.concatenate(parts_B),
         resonant=parts_R[0] if n_chunks == 1 else np.concatenate(parts_R), stats=stats,
         spectral=spectral, burn_in=burn,

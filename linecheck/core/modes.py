@@ -91,8 +91,3 @@ def _natural_modes_sparse(model: LinearModel, n_modes: int) -> Modes:
     phi = phi * np.sign(phi[big, np.arange(phi.shape[1])])
     return _modes(model, w2, phi)
 
-
-def lowest_frequency_hz(model: LinearModel) -> float:
-    """[Hz] the lowest undamped natural frequency of ``model`` (:func:`natural_modes`: dense up
-    to 600 DOFs, shift-invert Lanczos above)."""
-    return float(natural_modes(model, 1).frequencies_hz[0])

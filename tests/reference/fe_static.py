@@ -59,7 +59,7 @@ from scipy.linalg import solve_banded
 
 from linecheck.core.system import LineSystem
 
-from .truss import truss_internal, truss_state
+from .truss import load_stepping, truss_internal, truss_state
 
 _BAND = 5  # half band width in dofs: node k couples with node k+1 only
 
@@ -284,21 +284,10 @@ def solve_fe(
     U, its, res = _newton(model, U, model.fw, tol, max_iter, dmax)
     total_its, steps = its, 1
     if np.any(model.fy != 0.0):
-        lam, dlam = 0.0, 1.0 / wind_steps
-        while lam < 1.0:
-            target = min(1.0, lam + dlam)
-            try:
-                Un, its, res = _newton(model, U, model.fw + target * model.fy, tol, max_iter, dmax)
-            except FEConvergenceError:
-                dlam *= 0.5
-                if dlam < 1e-4:
-                    raise
-                continue
-            U, lam = Un, target
-            total_its += its
-            steps += 1
-            if its <= 5:
-                dlam = min(2.0 * dlam, 1.0)
+        U, res, its, n = load_stepping(lambda U0, f: _newton(model, U0, f, tol, max_iter, dmax), U, model.fw, model.fy,
+                                       wind_steps, 5, FEConvergenceError)
+        total_its += its
+        steps += n
     fext = model.fw + model.fy
     return _result(model, U, fext, res, total_its, steps)
 

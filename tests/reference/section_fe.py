@@ -57,7 +57,7 @@ from scipy.linalg import eigh
 from scipy.sparse.linalg import spsolve
 
 from . import irvine_inclined
-from .truss import truss_internal, truss_state
+from .truss import load_stepping, truss_internal, truss_state
 
 GRAVITY = 9.81  # [m/s2] paper Eq. 8
 
@@ -455,21 +455,8 @@ def solve(source: Section | str | Path, *, n_el: int = 100, insulator_stiffness:
     wstate = None
     if wind and sec.v_ref > 0.0:
         m.set_wind(m.X0 + U)
-        lam, dlam, total, steps = 0.0, 1.0 / wind_steps, 0, 0
-        while lam < 1.0:
-            target = min(1.0, lam + dlam)
-            try:
-                Un, its, res = _newton(m, U, m.fw + target * m.fq, tol, max_iter, dmax)
-            except FEConvergenceError:
-                dlam *= 0.5
-                if dlam < 1e-4:
-                    raise
-                continue
-            U, lam = Un, target
-            total += its
-            steps += 1
-            if its <= 6:
-                dlam = min(2.0 * dlam, 1.0)
+        U, res, total, steps = load_stepping(lambda U0, f: _newton(m, U0, f, tol, max_iter, dmax), U, m.fw, m.fq,
+                                             wind_steps, 6, FEConvergenceError)
         wstate = _state(m, U, m.fw + m.fq, res, total, steps)
     return Solution(sec, geo, n_el, still, wstate, np.array([c.Lu for c in geo.catenary]))
 

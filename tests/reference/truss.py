@@ -30,3 +30,30 @@ def truss_internal(N: np.ndarray, e: np.ndarray, a: np.ndarray, b: np.ndarray, n
     np.add.at(f, b, Ne)
     np.add.at(f, a, -Ne)
     return f.reshape(-1)
+
+
+def load_stepping(newton, U: np.ndarray, f0: np.ndarray, df: np.ndarray, steps: int, easy: int,
+                  failure: type[Exception]) -> tuple[np.ndarray, float, int, int]:
+    """Apply the external load f0 + lam df from lam = 0 to 1 in adaptive increments (load
+    control; Crisfield 1991, ch. 9): an increment whose Newton solve raises ``failure`` is
+    halved (down to 1e-4), one that converged within ``easy`` iterations lets the next double.
+
+    newton(U, fext) -> (U, iterations, residual [N]) solves one increment from U.
+    Returns (U, the last residual [N], the iterations of all increments, the increments).
+    """
+    lam, dlam, total, n, res = 0.0, 1.0 / steps, 0, 0, float("nan")
+    while lam < 1.0:
+        target = min(1.0, lam + dlam)
+        try:
+            Un, its, res = newton(U, f0 + target * df)
+        except failure:
+            dlam *= 0.5
+            if dlam < 1e-4:
+                raise
+            continue
+        U, lam = Un, target
+        total += its
+        n += 1
+        if its <= easy:
+            dlam = min(2.0 * dlam, 1.0)
+    return U, res, total, n

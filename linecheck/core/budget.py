@@ -158,9 +158,8 @@ def realization_chunk(case: Case, n_steps: int) -> int:
     whole-record arrays (turbulence, loads and work arrays per node, reaction histories per
     tower: about 3 n_nodes + 24 n_towers doubles per step and realization) exceed
     :data:`RUN_CHUNK_BYTES` (issue 20)."""
-    line = case.line
-    n_nodes = line.spans * line.elements_per_span + 1
-    per = float(n_steps) * F8 * (3 * n_nodes + 24 * (line.spans + 1))
+    n_nodes, _, n_towers = _sizes(case)
+    per = float(n_steps) * F8 * (3 * n_nodes + 24 * n_towers)
     return max(1, int(RUN_CHUNK_BYTES // per))
 
 
@@ -178,7 +177,7 @@ def estimate(case: Case, job: str = "run", *, realizations: int | None = None, b
     ``analysis.burn_in`` or 0).
     """
     a = case.analysis
-    n_nodes, n_dof, _ = _sizes(case)
+    n_nodes, n_dof, n_towers = _sizes(case)
     n_real = a.realizations if realizations is None else int(realizations)
     synoptic = case.wind.type == "synoptic"
     n_k = 1 if synoptic else a.mean_states
@@ -206,7 +205,7 @@ def estimate(case: Case, job: str = "run", *, realizations: int | None = None, b
         # the chunk's whole-record arrays, plus what the result keeps of every realization: B and R
         # at the tower of interest (6 doubles per step) and 15 statistics per tower and reaction
         parts["time histories"] = (REC_ARRAYS * F8 * float(held) * n_steps * n_nodes + STEP_ARRAYS * F8 * n_steps * n_nodes
-                                   + 6 * F8 * float(n_real) * n_steps + 45 * F8 * float(n_real) * (case.line.spans + 1))
+                                   + 6 * F8 * float(n_real) * n_steps + 45 * F8 * float(n_real) * n_towers)
         secs += n_steps * T_STEP + float(n_real) * n_steps * (T_NEWMARK * n_dof + T_SYNTH * n_nodes)
     if job == "wind":
         parts["time histories"] = STEP_ARRAYS * F8 * n_steps * n_nodes

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import lapack
 
+from . import kernel
 from .errors import Cancelled, NumericalError
 from .model import LinearModel, band_blocks, band_to_sparse, rotate_band
 
@@ -187,6 +188,7 @@ def integrate(
             """Second-order reactions of global displacements U (..., n_dof) under the state of step n."""
             return second_order_reactions(second_order[int(state_of_step[n])], U.reshape(-1, n_dof)).reshape(
                 U.shape[:-1] + (n_r,))
+    compiled = kernel.use(float(n_steps) * n_real * n_dof)  # optional compiled loops, same bits (issue 20)
     if model_at is None and n_dof > BACKGROUND_SOLVE_DOF:
         # a long line (issue 20): the dense static transfer (n_free x n_r) would cost O(n^2) per
         # step; solve K u_B = P l by the banded Cholesky instead (dpbtrs: column by column, so a
@@ -199,7 +201,8 @@ def integrate(
             per = max(1, rows // max(n_real, 1))
             for i0 in range(0, all_steps.size, per):
                 steps = all_steps[i0:i0 + per]
-                UB = _solve(c, loads_full(loads[steps].reshape(-1, n_free)).T).T  # (m, n_dof), global
+                rhs = loads_full(loads[steps].reshape(-1, n_free)).T  # (n_dof, m)
+                UB = (kernel.solve_columns(c, rhs) if compiled else _solve(c, rhs)).T  # (m, n_dof), global
                 R_B[steps] = _sparse_reactions(UB, *sparse_g).reshape(steps.size, n_real, n_r)
                 sk = steps >= second_order_start
                 if second_order is not None and sk.any():  # the quasi-static displacements themselves
@@ -286,8 +289,14 @@ def integrate(
         in_place = np.shares_memory(_dpbtrs(chat, probe.T, lower=0, overwrite_b=1)[0], probe)
         for b0 in range(int(s0), int(s1), block):
             b1 = min(b0 + block, int(s1))
-            Fb = (loads[b0:b1][..., None] * st.ycoef).reshape(b1 - b0, n_real, n_dof)
-            for k in range(b1 - b0):
+            if compiled:  # the same arithmetic as the loop below, compiled (same bits; kernel.py)
+                kernel.newmark_block(U, V, A, loads[b0:b1], st.ycoef, st.cu, st.cv, st.dm, st.r2, chat, rest,
+                                     a1, buf[: b1 - b0])
+                b_range = ()
+            else:
+                Fb = (loads[b0:b1][..., None] * st.ycoef).reshape(b1 - b0, n_real, n_dof)
+                b_range = range(b1 - b0)
+            for k in b_range:
                 # K_hat u_{n+1} = F_{n+1} + M (a0 u + a2 v + a) + C (a1 u + v)   (Bathe Table 9.3)
                 np.multiply(cu, U, out=U_new)
                 np.multiply(cv, V, out=tmp)

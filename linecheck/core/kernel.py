@@ -1,0 +1,280 @@
+"""The Newmark step loop as one compiled kernel (issue 20), optional.
+
+The numpy step loop of :func:`linecheck.core.dynamics.integrate` makes about a dozen numpy
+calls and one LAPACK ``dpbtrs`` per time step; for the six-span system that is ≈ 12 µs (one
+realization) to ≈ 60 µs (ten) per step of mostly call overhead.  With the optional extra
+``linecheck[fast]`` (Numba) the same recurrence runs here as one compiled loop over the steps
+of a block; without it (or with ``LINECHECK_KERNEL=numpy``) the numpy loop runs.
+
+**Same bits.**  The kernel repeats the numpy loop's arithmetic operation by operation, so the
+two paths give bit-identical results (tested on synoptic, downburst, structural-damping and
+section cases):
+
+- the right-hand side ((cu u + cv v) + dm a) + F (+ C~_off (a1 u + v)), each product and sum
+  rounded separately as numpy's ufuncs round them (no fused multiply-add: compiled without
+  ``contract``); F = load × ycoef as numpy forms it; the structural-damping remainder summed
+  row by row from 0 in CSR order, as scipy's ``csr_matvecs`` sums it;
+- the banded Cholesky solve U^T U x = b (upper band storage, LAPACK ``dpbtrs``: two
+  ``dtbsv`` calls per right-hand side) with the operation order of OpenBLAS's ``dtbsv`` —
+  the transposed solve as a dot product of the (at most BANDWIDTH) earlier unknowns
+  subtracted from b_j, then a division by the diagonal; the back-substitution column by
+  column (divide, then an axpy of −x_j times the column into the earlier entries) — compiled
+  *with* ``contract``, because OpenBLAS's Haswell kernels form those dot products and axpys
+  with fused multiply-adds (the test compares against ``dpbtrs`` itself, so a BLAS that rounds
+  differently is detected: :func:`available` then returns False and the numpy loop runs);
+- the trapezoidal updates v' = (u' − u) 2/Δt − v, a' = (v' − v) 2/Δt − a (Bathe Table 9.3).
+
+Each realization is integrated by itself (its own row), so its bits do not depend on which
+other realizations share the run, as in the numpy loop.
+
+This module imports Numba only when the kernel is first asked for; the rest of the core
+imports numpy and scipy only.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+
+import numpy as np
+
+_lock = threading.Lock()
+_state: dict[str, object] = {}
+
+
+def _compile():
+    """The compiled functions (Numba), or None when Numba is not installed."""
+    try:
+        import numba
+    except ImportError:
+        return None
+    njit = numba.njit
+
+    # the banded triangular solves, with contraction as OpenBLAS's Haswell dtbsv forms them.
+    # x is (n_groups, n_dof, 4): the realizations in groups of four lanes (padded with zeros),
+    # every lane solved by itself in dtbsv's order; four independent chains per group hide the
+    # latency of the dependent divide and multiply-adds, and the fixed four lanes vectorise
+    @njit(cache=True, nogil=True, fastmath={"contract"})
+    def band_solve(c, x):  # pragma: no cover - compiled
+        """Solve U^T U x = b in place for every lane of x (n_groups, n, 4); U upper band,
+        c[kd + i - j, j] = U[i, j]."""
+        kd = c.shape[0] - 1
+        n = c.shape[1]
+        for g in range(x.shape[0]):
+            y = x[g]
+            for j in range(n):  # U^T y = b: dtbsv('U', 'T', 'N'), a dot product per row
+                k = min(j, kd)
+                s0 = 0.0
+                s1 = 0.0
+                s2 = 0.0
+                s3 = 0.0
+                for t in range(k):
+                    i = j - k + t
+                    cij = c[kd + i - j, j]
+                    s0 += cij * y[i, 0]
+                    s1 += cij * y[i, 1]
+                    s2 += cij * y[i, 2]
+                    s3 += cij * y[i, 3]
+                cjj = c[kd, j]
+                y[j, 0] = (y[j, 0] - s0) / cjj
+                y[j, 1] = (y[j, 1] - s1) / cjj
+                y[j, 2] = (y[j, 2] - s2) / cjj
+                y[j, 3] = (y[j, 3] - s3) / cjj
+            for j in range(n - 1, -1, -1):  # U x = y: dtbsv('U', 'N', 'N'), an axpy per column
+                cjj = c[kd, j]
+                x0 = y[j, 0] / cjj
+                x1 = y[j, 1] / cjj
+                x2 = y[j, 2] / cjj
+                x3 = y[j, 3] / cjj
+                y[j, 0] = x0
+                y[j, 1] = x1
+                y[j, 2] = x2
+                y[j, 3] = x3
+                k = min(j, kd)
+                for t in range(k):
+                    i = j - k + t
+                    cij = c[kd + i - j, j]
+                    y[i, 0] += -x0 * cij
+                    y[i, 1] += -x1 * cij
+                    y[i, 2] += -x2 * cij
+                    y[i, 3] += -x3 * cij
+
+    @njit(cache=True, nogil=True)
+    def solve_columns(c, B):  # pragma: no cover - compiled
+        """dpbtrs on every column of B (n, m) in place, four columns at a time."""
+        n, m = B.shape
+        G = (m + 3) // 4
+        x = np.zeros((G, n, 4))
+        for r in range(m):
+            for d in range(n):
+                x[r // 4, d, r % 4] = B[d, r]
+        band_solve(c, x)
+        for r in range(m):
+            for d in range(n):
+                B[d, r] = x[r // 4, d, r % 4]
+
+    @njit(cache=True, nogil=True)
+    def steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, indptr, indices, data, a1,
+              out):  # pragma: no cover - compiled
+        """Newmark steps of one block; U, V, A updated in place.
+
+        U, V, A (n_real, n_dof) rotated state; loads (n_b, n_real, n_free) [N]; ycoef
+        (n_free, 3); out (n_b, n_real, n_dof) receives u after every step."""
+        n_b, m, n_free = loads.shape
+        n = U.shape[1]
+        G = (m + 3) // 4
+        u = np.zeros((G, n, 4))  # lane l of group g is realization 4 g + l (padding lanes stay 0)
+        v = np.zeros((G, n, 4))
+        a = np.zeros((G, n, 4))
+        b = np.zeros((G, n, 4))
+        w = np.zeros((n, 4))
+        f = np.zeros(4)
+        for r in range(m):
+            for d in range(n):
+                u[r // 4, d, r % 4] = U[r, d]
+                v[r // 4, d, r % 4] = V[r, d]
+                a[r // 4, d, r % 4] = A[r, d]
+        for k in range(n_b):
+            for g in range(G):
+                ug, vg, ag, bg = u[g], v[g], a[g], b[g]
+                for i in range(n_free):  # F = load x ycoef (the numpy loop's Fb)
+                    for l in range(4):
+                        r = 4 * g + l
+                        f[l] = loads[k, r, i] if r < m else 0.0
+                    for q in range(3):
+                        d = 3 * i + q
+                        yc = ycoef[i, q]
+                        for l in range(4):
+                            bg[d, l] = ((cu[d] * ug[d, l] + cv[d] * vg[d, l]) + dm[d] * ag[d, l]) + f[l] * yc
+                if has_rest:  # C~_off (a1 u + v): csr_matvecs order, each row summed from 0
+                    for d in range(n):
+                        for l in range(4):
+                            w[d, l] = a1 * ug[d, l] + vg[d, l]
+                    for d in range(n):
+                        t0 = 0.0
+                        t1 = 0.0
+                        t2 = 0.0
+                        t3 = 0.0
+                        for jj in range(indptr[d], indptr[d + 1]):
+                            gj = data[jj]
+                            e = indices[jj]
+                            t0 += gj * w[e, 0]
+                            t1 += gj * w[e, 1]
+                            t2 += gj * w[e, 2]
+                            t3 += gj * w[e, 3]
+                        bg[d, 0] += t0
+                        bg[d, 1] += t1
+                        bg[d, 2] += t2
+                        bg[d, 3] += t3
+            band_solve(chat, b)
+            for g in range(G):
+                ug, vg, ag, bg = u[g], v[g], a[g], b[g]
+                for d in range(n):  # v' = (u' - u) 2/dt - v, a' = (v' - v) 2/dt - a
+                    for l in range(4):
+                        vn = (bg[d, l] - ug[d, l]) * r2 - vg[d, l]
+                        ag[d, l] = (vn - vg[d, l]) * r2 - ag[d, l]
+                        vg[d, l] = vn
+                        ug[d, l] = bg[d, l]
+            for r in range(m):
+                for d in range(n):
+                    out[k, r, d] = u[r // 4, d, r % 4]
+        for r in range(m):
+            for d in range(n):
+                U[r, d] = u[r // 4, d, r % 4]
+                V[r, d] = v[r // 4, d, r % 4]
+                A[r, d] = a[r // 4, d, r % 4]
+
+    return band_solve, steps, solve_columns
+
+
+def _self_test(band_solve) -> bool:
+    """The compiled banded solve gives dpbtrs's bits on a system of the size the core uses."""
+    from scipy.linalg import lapack
+
+    from .model import BANDWIDTH
+
+    rng = np.random.default_rng(20)
+    n, kd = 60, BANDWIDTH
+    ab = np.zeros((kd + 1, n))
+    for off in range(kd + 1):
+        ab[kd - off, off:] = rng.uniform(-1.0, 1.0, n - off)
+    ab[kd] = 4.0 * (kd + 1) + rng.uniform(0.0, 1.0, n)
+    c, info = lapack.dpbtrf(ab, lower=0)
+    if info != 0:  # pragma: no cover - diagonally dominant by construction
+        return False
+    B = rng.standard_normal((4, n))
+    ref, info = lapack.dpbtrs(c, np.asfortranarray(B.T), lower=0)
+    X = np.ascontiguousarray(B.T)[None]  # one group of four lanes
+    band_solve(c, X)
+    return info == 0 and bool(np.array_equal(X[0], ref))
+
+
+#: loading Numba and the cached kernel costs ≈ 0.6 s once per process; below this much work
+#: (steps × realizations × DOFs, ≈ 0.3 s of the numpy loop) a process that has not loaded it yet
+#: keeps the numpy loop, which gives the same bits (a one-realization six-span run is 2.2e6)
+LOAD_WORK = 2.0e7
+
+
+def _mode() -> str:
+    """``LINECHECK_KERNEL``: "auto" (default), "numpy" (never compile) or "numba" (always)."""
+    return os.environ.get("LINECHECK_KERNEL", "auto").strip().lower()
+
+
+def use(work: float) -> bool:
+    """Whether to run ``work`` (steps × realizations × DOFs) through the compiled kernel: when
+    it is available and either already loaded in this process or the work pays for loading it
+    (:data:`LOAD_WORK`; ``LINECHECK_KERNEL=numba`` always loads it).  Same bits either way."""
+    mode = _mode()
+    if mode == "numpy":
+        return False
+    if "ok" in _state or mode == "numba" or work >= LOAD_WORK:
+        return available()
+    return False
+
+
+def available() -> bool:
+    """True when the compiled kernel is installed, wanted and bit-identical to LAPACK here.
+
+    ``LINECHECK_KERNEL=numpy`` switches it off (the numpy loop runs); the first call compiles
+    (or loads Numba's on-disk cache) and checks the banded solve against ``dpbtrs``."""
+    if _mode() == "numpy":
+        return False
+    with _lock:
+        if "ok" not in _state:
+            fns = _compile()
+            ok = fns is not None and _self_test(fns[0])
+            _state["ok"] = ok
+            _state["fns"] = fns if ok else None
+        return bool(_state["ok"])
+
+
+def newmark_block(U: np.ndarray, V: np.ndarray, A: np.ndarray, loads: np.ndarray, ycoef: np.ndarray,
+                  cu: np.ndarray, cv: np.ndarray, dm: np.ndarray, r2: float, chat: np.ndarray, rest,
+                  a1: float, out: np.ndarray) -> None:
+    """Newmark average-acceleration steps of one block (Bathe 1996 Table 9.3) in the node bases.
+
+    Args:
+        U, V, A: [m, m/s, m/s²] rotated state of every realization, (n_real, n_dof), C-ordered,
+            updated in place.
+        loads: [N] transverse loads of the block's steps, (n_b, n_real, n_free).
+        ycoef: [-] local components of each node's unit load, (n_free, 3).
+        cu, cv, dm: the diagonal operators of :class:`~linecheck.core.dynamics._Stepper`, (n_dof,).
+        r2: [1/s] 2/Δt.  chat: Cholesky factor of K̂ (upper band, (BANDWIDTH + 1, n_dof)).
+        rest: off-diagonal structural damping C~_off (scipy CSR) or None; a1: [1/s] 2/Δt.
+        out: receives u after every step, (n_b, n_real, n_dof).
+    """
+    steps = _state["fns"][1]
+    if rest is None:
+        z = np.zeros(1, dtype=np.int32)
+        steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, False, z, z, np.zeros(1), a1, out)
+    else:
+        steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, True, rest.indptr, rest.indices, rest.data, a1, out)
+
+
+def solve_columns(c: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """LAPACK ``dpbtrs`` (upper) on every column of B (n_dof, m), in place, with its bits.
+
+    c: Cholesky factor of a banded SPD matrix (upper band storage, (BANDWIDTH + 1, n_dof));
+    B: right-hand sides as columns.  Returns B (solved)."""
+    _state["fns"][2](c, B)
+    return B

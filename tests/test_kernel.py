@@ -1,0 +1,122 @@
+"""The optional compiled step loop (issue 20, ``linecheck[fast]``, Numba) gives the numpy loop's bits.
+
+The reference is the numpy/LAPACK path itself (``LINECHECK_KERNEL=numpy``), which the rest of
+the suite verifies against independent solvers; the kernel must reproduce it bit for bit on
+every kind of run it serves: a synoptic line with quasi-steady (structural) damping, a
+downburst (one operator per mean state), a section (load directions along the span normals)
+with second-order tension, several realizations (lanes in groups of four, padded), and a long
+line's banded background solves.  Without Numba installed these tests are skipped; the numpy
+path runs in every other test.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from scipy.linalg import lapack
+
+from linecheck import service
+from linecheck.core import kernel
+from linecheck.core.case import load_case
+from linecheck.core.model import BANDWIDTH
+
+from .conftest import CASES
+
+needs_kernel = pytest.mark.skipif(not kernel.available(), reason="Numba (linecheck[fast]) not installed")
+
+
+def _short(path, **analysis):
+    case = load_case(path)
+    return dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, **analysis))
+
+
+def _both(monkeypatch, case, **kw):
+    monkeypatch.setenv("LINECHECK_KERNEL", "numba")
+    fast = service.run_case(case, spectral_check=False, **kw)
+    monkeypatch.setenv("LINECHECK_KERNEL", "numpy")
+    slow = service.run_case(case, spectral_check=False, **kw)
+    return fast, slow
+
+
+@needs_kernel
+@pytest.mark.parametrize("m", [1, 3, 4, 9])
+def test_banded_solve_is_lapack_dpbtrs_bit_for_bit(m):
+    """Random banded SPD systems (the core's band width, 47 unknowns) against dpbtrs itself."""
+    rng = np.random.default_rng(m)
+    n, kd = 47, BANDWIDTH
+    ab = np.zeros((kd + 1, n))
+    for off in range(1, kd + 1):
+        ab[kd - off, off:] = rng.uniform(-1.0, 1.0, n - off)
+    ab[kd] = 2.0 * kd + rng.uniform(0.0, 1.0, n)  # diagonally dominant: SPD
+    c, info = lapack.dpbtrf(ab, lower=0)
+    assert info == 0
+    B = np.asfortranarray(rng.standard_normal((n, m)) * 10.0 ** rng.integers(-6, 6, m))
+    ref, info = lapack.dpbtrs(c, B, lower=0)
+    got = kernel.solve_columns(c, B.copy(order="F"))
+    assert np.array_equal(got, ref)
+    # and the solution is a solution (the comparison above is not against garbage)
+    A = np.diag(ab[kd])
+    for off in range(1, kd + 1):
+        A += np.diag(ab[kd - off, off:], off) + np.diag(ab[kd - off, off:], -off)
+    np.testing.assert_allclose(A @ got, B, rtol=1e-12, atol=1e-12 * np.abs(B).max())
+
+
+@needs_kernel
+def test_synoptic_with_structural_damping_same_bits(monkeypatch):
+    """Quasi-steady damping with structural damping: the inter-node remainder C~_off is used."""
+    case = _short(CASES / "paper" / "case09-six.toml", damping="quasi-steady", duration=60.0, burn_in=10.0)
+    assert case.analysis.structural_ratio > 0
+    fast, slow = _both(monkeypatch, case, realizations=[0, 1, 2, 3, 4])
+    assert np.array_equal(fast.resonant, slow.resonant)
+    assert np.array_equal(fast.background, slow.background)
+    assert np.abs(fast.resonant).max() > 0
+
+
+@needs_kernel
+def test_downburst_one_realization_same_bits(monkeypatch):
+    case = _short(CASES / "paper" / "case05-six.toml")
+    fast, slow = _both(monkeypatch, case, realizations=[2])
+    assert np.array_equal(fast.resonant, slow.resonant)
+    assert np.array_equal(fast.background, slow.background)
+
+
+@needs_kernel
+def test_section_second_order_same_bits(monkeypatch):
+    """A 12-span section (load directions along the span normals) with second-order tension."""
+    case = _short(CASES / "examples" / "section-12span.toml", duration=60.0, tension="second-order")
+    fast, slow = _both(monkeypatch, case, realizations=[0, 1])
+    assert np.array_equal(fast.resonant, slow.resonant)
+    assert np.array_equal(fast.background, slow.background)
+
+
+@needs_kernel
+def test_long_line_background_solves_same_bits(monkeypatch):
+    """Above BACKGROUND_SOLVE_DOF step 3 solves the banded stiffness per step (kernel: four
+    steps' right-hand sides at a time)."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bench"))
+    from bench_core import case_with, line_with_spans
+
+    case = line_with_spans(case_with("case09-six", realizations=1), 24)
+    case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, duration=30.0, burn_in=5.0))
+    fast, slow = _both(monkeypatch, case)
+    assert np.array_equal(fast.resonant, slow.resonant)
+    assert np.array_equal(fast.background, slow.background)
+
+
+def test_numpy_mode_never_loads_the_kernel(monkeypatch):
+    monkeypatch.setenv("LINECHECK_KERNEL", "numpy")
+    assert not kernel.use(1e12)
+    assert not kernel.available()
+
+
+def test_small_work_keeps_the_numpy_loop_until_loaded(monkeypatch):
+    """A process that has not loaded Numba does not pay ≈ 0.6 s to save less than that."""
+    monkeypatch.setenv("LINECHECK_KERNEL", "auto")
+    monkeypatch.setattr(kernel, "_state", {})
+    assert not kernel.use(kernel.LOAD_WORK / 10)
+    assert "ok" not in kernel._state

@@ -19,6 +19,7 @@ CORE_MODULES = [
     "linecheck.core.budget",
     "linecheck.core.spectral",
     "linecheck.core.codes",
+    "linecheck.core.kernel",
     "linecheck.core.second_order",
     "linecheck.core.catenary",
     "linecheck.core.wind.mean",

@@ -291,7 +291,7 @@ def integrate(
             b1 = min(b0 + block, int(s1))
             if compiled:  # the same arithmetic as the loop below, compiled (same bits; kernel.py)
                 kernel.newmark_block(U, V, A, loads[b0:b1], st.ycoef, st.cu, st.cv, st.dm, st.r2, chat, rest,
-                                     a1, buf[: b1 - b0])
+                                     a1, buf[: b1 - b0], st.nz, st.GT, st.cols, R_F[b0:b1])
                 b_range = ()
             else:
                 Fb = (loads[b0:b1][..., None] * st.ycoef).reshape(b1 - b0, n_real, n_dof)
@@ -323,7 +323,8 @@ def integrate(
                 V, V_new = V_new, V
                 A, A_new = A_new, A
                 buf[k] = U
-            R_F[b0:b1] = st.reactions(buf[: b1 - b0])
+            if not compiled:
+                R_F[b0:b1] = st.reactions(buf[: b1 - b0])
             c0 = max(b0, second_order_start)
             if second_order is not None and c0 < b1:  # from the node bases, u = T u~ node by node
                 R_F[c0:b1] += second_order_reactions(second_order[int(state_of_step[c0])],

@@ -115,11 +115,13 @@ def _compile():
 
     @njit(cache=True, nogil=True)
     def steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, indptr, indices, data, a1,
-              out):  # pragma: no cover - compiled
+              out, nz, GT, cols, R):  # pragma: no cover - compiled
         """Newmark steps of one block; U, V, A updated in place.
 
         U, V, A (n_real, n_dof) rotated state; loads (n_b, n_real, n_free) [N]; ycoef
-        (n_free, 3); out (n_b, n_real, n_dof) receives u after every step."""
+        (n_free, 3); out (n_b, n_real, n_dof) receives u after every step; R (n_b, n_real, n_r)
+        the reactions G u, summed coordinate by coordinate from zero over the columns
+        [cols[i, 0], cols[i, 1]) of GT's row i (the order of dynamics._sparse_reactions)."""
         n_b, m, n_free = loads.shape
         n = U.shape[1]
         G = (m + 3) // 4
@@ -176,8 +178,15 @@ def _compile():
                         vg[d, l] = vn
                         ug[d, l] = bg[d, l]
             for r in range(m):
+                ur = u[r // 4, :, r % 4]
                 for d in range(n):
-                    out[k, r, d] = u[r // 4, d, r % 4]
+                    out[k, r, d] = ur[d]
+                Rk = R[k, r]
+                Rk[:] = 0.0
+                for q in range(nz.size):
+                    x = ur[nz[q]]
+                    for c in range(cols[q, 0], cols[q, 1]):
+                        Rk[c] += x * GT[q, c]
         for r in range(m):
             for d in range(n):
                 U[r, d] = u[r // 4, d, r % 4]
@@ -250,7 +259,8 @@ def available() -> bool:
 
 def newmark_block(U: np.ndarray, V: np.ndarray, A: np.ndarray, loads: np.ndarray, ycoef: np.ndarray,
                   cu: np.ndarray, cv: np.ndarray, dm: np.ndarray, r2: float, chat: np.ndarray, rest,
-                  a1: float, out: np.ndarray) -> None:
+                  a1: float, out: np.ndarray, nz: np.ndarray, GT: np.ndarray, cols: np.ndarray,
+                  R: np.ndarray) -> None:
     """Newmark average-acceleration steps of one block (Bathe 1996 Table 9.3) in the node bases.
 
     Args:
@@ -262,13 +272,16 @@ def newmark_block(U: np.ndarray, V: np.ndarray, A: np.ndarray, loads: np.ndarray
         r2: [1/s] 2/Δt.  chat: Cholesky factor of K̂ (upper band, (BANDWIDTH + 1, n_dof)).
         rest: off-diagonal structural damping C~_off (scipy CSR) or None; a1: [1/s] 2/Δt.
         out: receives u after every step, (n_b, n_real, n_dof).
+        nz, GT, cols: the stepper's sparse reaction rows (:func:`~linecheck.core.dynamics._sparse_rows`).
+        R: [N] receives the reactions G T u~ after every step, (n_b, n_real, n_r) (the bits of
+            :func:`~linecheck.core.dynamics._sparse_reactions`).
     """
     steps = _state["fns"][1]
     if rest is None:
         z = np.zeros(1, dtype=np.int32)
-        steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, False, z, z, np.zeros(1), a1, out)
+        steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, False, z, z, np.zeros(1), a1, out, nz, GT, cols, R)
     else:
-        steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, True, rest.indptr, rest.indices, rest.data, a1, out)
+        steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, True, rest.indptr, rest.indices, rest.data, a1, out, nz, GT, cols, R)
 
 
 def solve_columns(c: np.ndarray, B: np.ndarray) -> np.ndarray:

@@ -120,3 +120,22 @@ def test_small_work_keeps_the_numpy_loop_until_loaded(monkeypatch):
     monkeypatch.setattr(kernel, "_state", {})
     assert not kernel.use(kernel.LOAD_WORK / 10)
     assert "ok" not in kernel._state
+
+
+@needs_kernel
+def test_change_of_node_bases_same_bits():
+    """kernel.rotate (compiled where verified at load) against st_rotate on random bases."""
+    from types import SimpleNamespace
+
+    from linecheck.core.dynamics import st_rotate
+
+    rng = np.random.default_rng(5)
+    To, Tn = (np.linalg.qr(rng.standard_normal((59, 3, 3)))[0] for _ in range(2))
+    X = rng.standard_normal((10, 177))
+    for old in (None, SimpleNamespace(T=To)):
+        got = kernel.rotate(X, old, SimpleNamespace(T=Tn))
+        assert np.array_equal(got, st_rotate(X, old, SimpleNamespace(T=Tn)))
+    # a rotation: lengths per node kept
+    back = kernel.rotate(X, None, SimpleNamespace(T=Tn))
+    np.testing.assert_allclose(np.linalg.norm(back.reshape(10, 59, 3), axis=2),
+                               np.linalg.norm(X.reshape(10, 59, 3), axis=2), rtol=1e-14)

@@ -264,8 +264,9 @@ def integrate(
         else:
             k = int(state_of_step[s0])
             new = _Stepper.from_bases(models[k], *stacked.get(k), nm, load_dirs)
+        rot = kernel.rotate if compiled else st_rotate  # the same bits
         if st is None:
-            U = st_rotate(U, None, new)
+            U = rot(U, None, new)
             V = np.zeros_like(U)
             A = np.zeros_like(U)  # M a0 = F0 - K u0 - C v0 = 0
         else:
@@ -276,17 +277,18 @@ def integrate(
             # axis) changes, before it could leak into the tangential motion.
             V[:, st.axial] = 0.0
             A[:, st.axial] = 0.0
-            U, V, A = (st_rotate(X, st, new) for X in (U, V, A))
+            U, V, A = (rot(X, st, new) for X in (U, V, A))
         st = new
         cu, cv, dm = (x.reshape(1, -1) for x in (st.cu, st.cv, st.dm))  # (1, n): no broadcast set-up per op
         r2, chat, rest, a1 = st.r2, st.chat, st.rest, st.a1
         # work arrays, reused every step (the step loop allocates nothing): the new state is
         # written into U_new, V_new, A_new and the names are swapped with the old ones
         U, V, A = (np.ascontiguousarray(X) for X in (U, V, A))
-        U_new, V_new, A_new, tmp = (np.empty_like(U) for _ in range(4))
-        rest_product = None if rest is None else _RestProduct(rest, a1, U.shape)
-        probe = np.zeros_like(U)
-        in_place = np.shares_memory(_dpbtrs(chat, probe.T, lower=0, overwrite_b=1)[0], probe)
+        if not compiled:
+            U_new, V_new, A_new, tmp = (np.empty_like(U) for _ in range(4))
+            rest_product = None if rest is None else _RestProduct(rest, a1, U.shape)
+            probe = np.zeros_like(U)
+            in_place = np.shares_memory(_dpbtrs(chat, probe.T, lower=0, overwrite_b=1)[0], probe)
         for b0 in range(int(s0), int(s1), block):
             b1 = min(b0 + block, int(s1))
             if compiled:  # the same arithmetic as the loop below, compiled (same bits; kernel.py)

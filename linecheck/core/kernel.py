@@ -193,7 +193,27 @@ def _compile():
                 V[r, d] = v[r // 4, d, r % 4]
                 A[r, d] = a[r // 4, d, r % 4]
 
-    return band_solve, steps, solve_columns
+    @njit(cache=True, nogil=True)
+    def rotate(X, To, Tn, has_old):  # pragma: no cover - compiled
+        """X (n_real, n_dof) from the node bases To (global if not has_old) to Tn, in place."""
+        m, n = X.shape
+        for r in range(m):
+            for i in range(n // 3):
+                x0 = X[r, 3 * i]
+                x1 = X[r, 3 * i + 1]
+                x2 = X[r, 3 * i + 2]
+                if has_old:  # u = T u~: numpy's einsum sums this 3-term reduction as (p0 + p2) + p1
+                    g0 = (x0 * To[i, 0, 0] + x2 * To[i, 0, 2]) + x1 * To[i, 0, 1]
+                    g1 = (x0 * To[i, 1, 0] + x2 * To[i, 1, 2]) + x1 * To[i, 1, 1]
+                    g2 = (x0 * To[i, 2, 0] + x2 * To[i, 2, 2]) + x1 * To[i, 2, 1]
+                else:
+                    g0 = x0
+                    g1 = x1
+                    g2 = x2
+                for j in range(3):  # u~ = T^T u: summed in order (p0 + p1) + p2
+                    X[r, 3 * i + j] = (g0 * Tn[i, 0, j] + g1 * Tn[i, 1, j]) + g2 * Tn[i, 2, j]
+
+    return band_solve, steps, solve_columns, rotate
 
 
 def _self_test(band_solve) -> bool:
@@ -241,6 +261,36 @@ def use(work: float) -> bool:
     return False
 
 
+def _rotate_test(rotate) -> bool:
+    """The compiled change of node bases gives :func:`~linecheck.core.dynamics.st_rotate`'s bits
+    (numpy's einsum order; if a numpy rounds it differently, the numpy rotation is used)."""
+    from types import SimpleNamespace
+
+    from .dynamics import st_rotate
+
+    rng = np.random.default_rng(21)
+    To, Tn = (np.linalg.qr(rng.standard_normal((20, 3, 3)))[0] for _ in range(2))
+    X = rng.standard_normal((5, 60))
+    ok = True
+    for old in (None, SimpleNamespace(T=To)):
+        Y = X.copy()
+        rotate(Y, To, Tn, old is not None)
+        ok &= bool(np.array_equal(Y, st_rotate(X, old, SimpleNamespace(T=Tn))))
+    return ok
+
+
+def rotate(X: np.ndarray, old, new) -> np.ndarray:
+    """Vectors (n_real, n_dof) from ``old``'s node bases (global if None) to ``new``'s, with the
+    bits of :func:`~linecheck.core.dynamics.st_rotate` (compiled when that was verified)."""
+    if not _state.get("rotate"):
+        from .dynamics import st_rotate
+
+        return st_rotate(X, old, new)
+    Y = np.array(X, dtype=float, order="C")
+    _state["fns"][3](Y, new.T if old is None else old.T, new.T, old is not None)
+    return Y
+
+
 def available() -> bool:
     """True when the compiled kernel is installed, wanted and bit-identical to LAPACK here.
 
@@ -254,6 +304,7 @@ def available() -> bool:
             ok = fns is not None and _self_test(fns[0])
             _state["ok"] = ok
             _state["fns"] = fns if ok else None
+            _state["rotate"] = ok and _rotate_test(fns[3])
         return bool(_state["ok"])
 
 

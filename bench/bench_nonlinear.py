@@ -57,6 +57,9 @@ import os
 
 # time fresh runs: a run synthesises its turbulence (the per-process memo serves scans; docs/wind.md)
 os.environ.setdefault("LINECHECK_UNIT_FIELD_MEMO", "0")
+# the compiled step loop when installed (linecheck[fast]; as in a batch or scan process that has
+# loaded it); LINECHECK_KERNEL=numpy times the numpy loop
+os.environ.setdefault("LINECHECK_KERNEL", "numba")
 
 import argparse
 import dataclasses

@@ -99,6 +99,26 @@ def _compile():
                     y[i, 2] += -x2 * cij
                     y[i, 3] += -x3 * cij
 
+    @njit(cache=True, nogil=True, fastmath={"contract"})
+    def band_solve_lane(c, y):  # pragma: no cover - compiled
+        """:func:`band_solve` for lane 0 of y (n, 4) alone (one realization: no padding lanes)."""
+        kd = c.shape[0] - 1
+        n = c.shape[1]
+        for j in range(n):
+            k = min(j, kd)
+            s0 = 0.0
+            for t in range(k):
+                i = j - k + t
+                s0 += c[kd + i - j, j] * y[i, 0]
+            y[j, 0] = (y[j, 0] - s0) / c[kd, j]
+        for j in range(n - 1, -1, -1):
+            x0 = y[j, 0] / c[kd, j]
+            y[j, 0] = x0
+            k = min(j, kd)
+            for t in range(k):
+                i = j - k + t
+                y[i, 0] += -x0 * c[kd + i - j, j]
+
     @njit(cache=True, nogil=True)
     def solve_columns(c, B):  # pragma: no cover - compiled
         """dpbtrs on every column of B (n, m) in place, four columns at a time."""
@@ -168,7 +188,10 @@ def _compile():
                         bg[d, 1] += t1
                         bg[d, 2] += t2
                         bg[d, 3] += t3
-            band_solve(chat, b)
+            if m == 1:
+                band_solve_lane(chat, b[0])
+            else:
+                band_solve(chat, b)
             for g in range(G):
                 ug, vg, ag, bg = u[g], v[g], a[g], b[g]
                 for d in range(n):  # v' = (u' - u) 2/dt - v, a' = (v' - v) 2/dt - a

@@ -350,10 +350,12 @@ def synthesize(x: np.ndarray, grid: SpectralGrid, phases: np.ndarray, decay: flo
     else:
         raise ValueError(f"unknown method {method!r}")
     m = grid.n_fft
-    spec = np.zeros((m // 2 + 1, n_nodes), dtype=complex)
+    spec = np.zeros((n_nodes, m // 2 + 1), dtype=complex)
     # Deodatis (1996) spectral sum by FFT: irfft gives (1/M)(X_k e^{..} + conj) = A_k cos(..) for X_k = (M/2) A_k e^{i psi}
-    spec[1:grid.n_freq + 1] = (0.5 * m) * (grid.amplitude[:, None] * y.T)
-    return sfft.irfft(spec, n=m, axis=0)[: grid.n_steps]
+    spec[:, 1:grid.n_freq + 1] = (0.5 * m) * (grid.amplitude[None, :] * y)
+    # one contiguous transform per node (pocketfft gives each 1-D transform the same bits whatever
+    # the layout; along the contiguous axis it is ~25 % faster than along axis 0; issue 20)
+    return np.ascontiguousarray(sfft.irfft(spec, n=m, axis=1)[:, : grid.n_steps].T)
 
 
 # ------------------------------------------------------------------------- case-level API

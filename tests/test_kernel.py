@@ -139,3 +139,15 @@ def test_change_of_node_bases_same_bits():
     back = kernel.rotate(X, None, SimpleNamespace(T=Tn))
     np.testing.assert_allclose(np.linalg.norm(back.reshape(10, 59, 3), axis=2),
                                np.linalg.norm(X.reshape(10, 59, 3), axis=2), rtol=1e-14)
+
+
+@needs_kernel
+def test_static_transfer_rows_same_bits():
+    """kernel.rowdot (step 3's static transfer, compiled where verified at load) against _rowdot."""
+    from linecheck.core.dynamics import _rowdot
+
+    rng = np.random.default_rng(6)
+    X, BT = rng.standard_normal((250, 59)), rng.standard_normal((59, 21))
+    got = kernel.rowdot(X, BT)
+    assert np.array_equal(got, _rowdot(X, BT))
+    np.testing.assert_allclose(got, X @ BT, rtol=1e-12, atol=1e-12 * np.abs(X @ BT).max())

@@ -223,7 +223,8 @@ def integrate(
             all_steps = np.flatnonzero(state_of_step == k)
             for i0 in range(0, all_steps.size, chunk):
                 steps = all_steps[i0:i0 + chunk]
-                R_B[steps] = _rowdot(loads[steps].reshape(-1, n_free), TB).reshape(steps.size, n_real, n_r)
+                R_B[steps] = (kernel.rowdot if compiled else _rowdot)(
+                    loads[steps].reshape(-1, n_free), TB).reshape(steps.size, n_real, n_r)
                 sk = steps[steps >= second_order_start]
                 if second_order is not None and sk.size:  # the quasi-static displacements themselves
                     R_B[sk] += second_order_of_loads(second_order[k], loads[sk].reshape(-1, n_free), X).reshape(

@@ -236,7 +236,21 @@ def _compile():
                 for j in range(3):  # u~ = T^T u: summed in order (p0 + p1) + p2
                     X[r, 3 * i + j] = (g0 * Tn[i, 0, j] + g1 * Tn[i, 1, j]) + g2 * Tn[i, 2, j]
 
-    return band_solve, steps, solve_columns, rotate
+    @njit(cache=True, nogil=True)
+    def rowdot(X, BT, out):  # pragma: no cover - compiled
+        """out = X @ BT, every row summed over d in order from zero (numpy's einsum "rd,dk->rk")."""
+        m, n = X.shape
+        q = BT.shape[1]
+        for r in range(m):
+            o = out[r]
+            for k in range(q):
+                o[k] = 0.0
+            for d in range(n):
+                x = X[r, d]
+                for k in range(q):
+                    o[k] += x * BT[d, k]
+
+    return band_solve, steps, solve_columns, rotate, rowdot
 
 
 def _self_test(band_solve) -> bool:
@@ -302,6 +316,33 @@ def _rotate_test(rotate) -> bool:
     return ok
 
 
+def _rowdot_test(rowdot) -> bool:
+    """The compiled X @ BT gives :func:`~linecheck.core.dynamics._rowdot`'s bits (numpy's einsum
+    order) on the shapes the core uses (many rows, tens of columns); else numpy's is used."""
+    from .dynamics import _rowdot
+
+    rng = np.random.default_rng(22)
+    ok = True
+    for m, n, q in ((480, 59, 21), (7, 177, 9), (33, 3, 40)):
+        X, BT = rng.standard_normal((m, n)), rng.standard_normal((n, q))
+        out = np.empty((m, q))
+        rowdot(X, BT, out)
+        ok &= bool(np.array_equal(out, _rowdot(X, BT)))
+    return ok
+
+
+def rowdot(X: np.ndarray, BT: np.ndarray) -> np.ndarray:
+    """X (m, n) @ BT (n, q) with the bits of :func:`~linecheck.core.dynamics._rowdot` (compiled
+    when that was verified at load)."""
+    if not _state.get("rowdot"):
+        from .dynamics import _rowdot
+
+        return _rowdot(X, BT)
+    out = np.empty((X.shape[0], BT.shape[1]))
+    _state["fns"][4](np.ascontiguousarray(X), np.ascontiguousarray(BT), out)
+    return out
+
+
 def rotate(X: np.ndarray, old, new) -> np.ndarray:
     """Vectors (n_real, n_dof) from ``old``'s node bases (global if None) to ``new``'s, with the
     bits of :func:`~linecheck.core.dynamics.st_rotate` (compiled when that was verified)."""
@@ -328,6 +369,7 @@ def available() -> bool:
             _state["ok"] = ok
             _state["fns"] = fns if ok else None
             _state["rotate"] = ok and _rotate_test(fns[3])
+            _state["rowdot"] = ok and _rowdot_test(fns[4])
         return bool(_state["ok"])
 
 

@@ -552,18 +552,34 @@ def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: n
     n_real = v.shape[0]
     loads = np.empty((t.size, n_real, free.size))
     direct = np.zeros((t.size, n_real, 3 * system.n_towers))
+    # the free nodes are usually one run (all but the strain towers' nodes): a slice, no gathers
+    run = free.size and np.array_equal(free, np.arange(free[0], free[0] + free.size))
+    sel = slice(int(free[0]), int(free[0]) + free.size) if run else free
+    pv = per_v[:, sel]
+    if quad:
+        pq, s2 = np.broadcast_to(per_q, vn.shape)[:, sel], np.broadcast_to(sig2, vn.shape)[:, sel]
     for i in range(n_real):
-        f_i = per_v * v[i]  # (n_steps, n_nodes)
+        # the same elementwise products as on every node, written straight into the loads
+        vi = v[i][:, sel]
+        np.multiply(pv, vi, out=loads[:, i, :])
         if quad:
-            f_i += per_q * (v[i] * v[i] - sig2)
-        loads[:, i, :] = f_i[:, free]
+            q = vi * vi
+            q -= s2
+            q *= pq
+            loads[:, i, :] += q
+        if not pinned.size:
+            continue
+        vp = v[i][:, pinned]
+        f_i = per_v[:, pinned] * vp  # (n_steps, n_pinned)
+        if quad:
+            f_i += np.broadcast_to(per_q, vn.shape)[:, pinned] * (vp * vp - np.broadcast_to(sig2, vn.shape)[:, pinned])
         # loads at pinned nodes go straight into their supports (R_y; a section: along the node normal)
         if system.straight_in_plan:
-            direct[:, i, 3 * np.flatnonzero(~system.suspension) + 1] = f_i[:, pinned]
+            direct[:, i, 3 * np.flatnonzero(~system.suspension) + 1] = f_i
         else:
             b = system.node_normals[pinned]
-            direct[:, i, 3 * np.flatnonzero(~system.suspension)] = f_i[:, pinned] * b[:, 0]
-            direct[:, i, 3 * np.flatnonzero(~system.suspension) + 1] = f_i[:, pinned] * b[:, 1]
+            direct[:, i, 3 * np.flatnonzero(~system.suspension)] = f_i * b[:, 0]
+            direct[:, i, 3 * np.flatnonzero(~system.suspension) + 1] = f_i * b[:, 1]
     return loads, direct
 
 

@@ -151,3 +151,17 @@ def test_static_transfer_rows_same_bits():
     got = kernel.rowdot(X, BT)
     assert np.array_equal(got, _rowdot(X, BT))
     np.testing.assert_allclose(got, X @ BT, rtol=1e-12, atol=1e-12 * np.abs(X @ BT).max())
+
+
+@needs_kernel
+def test_section_banded_background_same_bits(monkeypatch):
+    """The fused step-3 kernel along a section's span normals: the 12-span section forced onto
+    the long-line path (banded background solves) by lowering its DOF threshold."""
+    from linecheck.core import dynamics
+
+    monkeypatch.setattr(dynamics, "BACKGROUND_SOLVE_DOF", 100)
+    case = _short(CASES / "examples" / "section-12span.toml", duration=30.0)
+    fast, slow = _both(monkeypatch, case, realizations=[0, 1, 2])
+    assert np.array_equal(fast.background, slow.background)
+    assert np.array_equal(fast.resonant, slow.resonant)
+    assert np.abs(fast.background).max() > 0

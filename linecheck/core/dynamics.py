@@ -201,6 +201,10 @@ def integrate(
             per = max(1, rows // max(n_real, 1))
             for i0 in range(0, all_steps.size, per):
                 steps = all_steps[i0:i0 + per]
+                if compiled and second_order is None:  # the same arithmetic, compiled and fused
+                    R_B[steps] = kernel.background(c, loads[steps].reshape(-1, n_free), load_dirs,
+                                                   sparse_g).reshape(steps.size, n_real, n_r)
+                    continue
                 rhs = loads_full(loads[steps].reshape(-1, n_free)).T  # (n_dof, m)
                 UB = (kernel.solve_columns(c, rhs) if compiled else _solve(c, rhs)).T  # (m, n_dof), global
                 R_B[steps] = _sparse_reactions(UB, *sparse_g).reshape(steps.size, n_real, n_r)

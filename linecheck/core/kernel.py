@@ -134,6 +134,34 @@ def _compile():
                 B[d, r] = x[r // 4, d, r % 4]
 
     @njit(cache=True, nogil=True)
+    def background(c, L, dirs, straight, nz, GT, cols, R):  # pragma: no cover - compiled
+        """Step 3 of a long line for rows of loads L (m, n_free): K u = loads (global y, or along
+        ``dirs`` (n_free, 3) when not ``straight``), solved four rows at a time, and R (m, n_r)
+        = G u summed coordinate by coordinate from zero (dynamics._sparse_reactions' order)."""
+        m, n_free = L.shape
+        n = c.shape[1]
+        G = (m + 3) // 4
+        x = np.zeros((G, n, 4))
+        for r in range(m):
+            g, l = r // 4, r % 4
+            for i in range(n_free):
+                f = L[r, i]
+                if straight:
+                    x[g, 3 * i + 1, l] = f
+                else:
+                    for q in range(3):
+                        x[g, 3 * i + q, l] = f * dirs[i, q]
+        band_solve(c, x)
+        for r in range(m):
+            g, l = r // 4, r % 4
+            Rr = R[r]
+            Rr[:] = 0.0
+            for q in range(nz.size):
+                v = x[g, nz[q], l]
+                for k in range(cols[q, 0], cols[q, 1]):
+                    Rr[k] += v * GT[q, k]
+
+    @njit(cache=True, nogil=True)
     def steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, indptr, indices, data, a1,
               out, nz, GT, cols, R):  # pragma: no cover - compiled
         """Newmark steps of one block; U, V, A updated in place.
@@ -250,7 +278,7 @@ def _compile():
                 for k in range(q):
                     o[k] += x * BT[d, k]
 
-    return band_solve, steps, solve_columns, rotate, rowdot
+    return band_solve, steps, solve_columns, rotate, rowdot, background
 
 
 def _self_test(band_solve) -> bool:
@@ -398,6 +426,20 @@ def newmark_block(U: np.ndarray, V: np.ndarray, A: np.ndarray, loads: np.ndarray
         steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, False, z, z, np.zeros(1), a1, out, nz, GT, cols, R)
     else:
         steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, True, rest.indptr, rest.indices, rest.data, a1, out, nz, GT, cols, R)
+
+
+def background(c: np.ndarray, L: np.ndarray, load_dirs: np.ndarray | None, sparse_g) -> np.ndarray:
+    """Step 3 of a long line (:func:`~linecheck.core.dynamics.integrate`, above
+    BACKGROUND_SOLVE_DOF): the reactions G K^-1 P l of load rows L [N] (m, n_free), with the bits
+    of building the right-hand sides, ``dpbtrs`` and ``_sparse_reactions``.
+
+    c: Cholesky factor of K (upper band); load_dirs: (n_free, 3) or None (global y);
+    sparse_g: ``_sparse_rows(G)`` (nz, GT, cols).  Returns R [N] (m, n_r)."""
+    nz, GT, cols = sparse_g
+    R = np.empty((L.shape[0], GT.shape[1]))
+    dirs = np.zeros((1, 3)) if load_dirs is None else np.ascontiguousarray(load_dirs, dtype=float)
+    _state["fns"][5](c, np.ascontiguousarray(L), dirs, load_dirs is None, nz, GT, cols, R)
+    return R
 
 
 def solve_columns(c: np.ndarray, B: np.ndarray) -> np.ndarray:

@@ -99,26 +99,6 @@ def _compile():
                     y[i, 2] += -x2 * cij
                     y[i, 3] += -x3 * cij
 
-    @njit(cache=True, nogil=True, fastmath={"contract"})
-    def band_solve_lane(c, y):  # pragma: no cover - compiled
-        """:func:`band_solve` for lane 0 of y (n, 4) alone (one realization: no padding lanes)."""
-        kd = c.shape[0] - 1
-        n = c.shape[1]
-        for j in range(n):
-            k = min(j, kd)
-            s0 = 0.0
-            for t in range(k):
-                i = j - k + t
-                s0 += c[kd + i - j, j] * y[i, 0]
-            y[j, 0] = (y[j, 0] - s0) / c[kd, j]
-        for j in range(n - 1, -1, -1):
-            x0 = y[j, 0] / c[kd, j]
-            y[j, 0] = x0
-            k = min(j, kd)
-            for t in range(k):
-                i = j - k + t
-                y[i, 0] += -x0 * c[kd + i - j, j]
-
     @njit(cache=True, nogil=True)
     def solve_columns(c, B):  # pragma: no cover - compiled
         """dpbtrs on every column of B (n, m) in place, four columns at a time."""
@@ -160,6 +140,65 @@ def _compile():
                 v = x[g, nz[q], l]
                 for k in range(cols[q, 0], cols[q, 1]):
                     Rr[k] += v * GT[q, k]
+
+    @njit(cache=True, nogil=True, fastmath={"contract"})
+    def band_solve_1(c, x):  # pragma: no cover - compiled
+        """:func:`band_solve` for one vector x (n,) (one realization: no lanes)."""
+        kd = c.shape[0] - 1
+        n = c.shape[1]
+        for j in range(n):
+            k = min(j, kd)
+            s0 = 0.0
+            for t in range(k):
+                i = j - k + t
+                s0 += c[kd + i - j, j] * x[i]
+            x[j] = (x[j] - s0) / c[kd, j]
+        for j in range(n - 1, -1, -1):
+            x0 = x[j] / c[kd, j]
+            x[j] = x0
+            k = min(j, kd)
+            for t in range(k):
+                i = j - k + t
+                x[i] += -x0 * c[kd + i - j, j]
+
+    @njit(cache=True, nogil=True)
+    def steps_1(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, indptr, indices, data, a1,
+                out, nz, GT, cols, R):  # pragma: no cover - compiled
+        """:func:`steps` for one realization (U, V, A of shape (1, n_dof)): plain vectors."""
+        n_b, _, n_free = loads.shape
+        n = U.shape[1]
+        u = U[0]
+        v = V[0]
+        a = A[0]
+        b = np.empty(n)
+        w = np.empty(n)
+        for k in range(n_b):
+            for i in range(n_free):
+                f = loads[k, 0, i]
+                for q in range(3):
+                    d = 3 * i + q
+                    b[d] = ((cu[d] * u[d] + cv[d] * v[d]) + dm[d] * a[d]) + f * ycoef[i, q]
+            if has_rest:
+                for d in range(n):
+                    w[d] = a1 * u[d] + v[d]
+                for d in range(n):
+                    t0 = 0.0
+                    for jj in range(indptr[d], indptr[d + 1]):
+                        t0 += data[jj] * w[indices[jj]]
+                    b[d] += t0
+            band_solve_1(chat, b)
+            for d in range(n):
+                vn = (b[d] - u[d]) * r2 - v[d]
+                a[d] = (vn - v[d]) * r2 - a[d]
+                v[d] = vn
+                u[d] = b[d]
+                out[k, 0, d] = b[d]
+            Rk = R[k, 0]
+            Rk[:] = 0.0
+            for q in range(nz.size):
+                x = u[nz[q]]
+                for cc in range(cols[q, 0], cols[q, 1]):
+                    Rk[cc] += x * GT[q, cc]
 
     @njit(cache=True, nogil=True)
     def steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, indptr, indices, data, a1,
@@ -216,10 +255,7 @@ def _compile():
                         bg[d, 1] += t1
                         bg[d, 2] += t2
                         bg[d, 3] += t3
-            if m == 1:
-                band_solve_lane(chat, b[0])
-            else:
-                band_solve(chat, b)
+            band_solve(chat, b)
             for g in range(G):
                 ug, vg, ag, bg = u[g], v[g], a[g], b[g]
                 for d in range(n):  # v' = (u' - u) 2/dt - v, a' = (v' - v) 2/dt - a
@@ -278,7 +314,7 @@ def _compile():
                 for k in range(q):
                     o[k] += x * BT[d, k]
 
-    return band_solve, steps, solve_columns, rotate, rowdot, background
+    return band_solve, steps, solve_columns, rotate, rowdot, background, steps_1
 
 
 def _self_test(band_solve) -> bool:
@@ -420,7 +456,7 @@ def newmark_block(U: np.ndarray, V: np.ndarray, A: np.ndarray, loads: np.ndarray
         R: [N] receives the reactions G T u~ after every step, (n_b, n_real, n_r) (the bits of
             :func:`~linecheck.core.dynamics._sparse_reactions`).
     """
-    steps = _state["fns"][1]
+    steps = _state["fns"][6 if U.shape[0] == 1 else 1]
     if rest is None:
         z = np.zeros(1, dtype=np.int32)
         steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, False, z, z, np.zeros(1), a1, out, nz, GT, cols, R)

@@ -167,3 +167,18 @@ def test_section_banded_background_same_bits(monkeypatch):
     assert np.array_equal(fast.background, slow.background)
     assert np.array_equal(fast.resonant, slow.resonant)
     assert np.abs(fast.background).max() > 0
+
+
+def test_a_numba_that_fails_falls_back_to_numpy(monkeypatch):
+    """A Numba that cannot compile (or cache) here leaves the numpy loop, not an error."""
+    def broken():
+        raise RuntimeError("no locator available for the cache")
+
+    monkeypatch.setenv("LINECHECK_KERNEL", "numba")
+    monkeypatch.setattr(kernel, "_state", {})
+    monkeypatch.setattr(kernel, "_compile", broken)
+    assert not kernel.available()
+    assert not kernel.use(1e12)
+    case = _short(CASES / "paper" / "case09-single.toml", duration=20.0, burn_in=5.0)
+    res = service.run_case(case, realizations=[0], spectral_check=False)
+    assert np.all(np.isfinite(res.resonant)) and np.abs(res.resonant).max() > 0

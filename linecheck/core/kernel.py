@@ -428,12 +428,17 @@ def available() -> bool:
         return False
     with _lock:
         if "ok" not in _state:
-            fns = _compile()
-            ok = fns is not None and _self_test(fns[0])
+            try:
+                fns = _compile()
+                ok = fns is not None and _self_test(fns[0])
+                rot = ok and _rotate_test(fns[3])
+                dot = ok and _rowdot_test(fns[4])
+            except Exception:  # a Numba that cannot compile or cache here: the numpy loop (same bits)
+                fns, ok, rot, dot = None, False, False, False
             _state["ok"] = ok
             _state["fns"] = fns if ok else None
-            _state["rotate"] = ok and _rotate_test(fns[3])
-            _state["rowdot"] = ok and _rowdot_test(fns[4])
+            _state["rotate"] = rot
+            _state["rowdot"] = dot
         return bool(_state["ok"])
 
 

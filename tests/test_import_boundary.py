@@ -46,6 +46,19 @@ def test_core_imports_no_ui_libraries():
     assert out.stdout.strip() == "", f"core imported UI/front-end libraries: {out.stdout.strip()}"
 
 
+def test_core_imports_numba_only_when_the_kernel_is_asked_for():
+    """Numba (the optional compiled step loop, issue 20) is never imported by importing the core;
+    only :func:`linecheck.core.kernel.available` loads it."""
+    code = (
+        "import importlib, sys\n"
+        f"for m in {CORE_MODULES!r}:\n"
+        "    importlib.import_module(m)\n"
+        "print('numba' in sys.modules)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
 def test_every_core_module_is_listed():
     """A new core module must be added to the boundary check above."""
     from pathlib import Path

@@ -1,10 +1,13 @@
-"""The Newmark step loop as one compiled kernel (issue 20), optional.
+"""The compiled loops of steps 2 and 3 (issue 20), optional.
 
 The numpy step loop of :func:`linecheck.core.dynamics.integrate` makes about a dozen numpy
 calls and one LAPACK ``dpbtrs`` per time step; for the six-span system that is ≈ 12 µs (one
 realization) to ≈ 60 µs (ten) per step of mostly call overhead.  With the optional extra
 ``linecheck[fast]`` (Numba) the same recurrence runs here as one compiled loop over the steps
-of a block; without it (or with ``LINECHECK_KERNEL=numpy``) the numpy loop runs.
+of a block (:func:`newmark_block`), together with the reactions G u of every step, the change
+of node bases between mean states (:func:`rotate`), step 3's static transfer (:func:`rowdot`)
+and a long line's step 3 (:func:`background`, :func:`solve_columns`); without it (or with
+``LINECHECK_KERNEL=numpy``) the numpy code runs.
 
 **Same bits.**  The kernel repeats the numpy loop's arithmetic operation by operation, so the
 two paths give bit-identical results (tested on synoptic, downburst, structural-damping and
@@ -43,7 +46,7 @@ _state: dict[str, object] = {}
 
 
 def _compile():
-    """The compiled functions (Numba), or None when Numba is not installed."""
+    """The compiled functions (Numba) by name, or None when Numba is not installed."""
     try:
         import numba
     except ImportError:
@@ -53,7 +56,8 @@ def _compile():
     # the banded triangular solves, with contraction as OpenBLAS's Haswell dtbsv forms them.
     # x is (n_groups, n_dof, 4): the realizations in groups of four lanes (padded with zeros),
     # every lane solved by itself in dtbsv's order; four independent chains per group hide the
-    # latency of the dependent divide and multiply-adds, and the fixed four lanes vectorise
+    # latency of the dependent divide and multiply-adds (LLVM keeps the lanes scalar; measured:
+    # four lanes cost ≈ 1.4 x one, docs/performance.md)
     @njit(cache=True, nogil=True, fastmath={"contract"})
     def band_solve(c, x):  # pragma: no cover - compiled
         """Solve U^T U x = b in place for every lane of x (n_groups, n, 4); U upper band,
@@ -314,7 +318,10 @@ def _compile():
                 for k in range(q):
                     o[k] += x * BT[d, k]
 
-    return band_solve, steps, solve_columns, rotate, rowdot, background, steps_1
+    from types import SimpleNamespace
+
+    return SimpleNamespace(band_solve=band_solve, steps=steps, steps_1=steps_1, solve_columns=solve_columns,
+                           rotate=rotate, rowdot=rowdot, background=background)
 
 
 def _self_test(band_solve) -> bool:
@@ -403,7 +410,7 @@ def rowdot(X: np.ndarray, BT: np.ndarray) -> np.ndarray:
 
         return _rowdot(X, BT)
     out = np.empty((X.shape[0], BT.shape[1]))
-    _state["fns"][4](np.ascontiguousarray(X), np.ascontiguousarray(BT), out)
+    _state["fns"].rowdot(np.ascontiguousarray(X), np.ascontiguousarray(BT), out)
     return out
 
 
@@ -415,7 +422,7 @@ def rotate(X: np.ndarray, old, new) -> np.ndarray:
 
         return st_rotate(X, old, new)
     Y = np.array(X, dtype=float, order="C")
-    _state["fns"][3](Y, new.T if old is None else old.T, new.T, old is not None)
+    _state["fns"].rotate(Y, new.T if old is None else old.T, new.T, old is not None)
     return Y
 
 
@@ -430,9 +437,9 @@ def available() -> bool:
         if "ok" not in _state:
             try:
                 fns = _compile()
-                ok = fns is not None and _self_test(fns[0])
-                rot = ok and _rotate_test(fns[3])
-                dot = ok and _rowdot_test(fns[4])
+                ok = fns is not None and _self_test(fns.band_solve)
+                rot = ok and _rotate_test(fns.rotate)
+                dot = ok and _rowdot_test(fns.rowdot)
             except Exception:  # a Numba that cannot compile or cache here: the numpy loop (same bits)
                 fns, ok, rot, dot = None, False, False, False
             _state["ok"] = ok
@@ -461,7 +468,8 @@ def newmark_block(U: np.ndarray, V: np.ndarray, A: np.ndarray, loads: np.ndarray
         R: [N] receives the reactions G T u~ after every step, (n_b, n_real, n_r) (the bits of
             :func:`~linecheck.core.dynamics._sparse_reactions`).
     """
-    steps = _state["fns"][6 if U.shape[0] == 1 else 1]
+    fns = _state["fns"]
+    steps = fns.steps_1 if U.shape[0] == 1 else fns.steps
     if rest is None:
         z = np.zeros(1, dtype=np.int32)
         steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, False, z, z, np.zeros(1), a1, out, nz, GT, cols, R)
@@ -479,7 +487,7 @@ def background(c: np.ndarray, L: np.ndarray, load_dirs: np.ndarray | None, spars
     nz, GT, cols = sparse_g
     R = np.empty((L.shape[0], GT.shape[1]))
     dirs = np.zeros((1, 3)) if load_dirs is None else np.ascontiguousarray(load_dirs, dtype=float)
-    _state["fns"][5](c, np.ascontiguousarray(L), dirs, load_dirs is None, nz, GT, cols, R)
+    _state["fns"].background(c, np.ascontiguousarray(L), dirs, load_dirs is None, nz, GT, cols, R)
     return R
 
 
@@ -488,5 +496,5 @@ def solve_columns(c: np.ndarray, B: np.ndarray) -> np.ndarray:
 
     c: Cholesky factor of a banded SPD matrix (upper band storage, (BANDWIDTH + 1, n_dof));
     B: right-hand sides as columns.  Returns B (solved)."""
-    _state["fns"][2](c, B)
+    _state["fns"].solve_columns(c, B)
     return B

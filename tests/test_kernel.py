@@ -33,10 +33,17 @@ def _short(path, **analysis):
 
 
 def _both(monkeypatch, case, **kw):
+    """The run with the kernel forced on, then with the numpy loop; the kernel's step loop must
+    really have run the first (and not the second), or the comparison would prove nothing."""
+    calls = []
+    block = kernel.newmark_block
+    monkeypatch.setattr(kernel, "newmark_block", lambda *a: calls.append(1) or block(*a))
     monkeypatch.setenv("LINECHECK_KERNEL", "numba")
     fast = service.run_case(case, spectral_check=False, **kw)
+    n_fast = len(calls)
     monkeypatch.setenv("LINECHECK_KERNEL", "numpy")
     slow = service.run_case(case, spectral_check=False, **kw)
+    assert n_fast > 0 and len(calls) == n_fast
     return fast, slow
 
 
@@ -105,7 +112,11 @@ def test_long_line_background_solves_same_bits(monkeypatch):
 
     case = line_with_spans(case_with("case09-six", realizations=1), 24)
     case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, duration=30.0, burn_in=5.0))
+    used = []
+    bg = kernel.background
+    monkeypatch.setattr(kernel, "background", lambda *a: used.append(1) or bg(*a))
     fast, slow = _both(monkeypatch, case)
+    assert used  # the fused step-3 kernel ran
     assert np.array_equal(fast.resonant, slow.resonant)
     assert np.array_equal(fast.background, slow.background)
 
@@ -156,14 +167,20 @@ def test_static_transfer_rows_same_bits():
 
 
 @needs_kernel
-def test_section_banded_background_same_bits(monkeypatch):
-    """The fused step-3 kernel along a section's span normals: the 12-span section forced onto
-    the long-line path (banded background solves) by lowering its DOF threshold."""
+@pytest.mark.parametrize("tension", ["linear", "second-order"])
+def test_section_banded_background_same_bits(monkeypatch, tension):
+    """A long line's step 3 along a section's span normals: the 12-span section forced onto the
+    long-line path (banded background solves) by lowering its DOF threshold; linear tension takes
+    the fused kernel, second-order tension (which needs the displacements) the compiled solves."""
     from linecheck.core import dynamics
 
     monkeypatch.setattr(dynamics, "BACKGROUND_SOLVE_DOF", 100)
-    case = _short(CASES / "examples" / "section-12span.toml", duration=30.0)
+    case = _short(CASES / "examples" / "section-12span.toml", duration=30.0, tension=tension)
+    used = []
+    bg = kernel.background
+    monkeypatch.setattr(kernel, "background", lambda *a: used.append(1) or bg(*a))
     fast, slow = _both(monkeypatch, case, realizations=[0, 1, 2])
+    assert bool(used) == (tension == "linear")  # the fused step-3 kernel ran where it should
     assert np.array_equal(fast.background, slow.background)
     assert np.array_equal(fast.resonant, slow.resonant)
     assert np.abs(fast.background).max() > 0

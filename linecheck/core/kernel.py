@@ -43,6 +43,8 @@ import numpy as np
 
 _lock = threading.Lock()
 _state: dict[str, object] = {}
+_NO_INDEX = np.zeros(1, dtype=np.int32)  # the CSR arguments of a stepper without a remainder
+_NO_DATA = np.zeros(1)
 
 
 def _compile():
@@ -104,18 +106,40 @@ def _compile():
                     y[i, 3] += -x3 * cij
 
     @njit(cache=True, nogil=True)
+    def to_lanes(X):  # pragma: no cover - compiled
+        """Rows of X (m, n) as lanes (n_groups, n, 4): row r is lane r % 4 of group r // 4
+        (padding lanes zero)."""
+        m, n = X.shape
+        x = np.zeros(((m + 3) // 4, n, 4))
+        for r in range(m):
+            for d in range(n):
+                x[r // 4, d, r % 4] = X[r, d]
+        return x
+
+    @njit(cache=True, nogil=True)
+    def from_lanes(x, X):  # pragma: no cover - compiled
+        """The inverse of :func:`to_lanes`, into X (m, n)."""
+        m, n = X.shape
+        for r in range(m):
+            for d in range(n):
+                X[r, d] = x[r // 4, d, r % 4]
+
+    @njit(cache=True, nogil=True)
+    def reactions_into(u, nz, GT, cols, Rr):  # pragma: no cover - compiled
+        """Rr (n_r,) = G u, summed coordinate by coordinate from zero over the columns
+        [cols[q, 0], cols[q, 1]) of GT's row q (the order of dynamics._sparse_reactions)."""
+        Rr[:] = 0.0
+        for q in range(nz.size):
+            x = u[nz[q]]
+            for k in range(cols[q, 0], cols[q, 1]):
+                Rr[k] += x * GT[q, k]
+
+    @njit(cache=True, nogil=True)
     def solve_columns(c, B):  # pragma: no cover - compiled
         """dpbtrs on every column of B (n, m) in place, four columns at a time."""
-        n, m = B.shape
-        G = (m + 3) // 4
-        x = np.zeros((G, n, 4))
-        for r in range(m):
-            for d in range(n):
-                x[r // 4, d, r % 4] = B[d, r]
+        x = to_lanes(B.T)
         band_solve(c, x)
-        for r in range(m):
-            for d in range(n):
-                B[d, r] = x[r // 4, d, r % 4]
+        from_lanes(x, B.T)
 
     @njit(cache=True, nogil=True)
     def background(c, L, dirs, straight, nz, GT, cols, R):  # pragma: no cover - compiled
@@ -137,13 +161,7 @@ def _compile():
                         x[g, 3 * i + q, l] = f * dirs[i, q]
         band_solve(c, x)
         for r in range(m):
-            g, l = r // 4, r % 4
-            Rr = R[r]
-            Rr[:] = 0.0
-            for q in range(nz.size):
-                v = x[g, nz[q], l]
-                for k in range(cols[q, 0], cols[q, 1]):
-                    Rr[k] += v * GT[q, k]
+            reactions_into(x[r // 4, :, r % 4], nz, GT, cols, R[r])
 
     @njit(cache=True, nogil=True, fastmath={"contract"})
     def band_solve_1(c, x):  # pragma: no cover - compiled
@@ -197,12 +215,7 @@ def _compile():
                 v[d] = vn
                 u[d] = b[d]
                 out[k, 0, d] = b[d]
-            Rk = R[k, 0]
-            Rk[:] = 0.0
-            for q in range(nz.size):
-                x = u[nz[q]]
-                for cc in range(cols[q, 0], cols[q, 1]):
-                    Rk[cc] += x * GT[q, cc]
+            reactions_into(u, nz, GT, cols, R[k, 0])
 
     @njit(cache=True, nogil=True)
     def steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, indptr, indices, data, a1,
@@ -215,18 +228,13 @@ def _compile():
         [cols[i, 0], cols[i, 1]) of GT's row i (the order of dynamics._sparse_reactions)."""
         n_b, m, n_free = loads.shape
         n = U.shape[1]
-        G = (m + 3) // 4
-        u = np.zeros((G, n, 4))  # lane l of group g is realization 4 g + l (padding lanes stay 0)
-        v = np.zeros((G, n, 4))
-        a = np.zeros((G, n, 4))
+        u = to_lanes(U)  # lane l of group g is realization 4 g + l (padding lanes stay 0)
+        v = to_lanes(V)
+        a = to_lanes(A)
+        G = u.shape[0]
         b = np.zeros((G, n, 4))
         w = np.zeros((n, 4))
         f = np.zeros(4)
-        for r in range(m):
-            for d in range(n):
-                u[r // 4, d, r % 4] = U[r, d]
-                v[r // 4, d, r % 4] = V[r, d]
-                a[r // 4, d, r % 4] = A[r, d]
         for k in range(n_b):
             for g in range(G):
                 ug, vg, ag, bg = u[g], v[g], a[g], b[g]
@@ -268,21 +276,12 @@ def _compile():
                         ag[d, l] = (vn - vg[d, l]) * r2 - ag[d, l]
                         vg[d, l] = vn
                         ug[d, l] = bg[d, l]
+            from_lanes(u, out[k])
             for r in range(m):
-                ur = u[r // 4, :, r % 4]
-                for d in range(n):
-                    out[k, r, d] = ur[d]
-                Rk = R[k, r]
-                Rk[:] = 0.0
-                for q in range(nz.size):
-                    x = ur[nz[q]]
-                    for c in range(cols[q, 0], cols[q, 1]):
-                        Rk[c] += x * GT[q, c]
-        for r in range(m):
-            for d in range(n):
-                U[r, d] = u[r // 4, d, r % 4]
-                V[r, d] = v[r // 4, d, r % 4]
-                A[r, d] = a[r // 4, d, r % 4]
+                reactions_into(u[r // 4, :, r % 4], nz, GT, cols, R[k, r])
+        from_lanes(u, U)
+        from_lanes(v, V)
+        from_lanes(a, A)
 
     @njit(cache=True, nogil=True)
     def rotate(X, To, Tn, has_old):  # pragma: no cover - compiled
@@ -471,8 +470,8 @@ def newmark_block(U: np.ndarray, V: np.ndarray, A: np.ndarray, loads: np.ndarray
     fns = _state["fns"]
     steps = fns.steps_1 if U.shape[0] == 1 else fns.steps
     if rest is None:
-        z = np.zeros(1, dtype=np.int32)
-        steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, False, z, z, np.zeros(1), a1, out, nz, GT, cols, R)
+        steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, False, _NO_INDEX, _NO_INDEX, _NO_DATA, a1, out, nz, GT,
+              cols, R)
     else:
         steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, True, rest.indptr, rest.indices, rest.data, a1, out, nz, GT, cols, R)
 

@@ -555,9 +555,10 @@ def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: n
     # the free nodes are usually one run (all but the strain towers' nodes): a slice, no gathers
     run = free.size and np.array_equal(free, np.arange(free[0], free[0] + free.size))
     sel = slice(int(free[0]), int(free[0]) + free.size) if run else free
-    pv = per_v[:, sel]
+    pv, pv_p = per_v[:, sel], per_v[:, pinned]
     if quad:
         pq, s2 = np.broadcast_to(per_q, vn.shape)[:, sel], np.broadcast_to(sig2, vn.shape)[:, sel]
+        pq_p, s2_p = np.broadcast_to(per_q, vn.shape)[:, pinned], np.broadcast_to(sig2, vn.shape)[:, pinned]
     for i in range(n_real):
         # the same elementwise products as on every node, written straight into the loads
         vi = v[i][:, sel]
@@ -570,9 +571,9 @@ def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: n
         if not pinned.size:
             continue
         vp = v[i][:, pinned]
-        f_i = per_v[:, pinned] * vp  # (n_steps, n_pinned)
+        f_i = pv_p * vp  # (n_steps, n_pinned)
         if quad:
-            f_i += np.broadcast_to(per_q, vn.shape)[:, pinned] * (vp * vp - np.broadcast_to(sig2, vn.shape)[:, pinned])
+            f_i += pq_p * (vp * vp - s2_p)
         # loads at pinned nodes go straight into their supports (R_y; a section: along the node normal)
         if system.straight_in_plan:
             direct[:, i, 3 * np.flatnonzero(~system.suspension) + 1] = f_i

@@ -263,13 +263,13 @@ def integrate(
     # bases and rotated bands of all mean states in vectorised chunks (issue 20); the
     # reference scheme (model_at) builds one operator per step instead
     stacked = _StackedBases(models, damping, np.asarray(state_of_step)[starts]) if model_at is None else None
+    rot = kernel.rotate if compiled else st_rotate  # the change of node bases (the same bits)
     for s0, s1 in zip(starts, ends):
         if stacked is None:
             new = _Stepper.build(*model_of(int(s0)), nm, load_dirs)
         else:
             k = int(state_of_step[s0])
             new = _Stepper.from_bases(models[k], *stacked.get(k), nm, load_dirs)
-        rot = kernel.rotate if compiled else st_rotate  # the same bits
         if st is None:
             U = rot(U, None, new)
             V = np.zeros_like(U)

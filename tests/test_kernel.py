@@ -199,3 +199,35 @@ def test_a_numba_that_fails_falls_back_to_numpy(monkeypatch):
     case = _short(CASES / "paper" / "case09-single.toml", duration=20.0, burn_in=5.0)
     res = service.run_case(case, realizations=[0], spectral_check=False)
     assert np.all(np.isfinite(res.resonant)) and np.abs(res.resonant).max() > 0
+
+
+_CACHE_PROBE = r'''
+import dataclasses, os
+from linecheck import service
+from linecheck.core import kernel
+from linecheck.core.case import load_case
+case = load_case(os.environ["PROBE_CASE"])
+case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, duration=4.0, burn_in=1.0))
+for n in (1, 5):  # steps_1 and the four-lane steps
+    service.run_case(case, realizations=list(range(n)), spectral_check=False)
+fns = kernel._state["fns"]
+print(sum(sum(getattr(fns, f).stats.cache_misses.values()) for f in ("steps", "steps_1", "band_solve")),
+      sum(sum(getattr(fns, f).stats.cache_hits.values()) for f in ("steps", "steps_1", "band_solve")))
+'''
+
+
+@needs_kernel
+def test_the_compiled_loops_load_from_the_disk_cache_in_a_new_process(tmp_path):
+    """A second process finds the step loops in Numba's disk cache instead of compiling them
+    again (they once called other jitted functions through closure cells, which gave every
+    process a new cache key: ≈ 1–2 s of compilation per function and process)."""
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, LINECHECK_KERNEL="numba", NUMBA_CACHE_DIR=str(tmp_path),
+               PROBE_CASE=str(CASES / "paper" / "case09-single.toml"))
+    runs = [subprocess.run([sys.executable, "-c", _CACHE_PROBE], env=env, capture_output=True, text=True,
+                           check=True).stdout.split() for _ in range(2)]
+    assert int(runs[0][0]) == 3  # a fresh cache folder: compiled (and written) by the first
+    assert runs[1] == ["0", "3"]  # the second loads all three from it

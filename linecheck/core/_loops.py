@@ -1,0 +1,291 @@
+"""The compiled loops of the optional kernel (issue 20): Numba functions at module level.
+
+Imported only by :func:`linecheck.core.kernel._compile`, i.e. only when the kernel is asked
+for (the rest of the core imports numpy and scipy only; tests/test_import_boundary.py).  The
+functions are module-level so that Numba's on-disk cache (``cache=True``) can key them: a
+function that calls other jitted functions through closure cells gets a new cache key in every
+process (the cells are pickled by identity) and was recompiled every time (≈ 1–2 s per function
+and process, and a new cache entry each time).  What the loops compute, and why their bits
+equal the numpy loop's, is documented in :mod:`linecheck.core.kernel`.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+__all__ = ["background", "band_solve", "band_solve_1", "from_lanes", "reactions_into", "rotate", "rowdot",
+           "solve_columns", "steps", "steps_1", "to_lanes"]
+
+
+# the banded triangular solves, with contraction as OpenBLAS's Haswell dtbsv forms them.
+# x is (n_groups, n_dof, 4): the realizations in groups of four lanes (padded with zeros),
+# every lane solved by itself in dtbsv's order; four independent chains per group hide the
+# latency of the dependent divide and multiply-adds (LLVM keeps the lanes scalar; measured:
+# four lanes cost ≈ 1.4 x one, docs/performance.md)
+@numba.njit(cache=True, nogil=True, fastmath={"contract"})
+def band_solve(c, x):  # pragma: no cover - compiled
+    """Solve U^T U x = b in place for every lane of x (n_groups, n, 4); U upper band,
+    c[kd + i - j, j] = U[i, j]."""
+    kd = c.shape[0] - 1
+    n = c.shape[1]
+    for g in range(x.shape[0]):
+        y = x[g]
+        for j in range(n):  # U^T y = b: dtbsv('U', 'T', 'N'), a dot product per row
+            k = min(j, kd)
+            s0 = 0.0
+            s1 = 0.0
+            s2 = 0.0
+            s3 = 0.0
+            for t in range(k):
+                i = j - k + t
+                cij = c[kd + i - j, j]
+                s0 += cij * y[i, 0]
+                s1 += cij * y[i, 1]
+                s2 += cij * y[i, 2]
+                s3 += cij * y[i, 3]
+            cjj = c[kd, j]
+            y[j, 0] = (y[j, 0] - s0) / cjj
+            y[j, 1] = (y[j, 1] - s1) / cjj
+            y[j, 2] = (y[j, 2] - s2) / cjj
+            y[j, 3] = (y[j, 3] - s3) / cjj
+        for j in range(n - 1, -1, -1):  # U x = y: dtbsv('U', 'N', 'N'), an axpy per column
+            cjj = c[kd, j]
+            x0 = y[j, 0] / cjj
+            x1 = y[j, 1] / cjj
+            x2 = y[j, 2] / cjj
+            x3 = y[j, 3] / cjj
+            y[j, 0] = x0
+            y[j, 1] = x1
+            y[j, 2] = x2
+            y[j, 3] = x3
+            k = min(j, kd)
+            for t in range(k):
+                i = j - k + t
+                cij = c[kd + i - j, j]
+                y[i, 0] += -x0 * cij
+                y[i, 1] += -x1 * cij
+                y[i, 2] += -x2 * cij
+                y[i, 3] += -x3 * cij
+
+
+@numba.njit(cache=True, nogil=True)
+def to_lanes(X):  # pragma: no cover - compiled
+    """Rows of X (m, n) as lanes (n_groups, n, 4): row r is lane r % 4 of group r // 4
+    (padding lanes zero)."""
+    m, n = X.shape
+    x = np.zeros(((m + 3) // 4, n, 4))
+    for r in range(m):
+        for d in range(n):
+            x[r // 4, d, r % 4] = X[r, d]
+    return x
+
+
+@numba.njit(cache=True, nogil=True)
+def from_lanes(x, X):  # pragma: no cover - compiled
+    """The inverse of :func:`to_lanes`, into X (m, n)."""
+    m, n = X.shape
+    for r in range(m):
+        for d in range(n):
+            X[r, d] = x[r // 4, d, r % 4]
+
+
+@numba.njit(cache=True, nogil=True)
+def reactions_into(u, nz, GT, cols, Rr):  # pragma: no cover - compiled
+    """Rr (n_r,) = G u, summed coordinate by coordinate from zero over the columns
+    [cols[q, 0], cols[q, 1]) of GT's row q (the order of dynamics._sparse_reactions)."""
+    Rr[:] = 0.0
+    for q in range(nz.size):
+        x = u[nz[q]]
+        for k in range(cols[q, 0], cols[q, 1]):
+            Rr[k] += x * GT[q, k]
+
+
+@numba.njit(cache=True, nogil=True)
+def solve_columns(c, B):  # pragma: no cover - compiled
+    """dpbtrs on every column of B (n, m) in place, four columns at a time."""
+    x = to_lanes(B.T)
+    band_solve(c, x)
+    from_lanes(x, B.T)
+
+
+@numba.njit(cache=True, nogil=True)
+def background(c, L, dirs, straight, nz, GT, cols, R):  # pragma: no cover - compiled
+    """Step 3 of a long line for rows of loads L (m, n_free): K u = loads (global y, or along
+    ``dirs`` (n_free, 3) when not ``straight``), solved four rows at a time, and R (m, n_r)
+    = G u summed coordinate by coordinate from zero (dynamics._sparse_reactions' order)."""
+    m, n_free = L.shape
+    n = c.shape[1]
+    G = (m + 3) // 4
+    x = np.zeros((G, n, 4))
+    for r in range(m):
+        g, l = r // 4, r % 4
+        for i in range(n_free):
+            f = L[r, i]
+            if straight:
+                x[g, 3 * i + 1, l] = f
+            else:
+                for q in range(3):
+                    x[g, 3 * i + q, l] = f * dirs[i, q]
+    band_solve(c, x)
+    for r in range(m):
+        reactions_into(x[r // 4, :, r % 4], nz, GT, cols, R[r])
+
+
+@numba.njit(cache=True, nogil=True, fastmath={"contract"})
+def band_solve_1(c, x):  # pragma: no cover - compiled
+    """:func:`band_solve` for one vector x (n,) (one realization: no lanes)."""
+    kd = c.shape[0] - 1
+    n = c.shape[1]
+    for j in range(n):
+        k = min(j, kd)
+        s0 = 0.0
+        for t in range(k):
+            i = j - k + t
+            s0 += c[kd + i - j, j] * x[i]
+        x[j] = (x[j] - s0) / c[kd, j]
+    for j in range(n - 1, -1, -1):
+        x0 = x[j] / c[kd, j]
+        x[j] = x0
+        k = min(j, kd)
+        for t in range(k):
+            i = j - k + t
+            x[i] += -x0 * c[kd + i - j, j]
+
+
+@numba.njit(cache=True, nogil=True)
+def steps_1(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, indptr, indices, data, a1,
+            out, nz, GT, cols, R):  # pragma: no cover - compiled
+    """:func:`steps` for one realization (U, V, A of shape (1, n_dof)): plain vectors."""
+    n_b, _, n_free = loads.shape
+    n = U.shape[1]
+    u = U[0]
+    v = V[0]
+    a = A[0]
+    b = np.empty(n)
+    w = np.empty(n)
+    for k in range(n_b):
+        for i in range(n_free):
+            f = loads[k, 0, i]
+            for q in range(3):
+                d = 3 * i + q
+                b[d] = ((cu[d] * u[d] + cv[d] * v[d]) + dm[d] * a[d]) + f * ycoef[i, q]
+        if has_rest:
+            for d in range(n):
+                w[d] = a1 * u[d] + v[d]
+            for d in range(n):
+                t0 = 0.0
+                for jj in range(indptr[d], indptr[d + 1]):
+                    t0 += data[jj] * w[indices[jj]]
+                b[d] += t0
+        band_solve_1(chat, b)
+        for d in range(n):
+            vn = (b[d] - u[d]) * r2 - v[d]
+            a[d] = (vn - v[d]) * r2 - a[d]
+            v[d] = vn
+            u[d] = b[d]
+            out[k, 0, d] = b[d]
+        reactions_into(u, nz, GT, cols, R[k, 0])
+
+
+@numba.njit(cache=True, nogil=True)
+def steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, indptr, indices, data, a1,
+          out, nz, GT, cols, R):  # pragma: no cover - compiled
+    """Newmark steps of one block; U, V, A updated in place.
+
+    U, V, A (n_real, n_dof) rotated state; loads (n_b, n_real, n_free) [N]; ycoef
+    (n_free, 3); out (n_b, n_real, n_dof) receives u after every step; R (n_b, n_real, n_r)
+    the reactions G u, summed coordinate by coordinate from zero over the columns
+    [cols[i, 0], cols[i, 1]) of GT's row i (the order of dynamics._sparse_reactions)."""
+    n_b, m, n_free = loads.shape
+    n = U.shape[1]
+    u = to_lanes(U)  # lane l of group g is realization 4 g + l (padding lanes stay 0)
+    v = to_lanes(V)
+    a = to_lanes(A)
+    G = u.shape[0]
+    b = np.zeros((G, n, 4))
+    w = np.zeros((n, 4))
+    f = np.zeros(4)
+    for k in range(n_b):
+        for g in range(G):
+            ug, vg, ag, bg = u[g], v[g], a[g], b[g]
+            for i in range(n_free):  # F = load x ycoef (the numpy loop's Fb)
+                for l in range(4):
+                    r = 4 * g + l
+                    f[l] = loads[k, r, i] if r < m else 0.0
+                for q in range(3):
+                    d = 3 * i + q
+                    yc = ycoef[i, q]
+                    for l in range(4):
+                        bg[d, l] = ((cu[d] * ug[d, l] + cv[d] * vg[d, l]) + dm[d] * ag[d, l]) + f[l] * yc
+            if has_rest:  # C~_off (a1 u + v): csr_matvecs order, each row summed from 0
+                for d in range(n):
+                    for l in range(4):
+                        w[d, l] = a1 * ug[d, l] + vg[d, l]
+                for d in range(n):
+                    t0 = 0.0
+                    t1 = 0.0
+                    t2 = 0.0
+                    t3 = 0.0
+                    for jj in range(indptr[d], indptr[d + 1]):
+                        gj = data[jj]
+                        e = indices[jj]
+                        t0 += gj * w[e, 0]
+                        t1 += gj * w[e, 1]
+                        t2 += gj * w[e, 2]
+                        t3 += gj * w[e, 3]
+                    bg[d, 0] += t0
+                    bg[d, 1] += t1
+                    bg[d, 2] += t2
+                    bg[d, 3] += t3
+        band_solve(chat, b)
+        for g in range(G):
+            ug, vg, ag, bg = u[g], v[g], a[g], b[g]
+            for d in range(n):  # v' = (u' - u) 2/dt - v, a' = (v' - v) 2/dt - a
+                for l in range(4):
+                    vn = (bg[d, l] - ug[d, l]) * r2 - vg[d, l]
+                    ag[d, l] = (vn - vg[d, l]) * r2 - ag[d, l]
+                    vg[d, l] = vn
+                    ug[d, l] = bg[d, l]
+        from_lanes(u, out[k])
+        for r in range(m):
+            reactions_into(u[r // 4, :, r % 4], nz, GT, cols, R[k, r])
+    from_lanes(u, U)
+    from_lanes(v, V)
+    from_lanes(a, A)
+
+
+@numba.njit(cache=True, nogil=True)
+def rotate(X, To, Tn, has_old):  # pragma: no cover - compiled
+    """X (n_real, n_dof) from the node bases To (global if not has_old) to Tn, in place."""
+    m, n = X.shape
+    for r in range(m):
+        for i in range(n // 3):
+            x0 = X[r, 3 * i]
+            x1 = X[r, 3 * i + 1]
+            x2 = X[r, 3 * i + 2]
+            if has_old:  # u = T u~: numpy's einsum sums this 3-term reduction as (p0 + p2) + p1
+                g0 = (x0 * To[i, 0, 0] + x2 * To[i, 0, 2]) + x1 * To[i, 0, 1]
+                g1 = (x0 * To[i, 1, 0] + x2 * To[i, 1, 2]) + x1 * To[i, 1, 1]
+                g2 = (x0 * To[i, 2, 0] + x2 * To[i, 2, 2]) + x1 * To[i, 2, 1]
+            else:
+                g0 = x0
+                g1 = x1
+                g2 = x2
+            for j in range(3):  # u~ = T^T u: summed in order (p0 + p1) + p2
+                X[r, 3 * i + j] = (g0 * Tn[i, 0, j] + g1 * Tn[i, 1, j]) + g2 * Tn[i, 2, j]
+
+
+@numba.njit(cache=True, nogil=True)
+def rowdot(X, BT, out):  # pragma: no cover - compiled
+    """out = X @ BT, every row summed over d in order from zero (numpy's einsum "rd,dk->rk")."""
+    m, n = X.shape
+    q = BT.shape[1]
+    for r in range(m):
+        o = out[r]
+        for k in range(q):
+            o[k] = 0.0
+        for d in range(n):
+            x = X[r, d]
+            for k in range(q):
+                o[k] += x * BT[d, k]

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .core import budget
+from .core import budget, kernel
 from .core.case import Case
 from .core.damping import (aerodynamic_damping, aerodynamic_damping_stack, stiffness_proportional,
                            stiffness_proportional_stack)
@@ -584,6 +584,69 @@ def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: n
     return loads, direct
 
 
+class _AnyEvent:
+    """Set when the caller's cancel event is set or :meth:`set` was called (a failed chunk stops
+    its siblings); duck-types the ``is_set`` of :class:`threading.Event` for the core loops."""
+
+    def __init__(self, cancel: threading.Event | None) -> None:
+        self._cancel, self._own = cancel, threading.Event()
+
+    def set(self) -> None:
+        self._own.set()
+
+    def is_set(self) -> bool:
+        return self._own.is_set() or (self._cancel is not None and self._cancel.is_set())
+
+
+def _map_chunks(fn, n: int, threads: int, stop: _AnyEvent) -> list:
+    """[fn(0), ..., fn(n - 1)] in order, on up to ``threads`` threads.  The first failure sets
+    ``stop`` (the other chunks end at their next cancellation check) and is raised once every
+    started chunk has ended; a chunk stopped that way raises Cancelled, which is not reported."""
+    if threads <= 1 or n <= 1:
+        return [fn(i) for i in range(n)]
+    from concurrent.futures import ThreadPoolExecutor
+
+    out: list = [None] * n
+    errors: list[tuple[int, BaseException]] = []
+
+    def one(i: int) -> None:
+        if stop.is_set():
+            return
+        try:
+            out[i] = fn(i)
+        except BaseException as exc:  # noqa: BLE001 - re-raised below in the calling thread
+            errors.append((i, exc))
+            stop.set()
+
+    ex = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="linecheck-chunk")
+    try:
+        list(ex.map(one, range(n)))
+    except BaseException:  # e.g. Ctrl-C in the calling thread: the chunks stop at their next check
+        stop.set()
+        raise
+    finally:
+        ex.shutdown(wait=True, cancel_futures=True)
+    if errors:
+        real = [e for e in errors if not isinstance(e[1], Cancelled)]
+        raise min(real or errors, key=lambda e: e[0])[1]
+    if any(o is None for o in out):  # cancelled before that chunk started
+        raise Cancelled("run cancelled")
+    return out
+
+
+def run_threads(case: Case, n_real: int, threads: int, *, burn_in: float | None = None,
+                spectral_check: bool = True) -> int:
+    """Threads for ``run_case``: at most ``threads`` and one per realization, and no more than
+    keep the estimated memory (:func:`linecheck.core.budget.estimate`) within the limit; 1 when
+    even that does not fit (``check_budget`` then refuses the run with its message)."""
+    k = max(1, min(int(threads), int(n_real)))
+    limit, _ = budget.memory_limit()
+    while k > 1 and budget.estimate(case, "run", realizations=n_real, burn_in=burn_in,
+                                    spectral_check=spectral_check, threads=k).memory > limit:
+        k -= 1
+    return k
+
+
 def run_case(
     case: Case,
     *,
@@ -593,6 +656,7 @@ def run_case(
     progress: Progress | None = None,
     cancel: threading.Event | None = None,
     warn: Warn | None = None,
+    threads: int = 1,
 ) -> RunResult:
     """Steps 1-3 of the method for ``case`` and the statistics of Eqs 15-17.
 
@@ -609,13 +673,19 @@ def run_case(
         cancel: a :class:`threading.Event`; when set the run stops with ``Cancelled``.
         warn: ``warn(message)`` receives resource warnings; above the memory limit the run
             is refused before any work (:func:`check_budget`, CaseError).
+        threads: realization chunks integrated at once in threads (the wind synthesis, steps
+            2-3 and statistics of a chunk; step 1 and the check run once).  Every realization's
+            arithmetic is its own, so the result is bit-identical whatever ``threads``; fewer
+            threads are used where the chunks in flight would exceed the memory limit
+            (:func:`run_threads`).  Batch and scan workers are processes and keep 1.
     """
     from .core.wind.turbulence import fluctuating_velocity
 
     real = np.arange(case.analysis.realizations) if realizations is None else np.asarray(realizations, dtype=int)
+    threads = run_threads(case, int(real.size), threads, spectral_check=spectral_check)
     warned: list[str] = []
     check_budget(case, "run", warn=lambda m: (warned.append(m), warn(m) if warn else None),
-                 realizations=int(real.size), spectral_check=spectral_check)
+                 realizations=int(real.size), spectral_check=spectral_check, threads=threads)
     st = _static_analysis(case, progress=progress, cancel=cancel)
     system, mean = st.system, st.mean
     t = record_time(case)
@@ -640,8 +710,9 @@ def run_case(
     burn = synoptic_burn_in(case, st, sm, windows) if synoptic else BurnIn(
         0.0, 0.0, float("nan"), float("nan"), True, "none: a downburst starts from a weak running mean")
     if burn.seconds > 0:  # the derived burn-in lengthens the record: check the budget again
+        threads = run_threads(case, int(real.size), threads, burn_in=burn.seconds, spectral_check=spectral_check)
         check_budget(case, "run", warn=None if warned else warn, realizations=int(real.size),
-                     burn_in=burn.seconds, spectral_check=spectral_check)
+                     burn_in=burn.seconds, spectral_check=spectral_check, threads=threads)
         t = t[0] - dt * np.round(burn.seconds / dt) + dt * np.arange(t.size + int(np.round(burn.seconds / dt)))
     keep = t >= t[0] + burn.seconds - 1e-9  # the analysed record (after the burn-in)
     state_of_step, bracket, weights = _state_of_step(mean.time, t)
@@ -666,37 +737,55 @@ def run_case(
     load_dirs = None if system.straight_in_plan else system.node_normals[models[0].dofs.free_nodes]
     model_at = _interpolated_models(case, st, bracket, weights) if interpolate_states else None
 
-    # ---- realizations in chunks that fit in memory (issue 20: long lines): every realization's
-    # turbulence, Newmark columns and statistics are its own, so chunking changes no bit
-    chunk = budget.realization_chunk(case, t.size)
+    # ---- realizations in chunks that fit in memory (issue 20: long lines), ``threads`` of them at
+    # once: every realization's turbulence, Newmark columns and statistics are its own, so
+    # neither the chunking nor the threads change a bit
+    if threads > 1 and not kernel.use(float(t.size) * real.size * models[0].mass.size):
+        threads = 1  # the numpy step loop holds the GIL between its small calls: threads lose time
+    chunk = budget.realization_chunk(case, t.size, threads)
+    if threads > 1:
+        chunk = min(chunk, -(-real.size // threads))
     M_keep, still_air, window = M[keep], system.to_tower_frames(mean.still_air.reactions), peak_window_steps(case)
-    parts_stats, parts_B, parts_R = [], [], []
     n_chunks = -(-real.size // chunk)
-    for ci in range(n_chunks):
+    stop = _AnyEvent(cancel)  # the user's cancel, or a failed sibling chunk
+    lock = threading.Lock()
+    winds_done, steps_done = [0], [0] * n_chunks
+
+    def report(stage: str, done: int, total: int) -> None:
+        if progress is not None:
+            with lock:  # one call at a time, whichever thread reports
+                progress(stage, done, total)
+
+    def run_chunk(ci: int):
         rc = real[ci * chunk:(ci + 1) * chunk]
         # ---- fluctuating load F_w = rho C_d D L_e V_m v (paper Eq. 5), normal components
-        if progress is not None:
-            progress("wind", ci, n_chunks)
+        report("wind", winds_done[0], n_chunks)
         v = fluctuating_velocity(case, system, t, list(rc))  # (n_real, n_steps, n_nodes), along-wind
         loads, direct = fluctuating_loads(case, system, models[0], t, v, vn, vl)
-        if progress is not None:
-            progress("wind", ci + 1, n_chunks)
-        check_cancel()
+        with lock:
+            winds_done[0] += 1
+        report("wind", winds_done[0], n_chunks)
+        if stop.is_set():
+            raise Cancelled("run cancelled")
         del v
-        cb = None if progress is None else (
-            lambda d, n, ci=ci: progress("steps 2-3: dynamics", ci * n + d, n_chunks * n))
+
+        def cb(d: int, n: int) -> None:
+            steps_done[ci] = d
+            report("steps 2-3: dynamics", sum(steps_done), n_chunks * n)
+
         resp = integrate(models, damping, state_of_step, loads, dt, direct=direct, model_at=model_at,
-                         second_order=second, second_order_start=int(np.argmax(keep)), progress=cb, cancel=cancel,
-                         load_dirs=load_dirs)
+                         second_order=second, second_order_start=int(np.argmax(keep)),
+                         progress=None if progress is None else cb, cancel=stop, load_dirs=load_dirs)
         del loads, direct
         # every reaction from here on in its tower's own frame (issue 17; a straight line: the global frame)
         resp = DynamicResponse(system.to_tower_frames(resp.fluctuating), system.to_tower_frames(resp.background))
         Bk, Rk = resp.background[:, keep], resp.resonant[:, keep]
         del resp
-        parts_stats.append(compute_statistics(M_keep, Bk, Rk, still_air, gL, window=window))
-        parts_B.append(Bk[:, :, j, :].copy())
-        parts_R.append(Rk[:, :, j, :].copy())
-        del Bk, Rk
+        return (compute_statistics(M_keep, Bk, Rk, still_air, gL, window=window),
+                Bk[:, :, j, :].copy(), Rk[:, :, j, :].copy())
+
+    parts = _map_chunks(run_chunk, n_chunks, threads, stop)
+    parts_stats, parts_B, parts_R = (list(p) for p in zip(*parts))
     stats = parts_stats[0] if n_chunks == 1 else Statistics.concatenate(parts_stats)
     spectral = (spectral_analysis(case, static=st, synoptic=sm, windows=windows)
                 if synoptic and spectral_check else None)
@@ -772,6 +861,7 @@ def run_until(
     progress: Progress | None = None,
     cancel: threading.Event | None = None,
     warn: Warn | None = None,
+    threads: int = 1,
 ) -> RunResult:
     """Add realizations in chunks until :func:`relative_standard_error` <= ``target`` [-] or
     ``max_realizations`` have run (issue 18).
@@ -785,7 +875,7 @@ def run_until(
         raise ValueError(f"target {target!r} must be > 0")
     n = max(2, min(case.analysis.realizations, max_realizations))
     parts = [run_case(case, realizations=np.arange(n), interpolate_states=interpolate_states,
-                      spectral_check=spectral_check, progress=progress, cancel=cancel, warn=warn)]
+                      spectral_check=spectral_check, progress=progress, cancel=cancel, warn=warn, threads=threads)]
     while True:
         res = join_runs(parts)
         achieved = relative_standard_error(res)
@@ -796,7 +886,7 @@ def run_until(
         want = done * (achieved / target) ** 2 * UNTIL_OVERSHOOT if np.isfinite(achieved) else 2 * done
         nxt = int(min(max_realizations, done + UNTIL_MAX_CHUNK, max(done + 1, int(np.ceil(want)))))
         parts.append(run_case(case, realizations=np.arange(done, nxt), interpolate_states=interpolate_states,
-                              spectral_check=False, progress=progress, cancel=cancel, warn=warn))
+                              spectral_check=False, progress=progress, cancel=cancel, warn=warn, threads=threads))
 
 
 @dataclass(frozen=True)

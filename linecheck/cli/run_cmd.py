@@ -189,10 +189,17 @@ def run(
     models: ModelsOpt = None,
     until: UntilOpt = None,
     max_realizations: MaxRealOpt = 1000,
+    jobs: Annotated[int | None, typer.Option(
+        "--jobs", "-j", min=1, show_default=False,
+        help="Threads integrating realizations at once (default: the number of cores; the results are the "
+             "same bits whatever the number).")] = None,
 ) -> None:
     """Steps 1-3: mean, background and resonant reactions, gust factors and contributions."""
+    from ..batch.executors import default_jobs
+
     fields = title_block(project, line, engineer, revision, title, excel=excel)
     apply_max_memory(max_memory)
+    threads = default_jobs() if jobs is None else jobs
     case = override(read_case(case_file), realizations, seed)
     target = parse_until(until)
     if json_out is not None:
@@ -204,14 +211,16 @@ def run(
     names = service.parse_models(case, models) if models is not None else ()
     with progress_bar() as cb:
         if names:
-            spread = service.run_models(case, names, progress=cb, spectral_check=not no_check, warn=limits_warn)
+            spread = service.run_models(case, names, progress=cb, spectral_check=not no_check, warn=limits_warn,
+                                        threads=threads)
             own = case.wind.downburst.model_name
             res = spread[own] if own in spread else next(iter(spread.values()))
         elif target is not None:
             res = service.run_until(case, target, max_realizations=max_realizations, progress=cb,
-                                    spectral_check=not no_check, warn=limits_warn)
+                                    spectral_check=not no_check, warn=limits_warn, threads=threads)
         else:
-            res = service.run_case(case, progress=cb, spectral_check=not no_check, warn=limits_warn)
+            res = service.run_case(case, progress=cb, spectral_check=not no_check, warn=limits_warn,
+                                   threads=threads)
     doc = run_document(res, full_histories=full_histories)
     if names:
         from ..io.jsonout import model_reactions, with_models

@@ -153,14 +153,14 @@ def record_steps(case: Case, burn_in: float = 0.0) -> int:
 RUN_CHUNK_BYTES = 1.0e9  # [bytes] realizations of one run are integrated in chunks of about this size
 
 
-def realization_chunk(case: Case, n_steps: int) -> int:
+def realization_chunk(case: Case, n_steps: int, threads: int = 1) -> int:
     """Realizations integrated together [-] (``service.run_case``): all of them unless their
     whole-record arrays (turbulence, loads and work arrays per node, reaction histories per
     tower: about 3 n_nodes + 24 n_towers doubles per step and realization) exceed
-    :data:`RUN_CHUNK_BYTES` (issue 20)."""
+    :data:`RUN_CHUNK_BYTES` (issue 20) shared by the ``threads`` chunks in flight at once."""
     n_nodes, _, n_towers = _sizes(case)
     per = float(n_steps) * F8 * (3 * n_nodes + 24 * n_towers)
-    return max(1, int(RUN_CHUNK_BYTES // per))
+    return max(1, int(RUN_CHUNK_BYTES / max(1, int(threads)) // per))
 
 
 def _dense(n_dof: int) -> tuple[float, float]:
@@ -168,13 +168,14 @@ def _dense(n_dof: int) -> tuple[float, float]:
 
 
 def estimate(case: Case, job: str = "run", *, realizations: int | None = None, burn_in: float | None = None,
-             spectral_check: bool = True) -> Estimate:
+             spectral_check: bool = True, threads: int = 1) -> Estimate:
     """Estimate peak memory and time of ``job`` for ``case``.
 
     job: ``run`` (steps 1-3; ``realizations`` held at once, default all), ``static``
     (step 1), ``modes``, ``spectral`` (frequency-domain check), ``wind`` (point p, one
     realization).  burn_in [s]: the synoptic burn-in once known (default
-    ``analysis.burn_in`` or 0).
+    ``analysis.burn_in`` or 0).  threads: realization chunks of a run integrated at once
+    (``service.run_case``); the time is the single-thread work (the wall time is shorter).
     """
     a = case.analysis
     n_nodes, n_dof, n_towers = _sizes(case)
@@ -201,7 +202,8 @@ def estimate(case: Case, job: str = "run", *, realizations: int | None = None, b
         parts["dense matrices"] = mem
         secs += t * (3.0 if windowed else 1.0)  # two or three windows
     if job == "run":
-        held = min(n_real, realization_chunk(case, n_steps))  # realizations in memory at once
+        k = max(1, min(int(threads), n_real))
+        held = min(n_real, k * realization_chunk(case, n_steps, k))  # realizations in memory at once
         # the chunk's whole-record arrays, plus what the result keeps of every realization: B and R
         # at the tower of interest (6 doubles per step) and 15 statistics per tower and reaction
         parts["time histories"] = (REC_ARRAYS * F8 * float(held) * n_steps * n_nodes + STEP_ARRAYS * F8 * n_steps * n_nodes

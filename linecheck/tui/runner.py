@@ -14,6 +14,7 @@ import time
 from dataclasses import dataclass
 
 from .. import service
+from ..batch.executors import default_jobs
 from ..core.case import Case
 from ..core.errors import Cancelled
 from ..io.document import RunDocument
@@ -56,6 +57,7 @@ def execute(
     ``models``: e.g. ``"all"``: the downburst model spread (issue 15; :func:`service.run_models`);
     the result tabs show the case's own model, the document gets the ``"models"`` block."""
     t0 = time.perf_counter()
+    threads = default_jobs()  # realization chunks in threads: the same bits (service.run_case)
 
     def check() -> None:
         if cancel is not None and cancel.is_set():
@@ -68,12 +70,13 @@ def execute(
     if models is not None:
         from ..io.jsonout import model_reactions, with_models
 
-        spread = service.run_models(case, service.parse_models(case, models), progress=progress, cancel=cancel)
+        spread = service.run_models(case, service.parse_models(case, models), progress=progress, cancel=cancel,
+                                    threads=threads)
         own = case.wind.downburst.model_name
         result = spread[own] if own in spread else next(iter(spread.values()))
         doc = with_models(run_document(result), result.case.wind.downburst.model_name, model_reactions(spread))
     else:
-        result = service.run_case(case, progress=progress, cancel=cancel)
+        result = service.run_case(case, progress=progress, cancel=cancel, threads=threads)
         doc = run_document(result)
     modes = wind = None
     if extras:

@@ -158,6 +158,7 @@ def steps_1(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, indptr, indic
             out, nz, GT, cols, R):  # pragma: no cover - compiled
     """:func:`steps` for one realization (U, V, A of shape (1, n_dof)): plain vectors."""
     n_b, _, n_free = loads.shape
+    keep = out.shape[0] > 0  # the states after every step, for the second-order tension
     n = U.shape[1]
     u = U[0]
     v = V[0]
@@ -184,7 +185,8 @@ def steps_1(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, indptr, indic
             a[d] = (vn - v[d]) * r2 - a[d]
             v[d] = vn
             u[d] = b[d]
-            out[k, 0, d] = b[d]
+            if keep:
+                out[k, 0, d] = b[d]
         reactions_into(u, nz, GT, cols, R[k, 0])
 
 
@@ -194,10 +196,12 @@ def steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, indptr, indices
     """Newmark steps of one block; U, V, A updated in place.
 
     U, V, A (n_real, n_dof) rotated state; loads (n_b, n_real, n_free) [N]; ycoef
-    (n_free, 3); out (n_b, n_real, n_dof) receives u after every step; R (n_b, n_real, n_r)
+    (n_free, 3); out (n_b, n_real, n_dof) receives u after every step (not written when
+    out has no rows: only the second-order tension reads it); R (n_b, n_real, n_r)
     the reactions G u, summed coordinate by coordinate from zero over the columns
     [cols[i, 0], cols[i, 1]) of GT's row i (the order of dynamics._sparse_reactions)."""
     n_b, m, n_free = loads.shape
+    keep = out.shape[0] > 0  # the states after every step, for the second-order tension
     n = U.shape[1]
     u = to_lanes(U)  # lane l of group g is realization 4 g + l (padding lanes stay 0)
     v = to_lanes(V)
@@ -247,7 +251,8 @@ def steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, indptr, indices
                     ag[d, l] = (vn - vg[d, l]) * r2 - ag[d, l]
                     vg[d, l] = vn
                     ug[d, l] = bg[d, l]
-        from_lanes(u, out[k])
+        if keep:
+            from_lanes(u, out[k])
         for r in range(m):
             reactions_into(u[r // 4, :, r % 4], nz, GT, cols, R[k, r])
     from_lanes(u, U)

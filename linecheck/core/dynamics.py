@@ -298,7 +298,8 @@ def integrate(
             b1 = min(b0 + block, int(s1))
             if compiled:  # the same arithmetic as the loop below, compiled (same bits; kernel.py)
                 kernel.newmark_block(U, V, A, loads[b0:b1], st.ycoef, st.cu, st.cv, st.dm, st.r2, chat, rest,
-                                     a1, buf[: b1 - b0], st.nz, st.GT, st.cols, R_F[b0:b1])
+                                     a1, buf[: b1 - b0] if second_order is not None else buf[:0], st.nz, st.GT,
+                                     st.cols, R_F[b0:b1])
                 b_range = ()
             else:
                 Fb = (loads[b0:b1][..., None] * st.ycoef).reshape(b1 - b0, n_real, n_dof)

@@ -197,7 +197,8 @@ def newmark_block(U: np.ndarray, V: np.ndarray, A: np.ndarray, loads: np.ndarray
         cu, cv, dm: the diagonal operators of :class:`~linecheck.core.dynamics._Stepper`, (n_dof,).
         r2: [1/s] 2/Δt.  chat: Cholesky factor of K̂ (upper band, (BANDWIDTH + 1, n_dof)).
         rest: off-diagonal structural damping C~_off (scipy CSR) or None; a1: [1/s] 2/Δt.
-        out: receives u after every step, (n_b, n_real, n_dof).
+        out: receives u after every step, (n_b, n_real, n_dof); with no rows (0, n_real, n_dof)
+            nothing is written (only the second-order tension reads the states).
         nz, GT, cols: the stepper's sparse reaction rows (:func:`~linecheck.core.dynamics._sparse_rows`).
         R: [N] receives the reactions G T u~ after every step, (n_b, n_real, n_r) (the bits of
             :func:`~linecheck.core.dynamics._sparse_reactions`).

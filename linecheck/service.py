@@ -9,6 +9,7 @@ This module imports only the numerical core (numpy/scipy) and never prints.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import threading
 from collections.abc import Callable
@@ -634,6 +635,35 @@ def _map_chunks(fn, n: int, threads: int, stop: _AnyEvent) -> list:
     return out
 
 
+#: [s] the interpreter's thread switch interval while a run's threads work (default 5 ms): the
+#: chunks and the check alternate between GIL-free compiled work and short Python stretches,
+#: and a thread that wants the GIL back waited up to the whole interval (measured, 60 spans:
+#: two threads 4.3-5.3 s at 5 ms, 3.8-3.9 s at 1 ms, against 4.4-5.8 s on one thread)
+SWITCH_INTERVAL = 0.001
+_switch_lock = threading.Lock()
+_switch_users = [0, 0.0]  # runs inside _short_switch_interval, the interval before the first
+
+
+@contextlib.contextmanager
+def _short_switch_interval():
+    """:data:`SWITCH_INTERVAL` while at least one threaded run is inside; the previous interval
+    restored when the last one leaves."""
+    import sys
+
+    with _switch_lock:
+        if _switch_users[0] == 0:
+            _switch_users[1] = sys.getswitchinterval()
+            sys.setswitchinterval(min(SWITCH_INTERVAL, _switch_users[1]))
+        _switch_users[0] += 1
+    try:
+        yield
+    finally:
+        with _switch_lock:
+            _switch_users[0] -= 1
+            if _switch_users[0] == 0:
+                sys.setswitchinterval(_switch_users[1])
+
+
 def run_threads(case: Case, n_real: int, threads: int, *, burn_in: float | None = None,
                 spectral_check: bool = True) -> int:
     """Threads for ``run_case``: at most ``threads`` and one per realization, and no more than
@@ -674,14 +704,17 @@ def run_case(
         warn: ``warn(message)`` receives resource warnings; above the memory limit the run
             is refused before any work (:func:`check_budget`, CaseError).
         threads: realization chunks integrated at once in threads (the wind synthesis, steps
-            2-3 and statistics of a chunk; step 1 and the check run once).  Every realization's
-            arithmetic is its own, so the result is bit-identical whatever ``threads``; fewer
-            threads are used where the chunks in flight would exceed the memory limit
-            (:func:`run_threads`).  Batch and scan workers are processes and keep 1.
+            2-3 and statistics of a chunk; step 1 runs once before them), and with more than
+            one the frequency-domain check runs beside them on a thread of its own.  Every
+            realization's arithmetic is its own, so the result is bit-identical whatever
+            ``threads``; fewer threads are used where the chunks in flight would exceed the
+            memory limit (:func:`run_threads`), one without the compiled step loop (the numpy
+            loop holds the GIL).  Batch and scan workers are processes and keep 1.
     """
     from .core.wind.turbulence import fluctuating_velocity
 
     real = np.arange(case.analysis.realizations) if realizations is None else np.asarray(realizations, dtype=int)
+    asked = max(1, int(threads))
     threads = run_threads(case, int(real.size), threads, spectral_check=spectral_check)
     warned: list[str] = []
     check_budget(case, "run", warn=lambda m: (warned.append(m), warn(m) if warn else None),
@@ -740,8 +773,13 @@ def run_case(
     # ---- realizations in chunks that fit in memory (issue 20: long lines), ``threads`` of them at
     # once: every realization's turbulence, Newmark columns and statistics are its own, so
     # neither the chunking nor the threads change a bit
-    if threads > 1 and not kernel.use(float(t.size) * real.size * models[0].mass.size):
+    concurrent = asked > 1 and kernel.use(float(t.size) * real.size * models[0].mass.size)
+    if not concurrent:
         threads = 1  # the numpy step loop holds the GIL between its small calls: threads lose time
+    # the frequency-domain check needs only step 1 and the burn-in's models: with threads to
+    # spare it runs beside the realizations (issue 20: a long line's windows take seconds)
+    check_pool = check = None
+    switch = _short_switch_interval() if concurrent else contextlib.nullcontext()  # GIL hand-offs
     chunk = budget.realization_chunk(case, t.size, threads)
     if threads > 1:
         chunk = min(chunk, -(-real.size // threads))
@@ -784,11 +822,23 @@ def run_case(
         return (compute_statistics(M_keep, Bk, Rk, still_air, gL, window=window),
                 Bk[:, :, j, :].copy(), Rk[:, :, j, :].copy())
 
-    parts = _map_chunks(run_chunk, n_chunks, threads, stop)
+    with switch:
+        try:
+            if synoptic and spectral_check and concurrent:
+                from concurrent.futures import ThreadPoolExecutor
+
+                check_pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="linecheck-check")
+                check = check_pool.submit(spectral_analysis, case, static=st, synoptic=sm, windows=windows)
+            parts = _map_chunks(run_chunk, n_chunks, threads, stop)
+            spectral = check.result() if check is not None else None
+        finally:
+            if check_pool is not None:
+                check_pool.shutdown(wait=False, cancel_futures=True)  # a failed run does not wait for it
     parts_stats, parts_B, parts_R = (list(p) for p in zip(*parts))
     stats = parts_stats[0] if n_chunks == 1 else Statistics.concatenate(parts_stats)
-    spectral = (spectral_analysis(case, static=st, synoptic=sm, windows=windows)
-                if synoptic and spectral_check else None)
+    if check is None:
+        spectral = (spectral_analysis(case, static=st, synoptic=sm, windows=windows)
+                    if synoptic and spectral_check else None)
     return RunResult(
         case=case, system=system, static=st, realizations=real, time=t[keep], mean=M_keep,
         background=parts_B[0] if n_chunks == 1 else np.concatenate(parts_B),

@@ -141,3 +141,30 @@ def test_cli_run_jobs_same_json(tmp_path, monkeypatch):
         doc = json.loads((tmp_path / f"j{jobs}.json").read_text())
         out[jobs] = {k: v for k, v in doc.items() if k not in ("timing", "created", "elapsed")}
     assert out[1] == out[2]
+
+
+@needs_kernel
+def test_the_check_runs_beside_the_chunks_with_the_same_result(monkeypatch):
+    """With threads the frequency-domain check runs on a thread of its own while the chunks
+    integrate; its estimate is the one-thread estimate, and the interpreter's switch interval
+    (shortened meanwhile) is restored afterwards."""
+    import sys
+
+    monkeypatch.setenv("LINECHECK_KERNEL", "numba")
+    case = _short(CASES / "paper" / "case09-six.toml", duration=30.0, burn_in=5.0)
+    where: list[str] = []
+    real = service.spectral_analysis
+
+    def spy(*a, **kw):
+        where.append(threading.current_thread().name)
+        return real(*a, **kw)
+
+    monkeypatch.setattr(service, "spectral_analysis", spy)
+    before = sys.getswitchinterval()
+    one = service.run_case(case, realizations=[0, 1])
+    two = service.run_case(case, realizations=[0, 1], threads=2)
+    assert where[0] == "MainThread" and where[1].startswith("linecheck-check")
+    assert sys.getswitchinterval() == before
+    for f in ("peak_dynamic", "rms_fluctuating", "GF_Dy"):
+        assert np.array_equal(getattr(one.spectral.exact, f), getattr(two.spectral.exact, f), equal_nan=True)
+    assert _same(one, two)

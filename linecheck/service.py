@@ -773,7 +773,10 @@ def run_case(
     # ---- realizations in chunks that fit in memory (issue 20: long lines), ``threads`` of them at
     # once: every realization's turbulence, Newmark columns and statistics are its own, so
     # neither the chunking nor the threads change a bit
-    concurrent = asked > 1 and kernel.use(float(t.size) * real.size * models[0].mass.size)
+    # the compiled kernel (same bits) when installed and worth loading: decided once for the
+    # whole run, so that the chunks' wind synthesis uses it too
+    compiled = kernel.use(float(t.size) * real.size * models[0].mass.size)
+    concurrent = asked > 1 and compiled
     if not concurrent:
         threads = 1  # the numpy step loop holds the GIL between its small calls: threads lose time
     # the frequency-domain check needs only step 1 and the burn-in's models: with threads to

@@ -231,3 +231,26 @@ def test_the_compiled_loops_load_from_the_disk_cache_in_a_new_process(tmp_path):
                            check=True).stdout.split() for _ in range(2)]
     assert int(runs[0][0]) == 3  # a fresh cache folder: compiled (and written) by the first
     assert runs[1] == ["0", "3"]  # the second loads all three from it
+
+
+@needs_kernel
+@pytest.mark.parametrize("name", ["paper/case09-six", "paper/case05-six"])
+def test_wind_spectrum_same_bits(monkeypatch, name):
+    """The synthesis' phasors, KMS recursion and scaling compiled in one pass (kernel.kms_spectrum)
+    against the numpy form: the unit turbulence bit for bit, signs of zeros included."""
+    from linecheck.core.system import LineSystem
+    from linecheck.core.wind import turbulence as tb
+
+    case = load_case(CASES / f"{name}.toml")
+    system = LineSystem(case.line)
+    calls = []
+    spec = kernel.kms_spectrum
+    monkeypatch.setattr(kernel, "kms_spectrum", lambda *a: calls.append(1) or spec(*a))
+    monkeypatch.setenv("LINECHECK_KERNEL", "numba")
+    fast = tb.unit_field(case, system, 4001, 0.05, 3)
+    monkeypatch.setenv("LINECHECK_KERNEL", "numpy")
+    slow = tb.unit_field(case, system, 4001, 0.05, 3)
+    assert calls and kernel.kms_spectrum is not spec  # the compiled pass was asked for...
+    assert kernel._state.get("kms")  # ...and verified at load
+    assert np.array_equal(fast, slow) and np.array_equal(np.signbit(fast), np.signbit(slow))
+    assert 0.5 < float(fast.std()) < 1.5  # a unit-variance field (200 s of it): not a comparison of zeros

@@ -136,6 +136,47 @@ def _rowdot_test(rowdot) -> bool:
     return ok
 
 
+def _kms_spectrum_numpy(phases: np.ndarray, rho: np.ndarray, amp: np.ndarray, m: int) -> np.ndarray:
+    """The numpy form of :func:`kms_spectrum` (what linecheck.core.wind.turbulence.synthesize does)."""
+    from .wind.turbulence import kms_apply
+
+    y = kms_apply(rho, np.exp(1j * phases))
+    spec = np.zeros((phases.shape[0], m // 2 + 1), dtype=complex)
+    spec[:, 1:phases.shape[1] + 1] = (0.5 * m) * (amp[None, :] * y)
+    return spec
+
+
+def _kms_test(fn) -> bool:
+    """The compiled spectrum gives the numpy form's bits, signs of zeros included (glibc's sin
+    and cos for numpy's complex exp; numpy's real-times-complex products); else numpy's is used."""
+    rng = np.random.default_rng(23)
+    phases = rng.random((9, 301)) * (2.0 * np.pi)
+    rho = np.exp(-rng.random(301) * 3.0)
+    amp = rng.random(301)
+    m = 2 * 301 + 2
+    ref = _kms_spectrum_numpy(phases, rho, amp, m)
+    got = np.zeros_like(ref)
+    fn(phases, rho, np.sqrt(np.maximum(1.0 - rho * rho, 0.0)), amp, 0.5 * m, got)
+    return bool(np.array_equal(got.view(float), ref.view(float))
+                and np.array_equal(np.signbit(got.view(float)), np.signbit(ref.view(float))))
+
+
+def kms_spectrum(phases: np.ndarray, rho: np.ndarray, amp: np.ndarray, m: int) -> np.ndarray | None:
+    """The synthesis spectrum of equally spaced nodes (turbulence.synthesize, issue 20), compiled,
+    or None when the kernel is not loaded (or did not give numpy's bits at load).
+
+    phases [rad] (n_nodes, n_freq); rho [-] neighbour coherence (n_freq,); amp [-] cosine
+    amplitudes (n_freq,); m the FFT length.  Returns (n_nodes, m // 2 + 1) complex: column k + 1
+    = (m/2) amp_k y_k with y the KMS recursion of the unit phasors (Deodatis 1996)."""
+    if not (use(0.0) and _state.get("kms")):
+        return None
+    spec = np.zeros((phases.shape[0], m // 2 + 1), dtype=complex)
+    _state["fns"].kms_spectrum(np.ascontiguousarray(phases), np.ascontiguousarray(rho, dtype=float),
+                               np.sqrt(np.maximum(1.0 - rho * rho, 0.0)), np.ascontiguousarray(amp, dtype=float),
+                               0.5 * m, spec)
+    return spec
+
+
 def rowdot(X: np.ndarray, BT: np.ndarray) -> np.ndarray:
     """X (m, n) @ BT (n, q) with the bits of :func:`~linecheck.core.dynamics._rowdot` (compiled
     when that was verified at load)."""
@@ -180,6 +221,7 @@ def available() -> bool:
             _state["fns"] = fns if ok else None
             _state["rotate"] = rot
             _state["rowdot"] = dot
+            _state["kms"] = ok and _kms_test(fns.kms_spectrum)
         return bool(_state["ok"])
 
 

@@ -55,6 +55,7 @@ from scipy.linalg import LinAlgError, cholesky, eigh
 from scipy.special import beta as beta_fn
 from scipy.special import betainc
 
+from .. import kernel
 from ..case import Case
 from ..errors import CaseError
 from ..system import LineSystem
@@ -334,25 +335,30 @@ def synthesize(x: np.ndarray, grid: SpectralGrid, phases: np.ndarray, decay: flo
     n_nodes = x.size
     if phases.shape != (n_nodes, grid.n_freq):
         raise ValueError(f"phases shape {phases.shape} != {(n_nodes, grid.n_freq)}")
-    xi = np.exp(1j * phases)
     spacing = _uniform_spacing(x)
     if method == "auto":
         method = "kms" if spacing is not None else ("markov" if np.all(np.diff(x) >= 0) else "general")
+    m = grid.n_fft
+    spec = None
     if method == "kms":
         if spacing is None:
             raise ValueError("the KMS path needs equally spaced, increasing x")
         rho = davenport_coherence(grid.freq, spacing, decay, v_mean)  # coherence of neighbours: C_jk = rho^|j-k|
-        y = kms_apply(rho, xi)
+        # the phasors, the recursion and the scaling below in one compiled pass when the kernel
+        # is loaded (the same bits, checked at load; issue 20)
+        spec = kernel.kms_spectrum(phases, rho, grid.amplitude, m)
+        if spec is None:
+            y = kms_apply(rho, np.exp(1j * phases))
     elif method == "markov":
-        y = markov_apply(x, grid.freq, xi, decay, v_mean)
+        y = markov_apply(x, grid.freq, np.exp(1j * phases), decay, v_mean)
     elif method == "general":
-        y = general_apply(x, grid.freq, xi, decay, v_mean)
+        y = general_apply(x, grid.freq, np.exp(1j * phases), decay, v_mean)
     else:
         raise ValueError(f"unknown method {method!r}")
-    m = grid.n_fft
-    spec = np.zeros((n_nodes, m // 2 + 1), dtype=complex)
-    # Deodatis (1996) spectral sum by FFT: irfft gives (1/M)(X_k e^{..} + conj) = A_k cos(..) for X_k = (M/2) A_k e^{i psi}
-    spec[:, 1:grid.n_freq + 1] = (0.5 * m) * (grid.amplitude[None, :] * y)
+    if spec is None:
+        spec = np.zeros((n_nodes, m // 2 + 1), dtype=complex)
+        # Deodatis (1996) spectral sum by FFT: irfft gives (1/M)(X_k e^{..} + conj) = A_k cos(..) for X_k = (M/2) A_k e^{i psi}
+        spec[:, 1:grid.n_freq + 1] = (0.5 * m) * (grid.amplitude[None, :] * y)
     # one contiguous transform per node (pocketfft gives each 1-D transform the same bits whatever
     # the layout; along the contiguous axis it is ~25 % faster than along axis 0; issue 20)
     return np.ascontiguousarray(sfft.irfft(spec, n=m, axis=1)[:, : grid.n_steps].T)

@@ -254,3 +254,30 @@ def test_wind_spectrum_same_bits(monkeypatch, name):
     assert kernel._state.get("kms")  # ...and verified at load
     assert np.array_equal(fast, slow) and np.array_equal(np.signbit(fast), np.signbit(slow))
     assert 0.5 < float(fast.std()) < 1.5  # a unit-variance field (200 s of it): not a comparison of zeros
+
+
+@needs_kernel
+@pytest.mark.parametrize("name, drag", [("paper/case09-six", "linear"), ("paper/case05-six", "quadratic")])
+def test_drag_loads_same_bits(monkeypatch, name, drag):
+    """The fluctuating drag on the free nodes (paper Eq. 5, and the quadratic drag's v² term of
+    issue 16) compiled in one pass (kernel.drag_loads) against the numpy loop."""
+    from linecheck.core.model import build_model
+    from linecheck.core.wind.turbulence import fluctuating_velocity
+
+    case = _short(CASES / f"{name}.toml", drag=drag)
+    st = service.static_analysis(case)
+    system = st.system
+    model = build_model(system, st.mean.state(0))
+    t = service.record_time(case)[:3001]
+    vn, vl = service.record_mean_wind(case, st, t)
+    calls = []
+    fn = kernel.drag_loads
+    monkeypatch.setattr(kernel, "drag_loads", lambda *a: calls.append(fn(*a)) or calls[-1])
+    monkeypatch.setenv("LINECHECK_KERNEL", "numba")
+    v = fluctuating_velocity(case, system, t, [0, 1, 2])
+    fast, fast_d = service.fluctuating_loads(case, system, model, t, v, vn, vl)
+    monkeypatch.setenv("LINECHECK_KERNEL", "numpy")
+    slow, slow_d = service.fluctuating_loads(case, system, model, t, v, vn, vl)
+    assert calls[0] is True and calls[1] is False  # compiled, then the numpy loop
+    assert np.array_equal(fast, slow) and np.array_equal(fast_d, slow_d)
+    assert np.abs(fast).max() > 0

@@ -14,8 +14,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["background", "band_solve", "band_solve_1", "from_lanes", "kms_spectrum", "reactions_into", "rotate",
-           "rowdot", "solve_columns", "steps", "steps_1", "to_lanes"]
+__all__ = ["background", "band_solve", "band_solve_1", "drag_loads", "from_lanes", "kms_spectrum", "reactions_into",
+           "rotate", "rowdot", "solve_columns", "steps", "steps_1", "to_lanes"]
 
 
 # the banded triangular solves, with contraction as OpenBLAS's Haswell dtbsv forms them.
@@ -327,3 +327,22 @@ def kms_spectrum(phases, rho, s, amp, scale, spec):  # pragma: no cover - compil
             zr = a * yr - 0.0 * yi
             zi = a * yi + 0.0 * yr
             spec[j, k + 1] = complex(scale * zr - 0.0 * zi, scale * zi + 0.0 * zr)
+
+
+@numba.njit(cache=True, nogil=True)
+def drag_loads(pv, pq, s2, v, s0, quad, loads):  # pragma: no cover - compiled
+    """The fluctuating drag on the free nodes (service.fluctuating_loads) with numpy's bits:
+    loads[t, i, f] = pv[t, f] v[i, t, s0 + f] (paper Eq. 5), plus ((v^2 - s2) pq) with the
+    quadratic drag (issue 16), each product and sum rounded by itself.  pv, pq, s2 (n_steps,
+    n_free); v (n_real, n_steps, n_nodes), the free nodes s0 .. s0 + n_free - 1; loads
+    (n_steps, n_real, n_free)."""
+    n_real, n_steps = v.shape[0], v.shape[1]
+    n_free = loads.shape[2]
+    for t in range(n_steps):
+        for i in range(n_real):
+            for f in range(n_free):
+                x = v[i, t, s0 + f]
+                val = pv[t, f] * x
+                if quad:
+                    val = val + ((x * x - s2[t, f]) * pq[t, f])
+                loads[t, i, f] = val

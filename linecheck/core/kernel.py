@@ -6,8 +6,9 @@ realization) to ≈ 60 µs (ten) per step of mostly call overhead.  With the opt
 ``linecheck[fast]`` (Numba) the same recurrence runs here as one compiled loop over the steps
 of a block (:func:`newmark_block`), together with the reactions G u of every step, the change
 of node bases between mean states (:func:`rotate`), step 3's static transfer (:func:`rowdot`)
-and a long line's step 3 (:func:`background`, :func:`solve_columns`); without it (or with
-``LINECHECK_KERNEL=numpy``) the numpy code runs.
+and a long line's step 3 (:func:`background`, :func:`solve_columns`), and before the steps the
+wind synthesis' phasors and coherence recursion (:func:`kms_spectrum`) and the fluctuating drag
+(:func:`drag_loads`); without it (or with ``LINECHECK_KERNEL=numpy``) the numpy code runs.
 
 **Same bits.**  The kernel repeats the numpy loop's arithmetic operation by operation, so the
 two paths give bit-identical results (tested on synoptic, downburst, structural-damping and
@@ -177,6 +178,45 @@ def kms_spectrum(phases: np.ndarray, rho: np.ndarray, amp: np.ndarray, m: int) -
     return spec
 
 
+def _drag_loads_numpy(pv, pq, s2, v, s0, quad, loads) -> None:
+    """The numpy form of :func:`drag_loads` (what service.fluctuating_loads does)."""
+    sel = slice(s0, s0 + loads.shape[2])
+    for i in range(v.shape[0]):
+        vi = v[i][:, sel]
+        np.multiply(pv, vi, out=loads[:, i, :])
+        if quad:
+            q = vi * vi
+            q -= s2
+            q *= pq
+            loads[:, i, :] += q
+
+
+def _loads_test(fn) -> bool:
+    """The compiled drag loads give the numpy form's bits (linear and quadratic drag)."""
+    rng = np.random.default_rng(24)
+    v = rng.standard_normal((3, 40, 9))
+    pv, pq, s2 = (rng.random((40, 9))[:, 1:8] for _ in range(3))  # strided, as the slices of the service
+    ok = True
+    for quad in (False, True):
+        ref, got = np.empty((40, 3, 7)), np.empty((40, 3, 7))
+        _drag_loads_numpy(pv, pq, s2, v, 1, quad, ref)
+        fn(pv, pq, s2, v, 1, quad, got)
+        ok &= bool(np.array_equal(ref, got))
+    return ok
+
+
+def drag_loads(pv: np.ndarray, pq: np.ndarray | None, s2: np.ndarray | None, v: np.ndarray, s0: int,
+               loads: np.ndarray) -> bool:
+    """Fill loads (n_steps, n_real, n_free) [N] = pv v (+ (v² − s2) pq with the quadratic drag,
+    pq and s2 given) on the free nodes s0 .. s0 + n_free − 1 of v (n_real, n_steps, n_nodes) [m/s],
+    compiled with numpy's bits; False (nothing written) when the kernel is not loaded."""
+    if not (use(0.0) and _state.get("loads")):
+        return False
+    quad = pq is not None
+    _state["fns"].drag_loads(pv, pq if quad else pv, s2 if quad else pv, v, int(s0), quad, loads)
+    return True
+
+
 def rowdot(X: np.ndarray, BT: np.ndarray) -> np.ndarray:
     """X (m, n) @ BT (n, q) with the bits of :func:`~linecheck.core.dynamics._rowdot` (compiled
     when that was verified at load)."""
@@ -222,6 +262,7 @@ def available() -> bool:
             _state["rotate"] = rot
             _state["rowdot"] = dot
             _state["kms"] = ok and _kms_test(fns.kms_spectrum)
+            _state["loads"] = ok and _loads_test(fns.drag_loads)
         return bool(_state["ok"])
 
 

@@ -562,18 +562,8 @@ def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: n
         pq_p, s2_p = np.broadcast_to(per_q, vn.shape)[:, pinned], np.broadcast_to(sig2, vn.shape)[:, pinned]
     # the same elementwise products as on every node, written straight into the loads (one
     # compiled pass when the kernel is loaded: the same bits, issue 20)
-    done = bool(run) and kernel.drag_loads(pv, pq if quad else None, s2 if quad else None, v, int(free[0]), loads)
-    for i in range(n_real):
-        if not done:
-            vi = v[i][:, sel]
-            np.multiply(pv, vi, out=loads[:, i, :])
-            if quad:
-                q = vi * vi
-                q -= s2
-                q *= pq
-                loads[:, i, :] += q
-        if not pinned.size:
-            continue
+    kernel.drag_loads(pv, pq if quad else None, s2 if quad else None, v, sel, loads)
+    for i in range(n_real if pinned.size else 0):
         vp = v[i][:, pinned]
         f_i = pv_p * vp  # (n_steps, n_pinned)
         if quad:

@@ -33,16 +33,16 @@ def _short(path, **analysis):
     return dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, **analysis))
 
 
-def _chunk_threads(monkeypatch) -> list[str]:
-    """Record the thread that integrates every chunk (so a test knows the threads really ran)."""
+def _threads_of(monkeypatch, name: str) -> list[str]:
+    """Record the thread that calls ``service.<name>`` each time (so a test knows where it ran)."""
     names: list[str] = []
-    real = service.integrate
+    real = getattr(service, name)
 
     def spy(*a, **kw):
         names.append(threading.current_thread().name)
         return real(*a, **kw)
 
-    monkeypatch.setattr(service, "integrate", spy)
+    monkeypatch.setattr(service, name, spy)
     return names
 
 
@@ -60,7 +60,7 @@ def test_threads_give_the_bits_of_one_thread(monkeypatch, name, reals):
     monkeypatch.setenv("LINECHECK_KERNEL", "numba")
     extra = {"damping": "quasi-steady", "duration": 60.0, "burn_in": 10.0} if "09" in name else {}
     case = _short(CASES / f"{name}.toml", **extra)
-    names = _chunk_threads(monkeypatch)
+    names = _threads_of(monkeypatch, "integrate")  # one call per chunk
     one = service.run_case(case, realizations=list(range(reals)), spectral_check=False)
     assert names == ["MainThread"]
     names.clear()
@@ -152,14 +152,7 @@ def test_the_check_runs_beside_the_chunks_with_the_same_result(monkeypatch):
 
     monkeypatch.setenv("LINECHECK_KERNEL", "numba")
     case = _short(CASES / "paper" / "case09-six.toml", duration=30.0, burn_in=5.0)
-    where: list[str] = []
-    real = service.spectral_analysis
-
-    def spy(*a, **kw):
-        where.append(threading.current_thread().name)
-        return real(*a, **kw)
-
-    monkeypatch.setattr(service, "spectral_analysis", spy)
+    where = _threads_of(monkeypatch, "spectral_analysis")
     before = sys.getswitchinterval()
     one = service.run_case(case, realizations=[0, 1])
     two = service.run_case(case, realizations=[0, 1], threads=2)

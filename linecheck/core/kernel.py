@@ -178,13 +178,12 @@ def kms_spectrum(phases: np.ndarray, rho: np.ndarray, amp: np.ndarray, m: int) -
     return spec
 
 
-def _drag_loads_numpy(pv, pq, s2, v, s0, quad, loads) -> None:
-    """The numpy form of :func:`drag_loads` (what service.fluctuating_loads does)."""
-    sel = slice(s0, s0 + loads.shape[2])
+def drag_loads_numpy(pv, pq, s2, v, sel, loads) -> None:
+    """The numpy form of :func:`drag_loads`; ``sel`` the free nodes, a slice or an index array."""
     for i in range(v.shape[0]):
         vi = v[i][:, sel]
         np.multiply(pv, vi, out=loads[:, i, :])
-        if quad:
+        if pq is not None:  # the quadratic drag's (v^2 - s2) pq
             q = vi * vi
             q -= s2
             q *= pq
@@ -199,22 +198,24 @@ def _loads_test(fn) -> bool:
     ok = True
     for quad in (False, True):
         ref, got = np.empty((40, 3, 7)), np.empty((40, 3, 7))
-        _drag_loads_numpy(pv, pq, s2, v, 1, quad, ref)
+        drag_loads_numpy(pv, pq if quad else None, s2, v, slice(1, 8), ref)
         fn(pv, pq, s2, v, 1, quad, got)
         ok &= bool(np.array_equal(ref, got))
     return ok
 
 
-def drag_loads(pv: np.ndarray, pq: np.ndarray | None, s2: np.ndarray | None, v: np.ndarray, s0: int,
+def drag_loads(pv: np.ndarray, pq: np.ndarray | None, s2: np.ndarray | None, v: np.ndarray, sel,
                loads: np.ndarray) -> bool:
     """Fill loads (n_steps, n_real, n_free) [N] = pv v (+ (v² − s2) pq with the quadratic drag,
-    pq and s2 given) on the free nodes s0 .. s0 + n_free − 1 of v (n_real, n_steps, n_nodes) [m/s],
-    compiled with numpy's bits; False (nothing written) when the kernel is not loaded."""
-    if not (use(0.0) and _state.get("loads")):
-        return False
-    quad = pq is not None
-    _state["fns"].drag_loads(pv, pq if quad else pv, s2 if quad else pv, v, int(s0), quad, loads)
-    return True
+    pq and s2 given) on the free nodes ``sel`` of v (n_real, n_steps, n_nodes) [m/s]: compiled
+    in one pass when the kernel is loaded and ``sel`` is a slice (returns True), else by
+    :func:`drag_loads_numpy` (False).  The same bits either way."""
+    if isinstance(sel, slice) and use(0.0) and _state.get("loads"):
+        quad = pq is not None
+        _state["fns"].drag_loads(pv, pq if quad else pv, s2 if quad else pv, v, int(sel.start), quad, loads)
+        return True
+    drag_loads_numpy(pv, pq, s2, v, sel, loads)
+    return False
 
 
 def rowdot(X: np.ndarray, BT: np.ndarray) -> np.ndarray:

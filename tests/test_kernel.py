@@ -234,24 +234,25 @@ def test_the_compiled_loops_load_from_the_disk_cache_in_a_new_process(tmp_path):
 
 
 @needs_kernel
-@pytest.mark.parametrize("name", ["paper/case09-six", "paper/case05-six"])
+@pytest.mark.parametrize("name", ["paper/case09-six", "paper/case05-six", "examples/section-12span"])
 def test_wind_spectrum_same_bits(monkeypatch, name):
-    """The synthesis' phasors, KMS recursion and scaling compiled in one pass (kernel.kms_spectrum)
-    against the numpy form: the unit turbulence bit for bit, signs of zeros included."""
+    """The synthesis' phasors, coherence recursion and scaling compiled in one pass
+    (kernel.coherent_spectrum) against the numpy form: the unit turbulence bit for bit, signs of
+    zeros included; equal spans (the KMS recursion) and a section of unequal spans (Markov, a
+    coefficient row per gap)."""
     from linecheck.core.system import LineSystem
     from linecheck.core.wind import turbulence as tb
 
     case = load_case(CASES / f"{name}.toml")
     system = LineSystem(case.line)
     calls = []
-    spec = kernel.kms_spectrum
-    monkeypatch.setattr(kernel, "kms_spectrum", lambda *a: calls.append(1) or spec(*a))
+    spec = kernel.coherent_spectrum
+    monkeypatch.setattr(kernel, "coherent_spectrum", lambda *a: calls.append(spec(*a)) or calls[-1])
     monkeypatch.setenv("LINECHECK_KERNEL", "numba")
     fast = tb.unit_field(case, system, 4001, 0.05, 3)
     monkeypatch.setenv("LINECHECK_KERNEL", "numpy")
     slow = tb.unit_field(case, system, 4001, 0.05, 3)
-    assert calls and kernel.kms_spectrum is not spec  # the compiled pass was asked for...
-    assert kernel._state.get("kms")  # ...and verified at load
+    assert calls[0] is not None and calls[1] is None  # compiled, then the numpy form
     assert np.array_equal(fast, slow) and np.array_equal(np.signbit(fast), np.signbit(slow))
     assert 0.5 < float(fast.std()) < 1.5  # a unit-variance field (200 s of it): not a comparison of zeros
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["background", "band_solve", "band_solve_1", "drag_loads", "from_lanes", "kms_spectrum", "reactions_into",
+__all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "drag_loads", "from_lanes", "reactions_into",
            "rotate", "rowdot", "solve_columns", "steps", "steps_1", "to_lanes"]
 
 
@@ -297,18 +297,20 @@ def rowdot(X, BT, out):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, nogil=True)
-def kms_spectrum(phases, rho, s, amp, scale, spec):  # pragma: no cover - compiled
-    """The wind synthesis' spectrum of equally spaced nodes in one pass (issue 20): the unit
-    phasors xi = exp(i phi), the KMS recursion y_0 = xi_0, y_j = rho y_(j-1) + s xi_j along the
-    nodes and spec[j, k + 1] = scale (amp_k y_jk), with numpy's bits (turbulence.synthesize):
-    exp(0 + i phi) = cos phi + i sin phi (glibc's cexp at a zero real part), a real times a
-    complex as numpy forms it (the real cast to complex: (a x_r - 0 x_i, a x_i + 0 x_r)).
-    phases (n_nodes, n_freq); rho, s, amp (n_freq,); spec (n_nodes, >= n_freq + 1) complex,
-    zero outside columns 1 .. n_freq."""
+def coherent_spectrum(phases, rho_rows, s_rows, row_of_gap, amp, scale, spec):  # pragma: no cover - compiled
+    """The wind synthesis' spectrum of ordered nodes in one pass (issue 20): the unit phasors
+    xi = exp(i phi), the Markov (equal gaps: KMS) recursion y_0 = xi_0, y_j = rho y_(j-1) + s xi_j
+    along the nodes with the coefficient row of gap j - 1, and spec[j, k + 1] = scale (amp_k y_jk),
+    with numpy's bits (turbulence.synthesize): exp(0 + i phi) = cos phi + i sin phi (glibc's cexp
+    at a zero real part), a real times a complex as numpy forms it (the real cast to complex:
+    (a x_r - 0 x_i, a x_i + 0 x_r)).  phases (n_nodes, n_freq); rho_rows, s_rows (n_rows, n_freq);
+    row_of_gap (n_nodes - 1,); amp (n_freq,); spec (n_nodes, >= n_freq + 1) complex, zero outside
+    columns 1 .. n_freq."""
     n_nodes, n_freq = phases.shape
     pr = np.empty(n_freq)
     pi = np.empty(n_freq)
     for j in range(n_nodes):
+        g = row_of_gap[j - 1] if j > 0 else 0
         for k in range(n_freq):
             p = phases[j, k]
             xr = np.cos(p)
@@ -317,8 +319,8 @@ def kms_spectrum(phases, rho, s, amp, scale, spec):  # pragma: no cover - compil
                 yr = xr
                 yi = xi
             else:
-                r = rho[k]
-                w = s[k]
+                r = rho_rows[g, k]
+                w = s_rows[g, k]
                 yr = (r * pr[k] - 0.0 * pi[k]) + (w * xr - 0.0 * xi)
                 yi = (r * pi[k] + 0.0 * pr[k]) + (w * xi + 0.0 * xr)
             pr[k] = yr

@@ -7,7 +7,7 @@ realization) to ≈ 60 µs (ten) per step of mostly call overhead.  With the opt
 of a block (:func:`newmark_block`), together with the reactions G u of every step, the change
 of node bases between mean states (:func:`rotate`), step 3's static transfer (:func:`rowdot`)
 and a long line's step 3 (:func:`background`, :func:`solve_columns`), and before the steps the
-wind synthesis' phasors and coherence recursion (:func:`kms_spectrum`) and the fluctuating drag
+wind synthesis' phasors and coherence recursion (:func:`coherent_spectrum`) and the fluctuating drag
 (:func:`drag_loads`); without it (or with ``LINECHECK_KERNEL=numpy``) the numpy code runs.
 
 **Same bits.**  The kernel repeats the numpy loop's arithmetic operation by operation, so the
@@ -137,44 +137,68 @@ def _rowdot_test(rowdot) -> bool:
     return ok
 
 
-def _kms_spectrum_numpy(phases: np.ndarray, rho: np.ndarray, amp: np.ndarray, m: int) -> np.ndarray:
-    """The numpy form of :func:`kms_spectrum` (what linecheck.core.wind.turbulence.synthesize does)."""
-    from .wind.turbulence import kms_apply
-
-    y = kms_apply(rho, np.exp(1j * phases))
+def _spectrum_numpy(phases: np.ndarray, y: np.ndarray, amp: np.ndarray, m: int) -> np.ndarray:
+    """The FFT input of turbulence.synthesize from the recursion's output y (n_nodes, n_freq)."""
     spec = np.zeros((phases.shape[0], m // 2 + 1), dtype=complex)
     spec[:, 1:phases.shape[1] + 1] = (0.5 * m) * (amp[None, :] * y)
     return spec
 
 
-def _kms_test(fn) -> bool:
-    """The compiled spectrum gives the numpy form's bits, signs of zeros included (glibc's sin
-    and cos for numpy's complex exp; numpy's real-times-complex products); else numpy's is used."""
+def _spectrum_test(fn) -> bool:
+    """The compiled spectrum gives the numpy forms' bits, signs of zeros included (glibc's sin and
+    cos for numpy's complex exp; numpy's real-times-complex products): equal gaps (the KMS
+    recursion) and unequal ones (the Markov recursion, a coefficient row per gap); else numpy's."""
+    from .wind.turbulence import kms_apply, markov_apply
+
     rng = np.random.default_rng(23)
-    phases = rng.random((9, 301)) * (2.0 * np.pi)
-    rho = np.exp(-rng.random(301) * 3.0)
-    amp = rng.random(301)
-    m = 2 * 301 + 2
-    ref = _kms_spectrum_numpy(phases, rho, amp, m)
-    got = np.zeros_like(ref)
-    fn(phases, rho, np.sqrt(np.maximum(1.0 - rho * rho, 0.0)), amp, 0.5 * m, got)
-    return bool(np.array_equal(got.view(float), ref.view(float))
-                and np.array_equal(np.signbit(got.view(float)), np.signbit(ref.view(float))))
+    n_nodes, n_freq = 9, 301
+    phases = rng.random((n_nodes, n_freq)) * (2.0 * np.pi)
+    freq = np.arange(1, n_freq + 1) * 0.01
+    amp = rng.random(n_freq)
+    m = 2 * n_freq + 2
+    x = np.cumsum(np.r_[0.0, rng.choice([30.0, 12.5], n_nodes - 1)])
+    rows, gap = gap_rows(x, freq, 10.0, 40.0)
+    cases = [(markov_apply(x, freq, np.exp(1j * phases), 10.0, 40.0), rows, gap),
+             (kms_apply(rows[0], np.exp(1j * phases)), rows[:1], np.zeros(n_nodes - 1, dtype=np.int64))]
+    ok = True
+    for y, r, g in cases:
+        ref = _spectrum_numpy(phases, y, amp, m)
+        got = np.zeros_like(ref)
+        fn(phases, r, np.sqrt(np.maximum(1.0 - r * r, 0.0)), g, amp, 0.5 * m, got)
+        ok &= bool(np.array_equal(got.view(float), ref.view(float))
+                   and np.array_equal(np.signbit(got.view(float)), np.signbit(ref.view(float))))
+    return ok
 
 
-def kms_spectrum(phases: np.ndarray, rho: np.ndarray, amp: np.ndarray, m: int) -> np.ndarray | None:
-    """The synthesis spectrum of equally spaced nodes (turbulence.synthesize, issue 20), compiled,
-    or None when the kernel is not loaded (or did not give numpy's bits at load).
+def gap_rows(x: np.ndarray, freq: np.ndarray, decay: float, v_mean: float) -> tuple[np.ndarray, np.ndarray]:
+    """The Davenport coefficient rows rho = exp(-C f ds / V) of the distinct gaps ds of ordered
+    points x [m] (n_nodes,) at f [Hz] (n_freq,), shape (n_rows, n_freq), and the row of every gap
+    (n_nodes - 1,): the coefficients :func:`~linecheck.core.wind.turbulence.markov_apply` uses
+    (the same elementwise arithmetic, so the same bits)."""
+    from .wind.turbulence import davenport_coherence
 
-    phases [rad] (n_nodes, n_freq); rho [-] neighbour coherence (n_freq,); amp [-] cosine
-    amplitudes (n_freq,); m the FFT length.  Returns (n_nodes, m // 2 + 1) complex: column k + 1
-    = (m/2) amp_k y_k with y the KMS recursion of the unit phasors (Deodatis 1996)."""
-    if not (use(0.0) and _state.get("kms")):
+    gaps, row = np.unique(np.diff(np.asarray(x, dtype=float)), return_inverse=True)
+    rows = davenport_coherence(np.asarray(freq, dtype=float)[None, :], gaps[:, None], decay, v_mean)
+    return rows, row.astype(np.int64)
+
+
+def coherent_spectrum(phases: np.ndarray, rho_rows: np.ndarray, row_of_gap: np.ndarray, amp: np.ndarray,
+                      m: int) -> np.ndarray | None:
+    """The synthesis spectrum of ordered nodes (turbulence.synthesize, issue 20), compiled, or None
+    when the kernel is not loaded (or did not give numpy's bits at load).
+
+    phases [rad] (n_nodes, n_freq); rho_rows [-] neighbour coherence rows (n_rows, n_freq) and
+    the row of every gap (n_nodes - 1,) (equal gaps: one row); amp [-] cosine amplitudes
+    (n_freq,); m the FFT length.  Returns (n_nodes, m // 2 + 1) complex: column k + 1 =
+    (m/2) amp_k y_k with y the KMS / Markov recursion of the unit phasors (Deodatis 1996)."""
+    if not (use(0.0) and _state.get("spectrum")):
         return None
+    rho_rows = np.ascontiguousarray(rho_rows, dtype=float)
     spec = np.zeros((phases.shape[0], m // 2 + 1), dtype=complex)
-    _state["fns"].kms_spectrum(np.ascontiguousarray(phases), np.ascontiguousarray(rho, dtype=float),
-                               np.sqrt(np.maximum(1.0 - rho * rho, 0.0)), np.ascontiguousarray(amp, dtype=float),
-                               0.5 * m, spec)
+    _state["fns"].coherent_spectrum(np.ascontiguousarray(phases), rho_rows,
+                                    np.sqrt(np.maximum(1.0 - rho_rows * rho_rows, 0.0)),
+                                    np.ascontiguousarray(row_of_gap, dtype=np.int64),
+                                    np.ascontiguousarray(amp, dtype=float), 0.5 * m, spec)
     return spec
 
 
@@ -262,7 +286,7 @@ def available() -> bool:
             _state["fns"] = fns if ok else None
             _state["rotate"] = rot
             _state["rowdot"] = dot
-            _state["kms"] = ok and _kms_test(fns.kms_spectrum)
+            _state["spectrum"] = ok and _spectrum_test(fns.coherent_spectrum)
             _state["loads"] = ok and _loads_test(fns.drag_loads)
         return bool(_state["ok"])
 

@@ -346,11 +346,16 @@ def synthesize(x: np.ndarray, grid: SpectralGrid, phases: np.ndarray, decay: flo
         rho = davenport_coherence(grid.freq, spacing, decay, v_mean)  # coherence of neighbours: C_jk = rho^|j-k|
         # the phasors, the recursion and the scaling below in one compiled pass when the kernel
         # is loaded (the same bits, checked at load; issue 20)
-        spec = kernel.kms_spectrum(phases, rho, grid.amplitude, m)
+        spec = kernel.coherent_spectrum(phases, rho[None, :], np.zeros(max(n_nodes - 1, 0), dtype=np.int64),
+                                        grid.amplitude, m)
         if spec is None:
             y = kms_apply(rho, np.exp(1j * phases))
     elif method == "markov":
-        y = markov_apply(x, grid.freq, np.exp(1j * phases), decay, v_mean)
+        if np.any(np.diff(x) < 0):
+            raise ValueError("the Markov path needs ordered (non-decreasing) x")
+        spec = kernel.coherent_spectrum(phases, *kernel.gap_rows(x, grid.freq, decay, v_mean), grid.amplitude, m)
+        if spec is None:
+            y = markov_apply(x, grid.freq, np.exp(1j * phases), decay, v_mean)
     elif method == "general":
         y = general_apply(x, grid.freq, np.exp(1j * phases), decay, v_mean)
     else:

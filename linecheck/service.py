@@ -763,9 +763,6 @@ def run_case(
     load_dirs = None if system.straight_in_plan else system.node_normals[models[0].dofs.free_nodes]
     model_at = _interpolated_models(case, st, bracket, weights) if interpolate_states else None
 
-    # ---- realizations in chunks that fit in memory (issue 20: long lines), ``threads`` of them at
-    # once: every realization's turbulence, Newmark columns and statistics are its own, so
-    # neither the chunking nor the threads change a bit
     # the compiled kernel (same bits) when installed and worth loading: decided once for the
     # whole run, so that the chunks' wind synthesis uses it too
     compiled = kernel.use(float(t.size) * real.size * models[0].mass.size)
@@ -776,6 +773,9 @@ def run_case(
     # spare it runs beside the realizations (issue 20: a long line's windows take seconds)
     check_pool = check = None
     switch = _short_switch_interval() if concurrent else contextlib.nullcontext()  # GIL hand-offs
+    # ---- realizations in chunks that fit in memory (issue 20: long lines), ``threads`` of them at
+    # once: every realization's turbulence, Newmark columns and statistics are its own, so
+    # neither the chunking nor the threads change a bit
     chunk = budget.realization_chunk(case, t.size, threads)
     if threads > 1:
         chunk = min(chunk, -(-real.size // threads))

@@ -137,18 +137,11 @@ def _rowdot_test(rowdot) -> bool:
     return ok
 
 
-def _spectrum_numpy(phases: np.ndarray, y: np.ndarray, amp: np.ndarray, m: int) -> np.ndarray:
-    """The FFT input of turbulence.synthesize from the recursion's output y (n_nodes, n_freq)."""
-    spec = np.zeros((phases.shape[0], m // 2 + 1), dtype=complex)
-    spec[:, 1:phases.shape[1] + 1] = (0.5 * m) * (amp[None, :] * y)
-    return spec
-
-
 def _spectrum_test(fn) -> bool:
     """The compiled spectrum gives the numpy forms' bits, signs of zeros included (glibc's sin and
     cos for numpy's complex exp; numpy's real-times-complex products): equal gaps (the KMS
     recursion) and unequal ones (the Markov recursion, a coefficient row per gap); else numpy's."""
-    from .wind.turbulence import kms_apply, markov_apply
+    from .wind.turbulence import fft_input, gap_rows, kms_apply, markov_apply
 
     rng = np.random.default_rng(23)
     n_nodes, n_freq = 9, 301
@@ -162,24 +155,12 @@ def _spectrum_test(fn) -> bool:
              (kms_apply(rows[0], np.exp(1j * phases)), rows[:1], np.zeros(n_nodes - 1, dtype=np.int64))]
     ok = True
     for y, r, g in cases:
-        ref = _spectrum_numpy(phases, y, amp, m)
+        ref = fft_input(y, amp, m)
         got = np.zeros_like(ref)
         fn(phases, r, np.sqrt(np.maximum(1.0 - r * r, 0.0)), g, amp, 0.5 * m, got)
         ok &= bool(np.array_equal(got.view(float), ref.view(float))
                    and np.array_equal(np.signbit(got.view(float)), np.signbit(ref.view(float))))
     return ok
-
-
-def gap_rows(x: np.ndarray, freq: np.ndarray, decay: float, v_mean: float) -> tuple[np.ndarray, np.ndarray]:
-    """The Davenport coefficient rows rho = exp(-C f ds / V) of the distinct gaps ds of ordered
-    points x [m] (n_nodes,) at f [Hz] (n_freq,), shape (n_rows, n_freq), and the row of every gap
-    (n_nodes - 1,): the coefficients :func:`~linecheck.core.wind.turbulence.markov_apply` uses
-    (the same elementwise arithmetic, so the same bits)."""
-    from .wind.turbulence import davenport_coherence
-
-    gaps, row = np.unique(np.diff(np.asarray(x, dtype=float)), return_inverse=True)
-    rows = davenport_coherence(np.asarray(freq, dtype=float)[None, :], gaps[:, None], decay, v_mean)
-    return rows, row.astype(np.int64)
 
 
 def coherent_spectrum(phases: np.ndarray, rho_rows: np.ndarray, row_of_gap: np.ndarray, amp: np.ndarray,

@@ -68,7 +68,9 @@ __all__ = [
     "fluctuating_velocity",
     "general_apply",
     "kms_apply",
+    "fft_input",
     "gap_coherence",
+    "gap_rows",
     "length_scale",
     "markov_apply",
     "markov_quadratic_form",
@@ -234,26 +236,38 @@ def markov_apply(x: np.ndarray, freq: np.ndarray, xi: np.ndarray, decay: float, 
     Cholesky factor of the coherence matrix (the KMS factor of :func:`kms_apply` generalised to
     unequal gaps).  O(N) per frequency; a coefficient row per distinct gap is computed once.
     """
-    x = np.asarray(x, dtype=float)
-    gaps = np.diff(x)
-    if np.any(gaps < 0):
-        raise ValueError("the Markov path needs ordered (non-decreasing) x")
-    freq = np.asarray(freq, dtype=float)
-    rows: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+    rows, row = gap_rows(x, freq, decay, v_mean)
+    s = np.sqrt(np.maximum(1.0 - rows * rows, 0.0))  # the innovation weight of every row
     y = np.empty_like(xi)
     y[0] = xi[0]
     prev = y[0]
     for j in range(1, xi.shape[0]):
-        ds = float(gaps[j - 1])
-        if ds not in rows:
-            # Davenport (1961) coherence of neighbours a gap ds apart, and the innovation weight
-            rho = davenport_coherence(freq, ds, decay, v_mean)
-            rows[ds] = (rho, np.sqrt(np.maximum(1.0 - rho * rho, 0.0)))
-        rho, s = rows[ds]
+        g = row[j - 1]
         # AR(1) step with the gap's coefficient (Markov property of exp(-a |dx|))
-        prev = rho * prev + s * xi[j]
+        prev = rows[g] * prev + s[g] * xi[j]
         y[j] = prev
     return y
+
+
+def gap_rows(x: np.ndarray, freq: np.ndarray, decay: float, v_mean: float) -> tuple[np.ndarray, np.ndarray]:
+    """Davenport (1961) coherence of neighbours rho = exp(-C f ds / V) [-] for every distinct gap ds
+    of ordered points x [m] (n_nodes,) at f [Hz] (n_freq,): rows (n_rows, n_freq) and the row of
+    every gap (n_nodes - 1,) (int64).  The Markov recursion's coefficients (:func:`markov_apply`,
+    the compiled ``kernel.coherent_spectrum``); raises ValueError for unordered x."""
+    gaps, row = np.unique(np.diff(np.asarray(x, dtype=float)), return_inverse=True)
+    if gaps.size and gaps[0] < 0:
+        raise ValueError("the Markov path needs ordered (non-decreasing) x")
+    rows = davenport_coherence(np.asarray(freq, dtype=float)[None, :], gaps[:, None], decay, v_mean)
+    return rows, row.astype(np.int64)
+
+
+def fft_input(y: np.ndarray, amplitude: np.ndarray, m: int) -> np.ndarray:
+    """The inverse FFT's input of :func:`synthesize` from the correlated phasors y (n_nodes, n_freq):
+    (n_nodes, m // 2 + 1) complex, column k = (m/2) A_k y_k for k = 1 .. n_freq, zero elsewhere."""
+    spec = np.zeros((y.shape[0], m // 2 + 1), dtype=complex)
+    # Deodatis (1996) spectral sum by FFT: irfft gives (1/M)(X_k e^{..} + conj) = A_k cos(..) for X_k = (M/2) A_k e^{i psi}
+    spec[:, 1:y.shape[1] + 1] = (0.5 * m) * (amplitude[None, :] * y)
+    return spec
 
 
 def gap_coherence(x: np.ndarray, freq: np.ndarray, decay: float, v_mean: float) -> np.ndarray:
@@ -351,9 +365,7 @@ def synthesize(x: np.ndarray, grid: SpectralGrid, phases: np.ndarray, decay: flo
         if spec is None:
             y = kms_apply(rho, np.exp(1j * phases))
     elif method == "markov":
-        if np.any(np.diff(x) < 0):
-            raise ValueError("the Markov path needs ordered (non-decreasing) x")
-        spec = kernel.coherent_spectrum(phases, *kernel.gap_rows(x, grid.freq, decay, v_mean), grid.amplitude, m)
+        spec = kernel.coherent_spectrum(phases, *gap_rows(x, grid.freq, decay, v_mean), grid.amplitude, m)
         if spec is None:
             y = markov_apply(x, grid.freq, np.exp(1j * phases), decay, v_mean)
     elif method == "general":
@@ -361,9 +373,7 @@ def synthesize(x: np.ndarray, grid: SpectralGrid, phases: np.ndarray, decay: flo
     else:
         raise ValueError(f"unknown method {method!r}")
     if spec is None:
-        spec = np.zeros((n_nodes, m // 2 + 1), dtype=complex)
-        # Deodatis (1996) spectral sum by FFT: irfft gives (1/M)(X_k e^{..} + conj) = A_k cos(..) for X_k = (M/2) A_k e^{i psi}
-        spec[:, 1:grid.n_freq + 1] = (0.5 * m) * (grid.amplitude[None, :] * y)
+        spec = fft_input(y, grid.amplitude, m)
     # one contiguous transform per node (pocketfft gives each 1-D transform the same bits whatever
     # the layout; along the contiguous axis it is ~25 % faster than along axis 0; issue 20)
     return np.ascontiguousarray(sfft.irfft(spec, n=m, axis=1)[:, : grid.n_steps].T)

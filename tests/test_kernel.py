@@ -282,3 +282,25 @@ def test_drag_loads_same_bits(monkeypatch, name, drag):
     assert calls[0] is True and calls[1] is False  # compiled, then the numpy loop
     assert np.array_equal(fast, slow) and np.array_equal(fast_d, slow_d)
     assert np.abs(fast).max() > 0
+
+
+@needs_kernel
+@pytest.mark.parametrize("name", ["paper/case05-six", "paper/case09-single", "examples/downburst-ring-jet", "examples/downburst-user-field"])
+def test_step1_span_tension_same_bits(monkeypatch, name):
+    """Step 1's span-tension Newton (static._Spans.tension) with its integrands compiled
+    (kernel.span_terms, issue 20) against the numpy form: every mean state's tensions,
+    displacements and reactions bit for bit (a downburst's 250 states at once, a synoptic
+    state; sections solve their spans by :mod:`linecheck.core.catenary` instead)."""
+    case = load_case(CASES / f"{name}.toml")
+    calls = []
+    fn = kernel.span_terms
+    monkeypatch.setattr(kernel, "span_terms", lambda *a, **k: calls.append(1) or fn(*a, **k))
+    monkeypatch.setenv("LINECHECK_KERNEL", "numba")
+    fast = service.static_analysis(case).mean
+    n_fast = len(calls)
+    monkeypatch.setenv("LINECHECK_KERNEL", "numpy")
+    slow = service.static_analysis(case).mean
+    assert n_fast > 0 and len(calls) == n_fast  # compiled in the first, numpy in the second
+    assert fast.tension.shape[0] == (case.analysis.mean_states if case.wind.type == "downburst" else 1)
+    for f in ("tension", "displacement", "reactions", "insulator_force", "nodes", "element_tension"):
+        assert np.array_equal(getattr(fast, f), getattr(slow, f)), f

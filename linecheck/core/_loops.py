@@ -15,7 +15,7 @@ import numba
 import numpy as np
 
 __all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "drag_loads", "from_lanes", "reactions_into",
-           "rotate", "rowdot", "solve_columns", "steps", "steps_1", "to_lanes"]
+           "rotate", "rowdot", "solve_columns", "span_terms", "steps", "steps_1", "to_lanes"]
 
 
 # the banded triangular solves, with contraction as OpenBLAS's Haswell dtbsv forms them.
@@ -348,3 +348,34 @@ def drag_loads(pv, pq, s2, v, s0, quad, loads):  # pragma: no cover - compiled
                 if quad:
                     val = val + ((x * x - s2[t, f]) * pq[t, f])
                 loads[t, i, f] = val
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def span_terms(ay, az, by, bz, H, EA, l, with_e, f, g, e):  # pragma: no cover - compiled
+    """The integrands of one Newton step of the span tension (static.span_terms) with numpy's
+    bits, each product, quotient and sum rounded by itself in numpy's order:
+    p = a + b/H, u = sqrt((1 + p_y^2) + p_z^2), den = 1 + (H u)/EA, f = u/den,
+    g = ((-u^2)/EA)/den^2 + ((1/den^2) (-(p_y b_y + p_z b_z)/H^2))/u and, with with_e,
+    e = ((1/den^2) (-(p_y a_y + p_z a_z)/l))/u.  ay, az, H, l (n, n_spans); by, bz (1 or n,
+    n_spans, n_gp) (one for all states or one per state); f, g, e (n, n_spans, n_gp)."""
+    n, n_spans = H.shape
+    n_gp = by.shape[2]
+    for i in range(n):
+        iy = i if by.shape[0] > 1 else 0
+        iz = i if bz.shape[0] > 1 else 0
+        for j in range(n_spans):
+            h = H[i, j]
+            h2 = h * h
+            a_y, a_z, lj = ay[i, j], az[i, j], l[i, j]
+            by_r, bz_r, f_r, g_r, e_r = by[iy, j], bz[iz, j], f[i, j], g[i, j], e[i, j]
+            for q in range(n_gp):  # vectorised by LLVM (error_model="numpy": no zero-division branch)
+                b_y, b_z = by_r[q], bz_r[q]
+                py = a_y + b_y / h
+                pz = a_z + b_z / h
+                u = np.sqrt(1.0 + py * py + pz * pz)
+                den = 1.0 + h * u / EA
+                fu = 1.0 / (den * den)
+                f_r[q] = u / den
+                g_r[q] = -(u * u) / EA / (den * den) + fu * (-(py * b_y + pz * b_z) / h2) / u
+                if with_e:
+                    e_r[q] = fu * (-(py * a_y + pz * a_z) / lj) / u

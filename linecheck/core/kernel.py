@@ -8,7 +8,9 @@ of a block (:func:`newmark_block`), together with the reactions G u of every ste
 of node bases between mean states (:func:`rotate`), step 3's static transfer (:func:`rowdot`)
 and a long line's step 3 (:func:`background`, :func:`solve_columns`), and before the steps the
 wind synthesis' phasors and coherence recursion (:func:`coherent_spectrum`) and the fluctuating drag
-(:func:`drag_loads`); without it (or with ``LINECHECK_KERNEL=numpy``) the numpy code runs.
+(:func:`drag_loads`), and in step 1 the span tension's Newton integrands (:func:`span_terms`: a
+downburst's 250 mean states at once, their sums over the Gauss points left to numpy's
+``matmul``, so the same BLAS sums them); without it (or with ``LINECHECK_KERNEL=numpy``) the numpy code runs.
 
 **Same bits.**  The kernel repeats the numpy loop's arithmetic operation by operation, so the
 two paths give bit-identical results (tested on synoptic, downburst, structural-damping and
@@ -223,6 +225,55 @@ def drag_loads(pv: np.ndarray, pq: np.ndarray | None, s2: np.ndarray | None, v: 
     return False
 
 
+def _span_test(fn) -> bool:
+    """The compiled span-tension integrands give :func:`~linecheck.core.static.span_terms`'
+    bits (one and several states, with and without e)."""
+    from .static import span_terms as ref_terms
+
+    rng = np.random.default_rng(25)
+    ok = True
+    for lead in ((), (3,)):
+        by = rng.standard_normal(lead + (4, 9)) * 1e4  # per state (step 1's loads), as static passes it
+        bz = rng.standard_normal((4, 9)) * 1e4
+        ay, az = (rng.standard_normal(lead + (4, 1)) * 0.05 for _ in range(2))
+        H = rng.uniform(1e4, 5e4, lead + (4,))
+        l = rng.uniform(300.0, 500.0, lead + (4,))
+        for ll in (None, l):
+            ref = ref_terms(ay, az, by, bz, H, 3.2e7, ll)
+            got = span_terms(ay, az, by, bz, H, 3.2e7, ll, fn)
+            ok &= len(ref) == len(got) and all(np.array_equal(x, y) for x, y in zip(ref, got))
+    return ok
+
+
+def span_terms(ay: np.ndarray, az: np.ndarray, by: np.ndarray, bz: np.ndarray, H: np.ndarray, EA: float,
+               l: np.ndarray | None = None, fn=None) -> tuple[np.ndarray, ...]:
+    """:func:`~linecheck.core.static.span_terms` (the span tension's Newton integrands) in one
+    compiled pass with the same bits, when the kernel verified it at load (else the numpy form).
+    Shapes: ay, az (..., n_spans, 1); by, bz (..., n_spans, n_gp); H, l (..., n_spans)."""
+    if fn is None:
+        if not _state.get("span"):
+            from .static import span_terms as ref_terms
+
+            return ref_terms(ay, az, by, bz, H, EA, l)
+        fn = _state["fns"].span_terms
+    n_spans, n_gp = by.shape[-2:]
+    H2 = np.ascontiguousarray(H, dtype=float).reshape(-1, n_spans)
+
+    def per_state(b):  # (1 or n, n_spans, n_gp): one for all states or one per state
+        b = np.asarray(b, dtype=float).reshape(-1, n_spans, n_gp)
+        if b.shape[0] not in (1, H2.shape[0]):
+            raise ValueError(f"span_terms: load shape {b.shape} does not match {H.shape}")
+        return np.ascontiguousarray(b)
+
+    shape = np.broadcast_shapes(H.shape + (1,), by.shape, bz.shape)
+    out = [np.empty(shape) for _ in range(2 if l is None else 3)]
+    flat = [x.reshape(-1, n_spans, n_gp) for x in out]
+    fn(np.ascontiguousarray(ay, dtype=float).reshape(-1, n_spans), np.ascontiguousarray(az, dtype=float).reshape(-1, n_spans),
+       per_state(by), per_state(bz), H2, float(EA), H2 if l is None else np.ascontiguousarray(l, dtype=float).reshape(-1, n_spans),
+       l is not None, flat[0], flat[1], flat[-1])
+    return tuple(out)
+
+
 def rowdot(X: np.ndarray, BT: np.ndarray) -> np.ndarray:
     """X (m, n) @ BT (n, q) with the bits of :func:`~linecheck.core.dynamics._rowdot` (compiled
     when that was verified at load)."""
@@ -269,6 +320,7 @@ def available() -> bool:
             _state["rowdot"] = dot
             _state["spectrum"] = ok and _spectrum_test(fns.coherent_spectrum)
             _state["loads"] = ok and _loads_test(fns.drag_loads)
+            _state["span"] = ok and _span_test(fns.span_terms)
         return bool(_state["ok"])
 
 

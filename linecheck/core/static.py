@@ -33,6 +33,7 @@ from functools import lru_cache
 import numpy as np
 from scipy.linalg import lapack
 
+from . import kernel
 from .errors import Cancelled, ConvergenceError
 from .system import LineSystem
 
@@ -170,16 +171,11 @@ class _Spans:
         ay, az = (dy / l)[..., None], (dz / l)[..., None]
         by, bz = Lu[:, None] * self.qy_gp, -Lu[:, None] * self.qz_gp  # both (n_spans, n_gp)
         H = np.array(H0, dtype=float)
+        terms = kernel.span_terms if kernel.use(0.0) else span_terms
         for _ in range(60):
-            Hc = H[..., None]
-            py, pz = ay + by / Hc, az + bz / Hc
-            u = np.sqrt(1.0 + py**2 + pz**2)
-            den = 1.0 + Hc * u / EA
-            f = u / den
+            f, g = terms(ay, az, by, bz, H, EA)
             F = l * (f @ w) - Lu
-            fu = 1.0 / den**2
-            dpdH_dot_p = -(py * by + pz * bz) / Hc**2
-            dF = l * ((-(u**2) / EA / den**2 + fu * dpdH_dot_p / u) @ w)
+            dF = l * (g @ w)
             Hn = H - F / dF
             Hn = np.where(Hn <= 0.1 * H, 0.1 * H, Hn)  # F decreasing: guard the first steps only
             done = np.abs(Hn - H) <= 1e-13 * np.abs(H)
@@ -188,15 +184,33 @@ class _Spans:
                 break
         else:
             raise ConvergenceError("span tension iteration did not converge (non-finite loads?)")
-        Hc = H[..., None]
-        py, pz = ay + by / Hc, az + bz / Hc
-        u = np.sqrt(1.0 + py**2 + pz**2)
-        den = 1.0 + Hc * u / EA
-        fu = 1.0 / den**2
-        dF_dH = l * ((-(u**2) / EA / den**2 + fu * (-(py * by + pz * bz) / Hc**2) / u) @ w)
-        dF_dl = (u / den) @ w + l * ((fu * (-(py * ay + pz * az) / l[..., None]) / u) @ w)
-        self.u_last = u
+        f, g, e = terms(ay, az, by, bz, H, EA, l)
+        dF_dH = l * (g @ w)
+        dF_dl = f @ w + l * (e @ w)
         return H, -dF_dl / dF_dH
+
+
+def span_terms(ay: np.ndarray, az: np.ndarray, by: np.ndarray, bz: np.ndarray, H: np.ndarray,
+               EA: float, l: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+    """The integrands of one Newton step of :meth:`_Spans.tension`: f = u/(1 + H u/EA) (the
+    length integrand, F = l ∫f - L_u) and g = ∂f/∂H (∂F/∂H = l ∫g); with the chords l also
+    e = ∂f/∂l (∂F/∂l = ∫f + l ∫e); docs/method.md, "Elastic span relation".
+    (:func:`linecheck.core.kernel.span_terms` computes the same bits in one compiled pass when
+    the kernel is loaded.)
+
+    Args: ay, az [-] chord slopes (..., n_spans, 1); by, bz [N] L_u Q_y, −L_u Q_z at the Gauss
+        points (..., n_spans, n_gp); H [N] (..., n_spans); EA [N]; l [m] (..., n_spans).
+    Returns: f [-], g [1/N] (and e [1/m]), each (..., n_spans, n_gp).
+    """
+    Hc = H[..., None]
+    py, pz = ay + by / Hc, az + bz / Hc
+    u = np.sqrt(1.0 + py**2 + pz**2)
+    den = 1.0 + Hc * u / EA
+    fu = 1.0 / den**2
+    f, g = u / den, -(u**2) / EA / den**2 + fu * (-(py * by + pz * bz) / Hc**2) / u
+    if l is None:
+        return f, g
+    return f, g, fu * (-(py * ay + pz * az) / l[..., None]) / u
 
 
 def _reactions(sp: _Spans, H, l, dy, dz, n_towers) -> np.ndarray:

@@ -704,7 +704,7 @@ def run_case(
             memory limit (:func:`run_threads`), one without the compiled step loop (the numpy
             loop holds the GIL).  Batch and scan workers are processes and keep 1.
     """
-    from .core.wind.turbulence import fluctuating_velocity
+    from .core.wind.turbulence import fluctuating_velocity, modulation
 
     real = np.arange(case.analysis.realizations) if realizations is None else np.asarray(realizations, dtype=int)
     asked = max(1, int(threads))
@@ -755,6 +755,7 @@ def run_case(
     gL = case.g_yp * system.eq17_lengths if system.is_section else case.g_yp_L  # Eq. 17 per tower (issue 17)
     j = case.line.tower_of_interest - 1
     vn, vl = record_mean_wind(case, st, t)
+    a_turb = modulation(case, system, t)  # the turbulence's I V_m(x, t), evaluated once for all chunks
     second = None
     if case.analysis.tension == "second-order":
         from .core.second_order import second_order_operator
@@ -794,7 +795,7 @@ def run_case(
         rc = real[ci * chunk:(ci + 1) * chunk]
         # ---- fluctuating load F_w = rho C_d D L_e V_m v (paper Eq. 5), normal components
         report("wind", winds_done[0], n_chunks)
-        v = fluctuating_velocity(case, system, t, list(rc))  # (n_real, n_steps, n_nodes), along-wind
+        v = fluctuating_velocity(case, system, t, list(rc), a_turb)  # (n_real, n_steps, n_nodes), along-wind
         loads, direct = fluctuating_loads(case, system, models[0], t, v, vn, vl)
         with lock:
             winds_done[0] += 1

@@ -123,21 +123,27 @@ def band_to_dense(ab: np.ndarray) -> np.ndarray:
 
 
 def band_to_sparse(ab: np.ndarray):
-    """Upper banded storage to a symmetric scipy CSR matrix (no dense intermediate)."""
-    from scipy.sparse import dia_matrix
+    """Upper banded storage (LAPACK 'U', ab[u + i - j, j] = A[i, j]) to a symmetric scipy CSR
+    matrix (no dense intermediate).
+
+    The arrays of scipy's ``dia_matrix(...).tocsr()`` (explicit zeros dropped, each row's
+    columns ascending, int32 indices), gathered in one vectorised pass: about half the time,
+    which counts for the 250 mean states of a downburst (issue 20; the same arrays, tested)."""
+    from scipy.sparse import csr_matrix
 
     u, n = ab.shape[0] - 1, ab.shape[1]
-    data, offsets = [], []
-    for k in range(u + 1):
-        row = ab[u - k]
-        data.append(row)  # dia convention: data[i, j] = A[j - offset, j]
-        offsets.append(k)
-        if k:
-            low = np.zeros(n)
-            low[: n - k] = row[k:]  # A[j + k, j] = A[j, j + k]
-            data.append(low)
-            offsets.append(-k)
-    return dia_matrix((np.array(data), np.array(offsets)), shape=(n, n)).tocsr()
+    offs = np.arange(-u, u + 1)
+    rows = np.arange(n)[:, None]
+    cols = rows + offs  # (n, 2u + 1): row i's possible columns, ascending
+    inside = (cols >= 0) & (cols < n)
+    # A[i, i + k] = ab[u - k, i + k] (k >= 0) and A[i, i + k] = A[i + k, i] = ab[u + k, i] (k < 0)
+    vals = np.where(inside, ab[u - np.abs(offs), np.clip(np.where(offs >= 0, cols, rows), 0, n - 1)], 0.0)
+    keep = vals != 0.0
+    indptr = np.zeros(n + 1, dtype=np.int32)
+    np.cumsum(keep.sum(axis=1), out=indptr[1:])
+    out = csr_matrix((vals[keep], cols[keep].astype(np.int32), indptr), shape=(n, n))
+    out.has_canonical_format = True
+    return out
 
 
 def _cable_blocks(nodes: np.ndarray, tension: np.ndarray, ea: float) -> np.ndarray:

@@ -427,14 +427,17 @@ def _record(time: np.ndarray) -> tuple[int, float]:
     return t.size, float(f"{dt:.12g}")
 
 
-def fluctuating_velocity(case: Case, system: LineSystem, time: np.ndarray, realizations: Sequence[int]) -> np.ndarray:
+def fluctuating_velocity(case: Case, system: LineSystem, time: np.ndarray, realizations: Sequence[int],
+                         a: np.ndarray | None = None) -> np.ndarray:
     """Fluctuating along-wind velocity a(x, t) u_r(x, t) [m/s] at the global FE nodes.
 
-    time [s] equally spaced, shape (n_steps,); realizations: 0-based indices.
+    time [s] equally spaced, shape (n_steps,); realizations: 0-based indices; ``a`` [m/s]: the
+    :func:`modulation` over ``time`` when the caller has it already (a run's chunks share it).
     Returns shape (n_real, n_steps, n_nodes).
     """
     n_steps, dt = _record(time)
-    a = modulation(case, system, np.asarray(time, dtype=float))
+    if a is None:
+        a = modulation(case, system, np.asarray(time, dtype=float))
     reals = list(realizations)
     out = np.empty((len(reals), n_steps, system.n_nodes))
     for i, r in enumerate(reals):

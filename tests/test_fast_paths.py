@@ -212,3 +212,24 @@ def test_structural_damping_product_without_dispatch_is_the_same_bits(monkeypatc
     slow = service.run_case(case, spectral_check=False)
     assert np.array_equal(fast.background, slow.background)
     assert np.array_equal(fast.resonant, slow.resonant)
+
+
+@pytest.mark.parametrize("name", ["paper/case05-six", "paper/case05-single", "paper/case03-single",
+                                  "examples/downburst-ring-jet", "examples/downburst-user-field", "paper/case09-six",
+                                  "examples/section-12span"])
+def test_record_wind_is_the_mean_wind_and_modulation_bit_for_bit(name):
+    """service.record_wind (one evaluation of an equal-span downburst's field at the distinct
+    stations of the span and global nodes, issue 20) against record_mean_wind and
+    turbulence.modulation, which evaluate it at each set by itself: the same bits (the paper's
+    single spans have stations that differ in the last bit between the two sets)."""
+    from linecheck.core.wind.turbulence import modulation
+
+    case = load_case(CASES / f"{name}.toml")
+    st = service.static_analysis(case)
+    t = service.record_time(case)[::7]
+    vn, vl, a = service.record_wind(case, st, t)
+    rn, rl = service.record_mean_wind(case, st, t)
+    assert np.array_equal(vn, rn) and (vl is None and rl is None or np.array_equal(vl, rl))
+    assert np.array_equal(a, modulation(case, st.system, t))
+    if case.wind.type == "downburst":
+        assert a.shape == (t.size, st.system.n_nodes) and np.ptp(a) > 0  # a varying field, not a constant

@@ -154,17 +154,19 @@ def _dia_csr(ab: np.ndarray):
 
 @pytest.mark.parametrize("n, u", [(2, 1), (6, 5), (7, 5), (183, 5), (30, 0)])
 def test_band_to_sparse_gives_scipys_csr_arrays(n, u):
-    """model.band_to_sparse (one vectorised gather, issue 20) against scipy's dia -> csr: the same
+    """model.band_to_csr / band_to_sparse (one vectorised gather, issue 20) against scipy's dia -> csr: the same
     indptr, indices (int32) and data, explicit zeros dropped, columns ascending -- the
     structural-damping remainder's products (CSR order) keep their bits -- and the dense matrix."""
-    from linecheck.core.model import band_to_dense, band_to_sparse
+    from linecheck.core.model import band_to_csr, band_to_dense, band_to_sparse
 
     rng = np.random.default_rng(n + u)
     ab = rng.standard_normal((u + 1, n))
     ab[rng.random(ab.shape) < 0.3] = 0.0
     for k in range(1, u + 1):
         ab[u - k, :k] = 0.0  # outside the matrix in upper band storage
-    got, ref = band_to_sparse(ab), _dia_csr(ab)
-    for f in ("indptr", "indices", "data"):
-        assert getattr(got, f).dtype == getattr(ref, f).dtype and np.array_equal(getattr(got, f), getattr(ref, f)), f
+    ref = _dia_csr(ab)
+    for got in (band_to_csr(ab), band_to_sparse(ab)):  # the arrays the step loops read, and the scipy matrix
+        for f in ("indptr", "indices", "data"):
+            assert getattr(got, f).dtype == getattr(ref, f).dtype and np.array_equal(getattr(got, f), getattr(ref, f)), f
+    got = band_to_sparse(ab)
     assert np.array_equal(got.toarray(), band_to_dense(ab))

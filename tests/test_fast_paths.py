@@ -201,12 +201,13 @@ def test_unrefined_pole_gets_an_exclusion_zone():
 def test_structural_damping_product_without_dispatch_is_the_same_bits(monkeypatch):
     """The step loop's C~_off (a1 u + v) calls scipy's CSR kernel directly (issue 20); a run with
     quasi-steady damping (structural damping on: the remainder exists) gives the same bits as
-    with the public ``rest @ x`` product."""
+    with the public ``rest @ x`` product (of the scipy matrix built from the stepper's CSR arrays)."""
     from linecheck.core import dynamics
 
     case = load_case(CASES / "examples" / "section-12span.toml")
     case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, realizations=2, duration=60.0))
     assert case.analysis.damping == "quasi-steady" and case.analysis.structural_ratio > 0
+    monkeypatch.setenv("LINECHECK_KERNEL", "numpy")  # the numpy step loop, where the product is used
     fast = service.run_case(case, spectral_check=False)
     monkeypatch.setattr(dynamics, "_csr_matvecs", None)
     slow = service.run_case(case, spectral_check=False)

@@ -29,7 +29,7 @@ from scipy.linalg import lapack
 
 from . import kernel
 from .errors import Cancelled, NumericalError
-from .model import LinearModel, band_blocks, band_to_sparse, rotate_band
+from .model import CSRArrays, LinearModel, band_blocks, band_to_csr, rotate_band
 
 _dpbtrf = lapack.dpbtrf
 _dpbtrs = lapack.dpbtrs
@@ -461,7 +461,7 @@ class _Stepper:
     dm: np.ndarray  # [kg] diagonal of M~, (n_dof,)
     cu: np.ndarray  # a0 dm + a1 dc
     cv: np.ndarray  # a2 dm + dc
-    rest: object  # off-diagonal part of C~ (scipy CSR) or None
+    rest: CSRArrays | None  # off-diagonal part of C~ (its CSR arrays) or None
     a1: float
     r2: float  # 2/dt
     ycoef: np.ndarray  # local components of a unit load along each node's load direction (global y), (n_nodes, 3)
@@ -492,7 +492,7 @@ class _Stepper:
             off[:] = 0.0
             rest = None
         else:
-            rest = band_to_sparse(off)
+            rest = band_to_csr(off)
         used = off.copy()
         used[-1] = dc
         chat = _factor(Kr, nm.a0 * dm, "effective stiffness", band_add=nm.a1 * used)
@@ -525,6 +525,8 @@ class _RestProduct:
     def __init__(self, rest, a1: float, shape: tuple[int, int]):
         self.rest, self.a1 = rest, a1
         self.fast = _csr_matvecs is not None and getattr(rest, "format", "") == "csr"
+        if not self.fast and isinstance(rest, CSRArrays):  # the public product needs the scipy matrix
+            self.rest = rest.tocsr()
         if self.fast:
             self.w = np.empty(shape)
             self.xT = np.empty(shape[::-1])

@@ -122,15 +122,31 @@ def band_to_dense(ab: np.ndarray) -> np.ndarray:
     return A
 
 
-def band_to_sparse(ab: np.ndarray):
-    """Upper banded storage (LAPACK 'U', ab[u + i - j, j] = A[i, j]) to a symmetric scipy CSR
-    matrix (no dense intermediate).
+@dataclass(frozen=True)
+class CSRArrays:
+    """A square CSR matrix as its three arrays (what the step loops read), without building a
+    scipy matrix (≈ 40 µs each, 250 times in a downburst run); :meth:`tocsr` builds one."""
 
-    The arrays of scipy's ``dia_matrix(...).tocsr()`` (explicit zeros dropped, each row's
-    columns ascending, int32 indices), gathered in one vectorised pass: about half the time,
-    which counts for the 250 mean states of a downburst (issue 20; the same arrays, tested)."""
-    from scipy.sparse import csr_matrix
+    indptr: np.ndarray  # int32, (n + 1,)
+    indices: np.ndarray  # int32, (nnz,): each row's columns ascending
+    data: np.ndarray  # (nnz,)
+    shape: tuple[int, int]
+    format = "csr"
 
+    def tocsr(self):
+        """The scipy CSR matrix of these arrays."""
+        from scipy.sparse import csr_matrix
+
+        out = csr_matrix((self.data, self.indices, self.indptr), shape=self.shape)
+        out.has_canonical_format = True
+        return out
+
+
+def band_to_csr(ab: np.ndarray) -> CSRArrays:
+    """Upper banded storage (LAPACK 'U', ab[u + i - j, j] = A[i, j]) of a symmetric matrix to
+    its CSR arrays: those of scipy's ``dia_matrix(...).tocsr()`` (explicit zeros dropped, each
+    row's columns ascending, int32 indices), gathered in one vectorised pass (issue 20; the same
+    arrays, tested)."""
     u, n = ab.shape[0] - 1, ab.shape[1]
     offs = np.arange(-u, u + 1)
     rows = np.arange(n)[:, None]
@@ -141,9 +157,13 @@ def band_to_sparse(ab: np.ndarray):
     keep = vals != 0.0
     indptr = np.zeros(n + 1, dtype=np.int32)
     np.cumsum(keep.sum(axis=1), out=indptr[1:])
-    out = csr_matrix((vals[keep], cols[keep].astype(np.int32), indptr), shape=(n, n))
-    out.has_canonical_format = True
-    return out
+    return CSRArrays(indptr, cols[keep].astype(np.int32), vals[keep], (n, n))
+
+
+def band_to_sparse(ab: np.ndarray):
+    """Upper banded storage to a symmetric scipy CSR matrix (no dense intermediate;
+    :func:`band_to_csr`)."""
+    return band_to_csr(ab).tocsr()
 
 
 def _cable_blocks(nodes: np.ndarray, tension: np.ndarray, ea: float) -> np.ndarray:

@@ -29,6 +29,7 @@ v_ref = {V:.1f}           # m/s
 turbulence_intensity = 0.12
 air_density = 1.25
 coherence_decay = 10.0
+fft_length = "record"  # the synthesis' inverse FFT as long as the record (pinned; docs/wind.md)
 """
 
 ANALYSIS = """[analysis]
@@ -96,6 +97,7 @@ v_ref = {V:.1f}
 turbulence_intensity = 0.15
 air_density = 1.2
 coherence_decay = 10.0
+fft_length = "record"  # the synthesis' inverse FFT as long as the record (pinned; docs/wind.md)
 
 [analysis]
 duration = 600.0

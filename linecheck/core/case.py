@@ -38,6 +38,7 @@ DOWNBURST_MODELS = ("holmes-oliver", "table", "ring-jet")
 DAMPING_MODELS = ("quasi-steady", "paper")
 CODE_TERRAINS = ("sea", "open", "suburban", "urban")  # [codes] terrain (docs/codes.md)
 DRAG_MODELS = ("linear", "quadratic")
+FFT_LENGTHS = ("record", "fast")  # turbulence synthesis: docs/wind.md "Synthesis length"
 TENSION_MODELS = ("linear", "second-order")
 # Conductor self-damping assumed with the quasi-steady model (ratio at the lowest mean-state
 # mode, stiffness-proportional): it damps the axial modes that no aerodynamic model damps.
@@ -137,6 +138,7 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         _f("direction", "deg", "mean wind vector V (sin d, cos d, 0): 0 = +y, normal to the first span", default=0.0, low=-360.0, high=360.0),
         _f("profile_exponent", "-", "power-law exponent alpha of V(z) = v_ref (z / reference_height)^alpha (0: uniform)", default=0.0, low=0.0, high=1.0),
         _f("reference_height", "m", "height above ground of v_ref (default: the mean clamp height above ground)", low=0.0, high=1000.0, low_open=True),
+        FieldSpec("fft_length", "choice", "-", 'turbulence synthesis: "record" (an inverse FFT as long as the record, the paper cases) or "fast" (the next length with prime factors 2, 3, 5 only, the record\'s first samples kept: the same spectrum and coherence, other random draws; docs/wind.md)', default="record", choices=FFT_LENGTHS),
     ),
     "wind.downburst": (
         FieldSpec("model", "choice", "-", 'running-mean model (default: "table" with a field file, else "holmes-oliver")', choices=DOWNBURST_MODELS),
@@ -289,6 +291,7 @@ class Wind:
     direction: float = 0.0  # [deg] mean wind vector V (sin d, cos d, 0)
     profile_exponent: float = 0.0  # [-] V(z) = v_ref (z / z_ref)^alpha
     reference_height: float | None = None  # [m]; None = mean clamp height above ground
+    fft_length: str = "record"  # FFT_LENGTHS: the synthesis' transform length (docs/wind.md)
 
 
 @dataclass(frozen=True)

@@ -137,7 +137,8 @@ class SpectralGrid:
     """Frequency discretisation of one record.
 
     Attributes:
-        n_steps: samples in the record; dt: [s] time step; n_fft: FFT length (= n_steps).
+        n_steps: samples in the record; dt: [s] time step; n_fft: FFT length (= n_steps, or the
+            next 5-smooth length with ``fft_length = "fast"``; the first n_steps samples are used).
         df: [Hz] frequency step 1/(n_fft dt).
         freq: [Hz] simulated frequencies f_k = k df, k = 1 .. n_freq, shape (n_freq,).
         amplitude: [-] cosine amplitude sqrt(2 P_k) of each bin (sum P_k = 1), shape (n_freq,).
@@ -161,7 +162,7 @@ class SpectralGrid:
 
 
 @lru_cache(maxsize=32)
-def spectral_grid(n_steps: int, dt: float, length_scale: float, v_mean: float) -> SpectralGrid:
+def spectral_grid(n_steps: int, dt: float, length_scale: float, v_mean: float, fast: bool = False) -> SpectralGrid:
     """Bins and amplitudes for ``n_steps`` samples at ``dt`` [s] (cached; arrays read-only).
 
     Bin k carries P_k = int over [f_k - df/2, f_k + df/2] of S(f)/sigma^2 df (exact, closed
@@ -173,7 +174,12 @@ def spectral_grid(n_steps: int, dt: float, length_scale: float, v_mean: float) -
                         key="analysis.duration")
     if not (dt > 0 and math.isfinite(dt)):
         raise CaseError(f"time step {dt!r} is not allowed: expected a positive number", key="analysis.time_step")
-    n_fft = int(n_steps)
+    # the transform as long as the record (the paper cases), or with ``fast`` the next length
+    # >= n_steps whose prime factors are 2, 3 and 5 only (scipy.fft.next_fast_len, real
+    # transforms): a record of 12,001 samples (= 11 x 1091) takes pocketfft's Bluestein
+    # algorithm, ≈ 7x slower than 12,000; the first n_steps samples of the periodic synthesis
+    # are used (docs/wind.md, "Synthesis length")
+    n_fft = sfft.next_fast_len(int(n_steps), real=True) if fast else int(n_steps)
     df = 1.0 / (n_fft * dt)
     n_freq = (n_fft - 1) // 2  # k = 1 .. ceil(M/2) - 1: no DC, no Nyquist term
     edges = (np.arange(n_freq + 1, dtype=float) + 0.5) * df
@@ -186,7 +192,7 @@ def spectral_grid(n_steps: int, dt: float, length_scale: float, v_mean: float) -
     freq = np.arange(1, n_freq + 1, dtype=float) * df
     freq.setflags(write=False)
     amplitude.setflags(write=False)
-    return SpectralGrid(n_fft, float(dt), n_fft, df, freq, amplitude,
+    return SpectralGrid(int(n_steps), float(dt), n_fft, df, freq, amplitude,
                         low_fraction=float(cum[0] / total), high_fraction=float(1.0 - cum[-1] / total))
 
 
@@ -394,7 +400,7 @@ def unit_field(case: Case, system: LineSystem, n_steps: int, dt: float, realizat
     if not v > 0:
         raise CaseError("value 0.0 is not allowed for turbulence synthesis: expected v_ref > 0",
                         file=str(case.source) if case.source else None, key="wind.v_ref")
-    grid = spectral_grid(int(n_steps), float(dt), length_scale(case), v)
+    grid = spectral_grid(int(n_steps), float(dt), length_scale(case), v, case.wind.fft_length == "fast")
     phases = random_phases(case.analysis.seed, realization, x.size, grid.n_freq)
     return synthesize(x, grid, phases, case.wind.coherence_decay, v)
 
@@ -461,7 +467,7 @@ def _unit_field_memo(case: Case, system: LineSystem, n_steps: int, dt: float, re
     run reuses it.  The same bits as computing it afresh (it is deterministic)."""
     x = system.node_station if system.is_section else system.node_x0
     key = (x.tobytes(), bool(system.is_section), float(case.wind.v_ref), float(length_scale(case)),
-           float(case.wind.coherence_decay), int(case.analysis.seed), realization, n_steps, dt)
+           float(case.wind.coherence_decay), int(case.analysis.seed), realization, n_steps, dt, case.wind.fft_length)
     with _memo_lock:
         got = _memo.pop(key, None)
         if got is not None:

@@ -304,3 +304,29 @@ def test_step1_span_tension_same_bits(monkeypatch, name):
     assert fast.tension.shape[0] == (case.analysis.mean_states if case.wind.type == "downburst" else 1)
     for f in ("tension", "displacement", "reactions", "insulator_force", "nodes", "element_tension"):
         assert np.array_equal(getattr(fast, f), getattr(slow, f)), f
+
+
+@needs_kernel
+@pytest.mark.parametrize("name, window", [("paper/case05-six", None), ("paper/case09-six", None),
+                                          ("paper/case09-six", 60.0)])
+def test_statistics_reductions_same_bits(monkeypatch, name, window):
+    """The statistics' r.m.s. values and peaks over time in one compiled pass
+    (kernel.history_reductions, issue 20) against the numpy form, through whole runs: every
+    statistic of every realization and tower bit for bit (with peak windows: one mean per sample)."""
+    from linecheck.core import results
+
+    case = _short(CASES / f"{name}.toml", duration=120.0, peak_window=window)
+    calls = []
+    fn = results.history_reductions
+    monkeypatch.setattr(results, "history_reductions", lambda *a: calls.append(1) or fn(*a))
+    monkeypatch.setenv("LINECHECK_KERNEL", "numba")
+    fast = service.run_case(case, realizations=[0, 1, 2], spectral_check=False).stats
+    assert not calls  # the compiled pass, not the numpy form
+    monkeypatch.setenv("LINECHECK_KERNEL", "numpy")
+    slow = service.run_case(case, realizations=[0, 1, 2], spectral_check=False).stats
+    assert calls  # the numpy form
+    for f in dataclasses.fields(results.Statistics):
+        a, b = getattr(fast, f.name), getattr(slow, f.name)
+        assert np.array_equal(a, b, equal_nan=True), f.name
+    assert fast.n_samples == (3 if window is None else 3 * 2)
+    assert np.all(fast.peak_dynamic > 0)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "drag_loads", "from_lanes", "reactions_into",
+__all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "drag_loads", "from_lanes", "history_reductions", "reactions_into",
            "rotate", "rowdot", "solve_columns", "span_terms", "steps", "steps_1", "to_lanes"]
 
 
@@ -379,3 +379,37 @@ def span_terms(ay, az, by, bz, H, EA, l, with_e, f, g, e):  # pragma: no cover -
                 g_r[q] = -(u * u) / EA / (den * den) + fu * (-(py * b_y + pz * b_z) / h2) / u
                 if with_e:
                     e_r[q] = fu * (-(py * a_y + pz * a_z) / lj) / u
+
+
+@numba.njit(cache=True, nogil=True)
+def history_reductions(M, B, R, sa, out):  # pragma: no cover - compiled
+    """results.history_reductions in one pass with numpy's bits: per (sample, tower, component)
+    the sums of B^2, R^2, (B + R)^2 over time, one sample after the other from the first (numpy's
+    order along a non-contiguous axis), divided by n_t, square-rooted; and the largest |M + B|,
+    |(M + B) + R|, |(M + B) + sa|, |((M + B) + R) + sa|.  The histories are finite (the time
+    integration checks them).  M (1 or n, n_t, n_towers, 3); B, R (n, n_t, n_towers, 3); sa
+    (n_towers, 3); out (7, n, n_towers, 3)."""
+    n, T, nt, nc = B.shape
+    out[:] = 0.0
+    for i in range(n):
+        im = i if M.shape[0] > 1 else 0
+        for t in range(T):
+            for k in range(nt):
+                for c in range(nc):
+                    b = B[i, t, k, c]
+                    r = R[i, t, k, c]
+                    qs = M[im, t, k, c] + b
+                    dy = qs + r
+                    f = b + r
+                    out[0, i, k, c] += b * b
+                    out[1, i, k, c] += r * r
+                    out[2, i, k, c] += f * f
+                    out[3, i, k, c] = max(out[3, i, k, c], abs(qs))
+                    out[4, i, k, c] = max(out[4, i, k, c], abs(dy))
+                    out[5, i, k, c] = max(out[5, i, k, c], abs(qs + sa[k, c]))
+                    out[6, i, k, c] = max(out[6, i, k, c], abs(dy + sa[k, c]))
+    for q in range(3):
+        for i in range(n):
+            for k in range(nt):
+                for c in range(nc):
+                    out[q, i, k, c] = np.sqrt(out[q, i, k, c] / T)

@@ -737,6 +737,9 @@ def run_case(
     warned: list[str] = []
     check_budget(case, "run", warn=lambda m: (warned.append(m), warn(m) if warn else None),
                  realizations=int(real.size), spectral_check=spectral_check, threads=threads)
+    # load the compiled kernel (same bits) before step 1 when the steps will pay for it, so that
+    # step 1's span tension (a downburst's 250 states) and the statistics use it too (issue 20)
+    kernel.use(float(record_time(case).size) * real.size * 3 * (case.line.spans * case.line.elements_per_span + 1))
     st = _static_analysis(case, progress=progress, cancel=cancel)
     system, mean = st.system, st.mean
     t = record_time(case)

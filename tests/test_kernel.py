@@ -330,3 +330,27 @@ def test_statistics_reductions_same_bits(monkeypatch, name, window):
         assert np.array_equal(a, b, equal_nan=True), f.name
     assert fast.n_samples == (3 if window is None else 3 * 2)
     assert np.all(fast.peak_dynamic > 0)
+
+
+@needs_kernel
+@pytest.mark.parametrize("reals, loaded", [(list(range(10)), True), ([0], False)])
+def test_the_kernel_loads_before_step_1_when_the_steps_pay_for_it(monkeypatch, reals, loaded):
+    """run_case decides on the compiled kernel before step 1 (issue 20), so that step 1's span
+    tension and the statistics use it too: a fresh process (no kernel loaded yet) running ten
+    realizations of a six-span downburst (12,001 steps x 10 x 183 DOFs > LOAD_WORK) loads it
+    first; one realization (below LOAD_WORK) does not."""
+    monkeypatch.setenv("LINECHECK_KERNEL", "auto")
+    monkeypatch.setattr(kernel, "_state", {})
+    seen = []
+
+    class Stop(Exception):
+        pass
+
+    def step1(case, **kw):
+        seen.append("ok" in kernel._state)
+        raise Stop
+
+    monkeypatch.setattr(service, "_static_analysis", step1)
+    with pytest.raises(Stop):
+        service.run_case(load_case(CASES / "paper" / "case05-six.toml"), realizations=reals, spectral_check=False)
+    assert seen == [loaded]

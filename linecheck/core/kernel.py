@@ -8,9 +8,13 @@ of a block (:func:`newmark_block`), together with the reactions G u of every ste
 of node bases between mean states (:func:`rotate`), step 3's static transfer (:func:`rowdot`)
 and a long line's step 3 (:func:`background`, :func:`solve_columns`), and before the steps the
 wind synthesis' phasors and coherence recursion (:func:`coherent_spectrum`) and the fluctuating drag
-(:func:`drag_loads`), and in step 1 the span tension's Newton integrands (:func:`span_terms`: a
+(:func:`drag_loads`), in step 1 the span tension's Newton integrands (:func:`span_terms`: a
 downburst's 250 mean states at once, their sums over the Gauss points left to numpy's
-``matmul``, so the same BLAS sums them); without it (or with ``LINECHECK_KERNEL=numpy``) the numpy code runs.
+``matmul``, so the same BLAS sums them), and after the steps the statistics' r.m.s. values and
+peaks over time (:func:`history_reductions`: numpy sums along the time axis one sample after the
+other, and so does the loop); without it (or with ``LINECHECK_KERNEL=numpy``) the numpy code runs.
+Each compiled function is compared with its numpy form when the kernel loads; one that differs
+here is not used.
 
 **Same bits.**  The kernel repeats the numpy loop's arithmetic operation by operation, so the
 two paths give bit-identical results (tested on synoptic, downburst, structural-damping and

@@ -206,3 +206,44 @@ def test_scan_positions_share_the_unit_turbulence_bit_for_bit(monkeypatch):
     assert np.array_equal(b, tb.fluctuating_velocity(moved, system, t, [1]))
     assert not np.array_equal(a[1], b[0])  # the running mean (the modulation) differs
     assert len(tb._memo) == 0
+
+
+def test_one_storm_scan_positions_share_the_phases_bit_for_bit(monkeypatch):
+    """A one-storm scan (``--hold jet``) gives each position its own V_ref at p, hence its own unit
+    field; the random phases and their compiled phasors are shared (turbulence.unit_phases,
+    issue 20), and the fields are the same bits as computed with every memo off."""
+    from linecheck.batch.tasks import apply_changes, fixed_jet_case, scan_changes
+    from linecheck.core import kernel
+    from linecheck.core.system import LineSystem
+    from linecheck.core.wind import turbulence as tb
+    from linecheck.core.wind.mean import downburst_field
+    from linecheck.service import record_time
+
+    compiled = kernel.available()  # the phasors are the compiled kernel's (else only the fields are shared)
+    if compiled:
+        monkeypatch.setenv("LINECHECK_KERNEL", "numba")
+    case = load_case(CASES / "paper" / "case05-six.toml")
+    system = LineSystem(case.line)
+    t = record_time(case)[:2001]
+    v_max = float(downburst_field(case).v_max)
+    moved = [fixed_jet_case(apply_changes(case, scan_changes(d, 20.0, case.wind.downburst.jet_diameter)), v_max)
+             for d in (700.0, 900.0)]
+    assert moved[0].wind.v_ref != moved[1].wind.v_ref  # one storm: V_ref at p differs
+    tb._memo.clear()
+    tb._phase_memo.clear()
+    calls = []
+    real = tb.random_phases
+    monkeypatch.setattr(tb, "random_phases", lambda *a: calls.append(a) or real(*a))
+    got = [tb.fluctuating_velocity(c, system, t, [0, 1]) for c in moved]
+    assert len(tb._memo) == 4  # a unit field per position and realization
+    if compiled:
+        assert len(calls) == 2 and len(tb._phase_memo) == 2  # the phases drawn once per realization
+        assert not tb._phase_memo[next(iter(tb._phase_memo))].phasors[0].flags.writeable
+    monkeypatch.setattr(tb, "UNIT_FIELD_MEMO_BYTES", 0.0)
+    tb._memo.clear()
+    tb._phase_memo.clear()
+    for c, g in zip(moved, got):
+        assert np.array_equal(g, tb.fluctuating_velocity(c, system, t, [0, 1]))
+    assert len(tb._memo) == 0 and len(tb._phase_memo) == 0
+    assert not np.array_equal(tb.unit_field(moved[0], system, t.size, 0.05, 0),
+                              tb.unit_field(moved[1], system, t.size, 0.05, 0))  # the spectra differ

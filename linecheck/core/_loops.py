@@ -14,7 +14,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "drag_loads", "from_lanes", "history_reductions", "reactions_into",
+__all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "drag_loads", "from_lanes", "history_reductions", "phasors", "reactions_into",
            "rotate", "rowdot", "solve_columns", "span_terms", "steps", "steps_1", "to_lanes"]
 
 
@@ -297,24 +297,34 @@ def rowdot(X, BT, out):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, nogil=True)
-def coherent_spectrum(phases, rho_rows, s_rows, row_of_gap, amp, scale, spec):  # pragma: no cover - compiled
-    """The wind synthesis' spectrum of ordered nodes in one pass (issue 20): the unit phasors
-    xi = exp(i phi), the Markov (equal gaps: KMS) recursion y_0 = xi_0, y_j = rho y_(j-1) + s xi_j
-    along the nodes with the coefficient row of gap j - 1, and spec[j, k + 1] = scale (amp_k y_jk),
-    with numpy's bits (turbulence.synthesize): exp(0 + i phi) = cos phi + i sin phi (glibc's cexp
-    at a zero real part), a real times a complex as numpy forms it (the real cast to complex:
-    (a x_r - 0 x_i, a x_i + 0 x_r)).  phases (n_nodes, n_freq); rho_rows, s_rows (n_rows, n_freq);
-    row_of_gap (n_nodes - 1,); amp (n_freq,); spec (n_nodes, >= n_freq + 1) complex, zero outside
-    columns 1 .. n_freq."""
+def phasors(phases, xr, xi):  # pragma: no cover - compiled
+    """The unit phasors exp(i phi) = cos phi + i sin phi of the wind synthesis (glibc's cexp at a
+    zero real part, as numpy's complex exp): xr = cos, xi = sin, each (n_nodes, n_freq)."""
     n_nodes, n_freq = phases.shape
+    for j in range(n_nodes):
+        for k in range(n_freq):
+            p = phases[j, k]
+            xr[j, k] = np.cos(p)
+            xi[j, k] = np.sin(p)
+
+
+@numba.njit(cache=True, nogil=True)
+def coherent_spectrum(xr_, xi_, rho_rows, s_rows, row_of_gap, amp, scale, spec):  # pragma: no cover - compiled
+    """The wind synthesis' spectrum of ordered nodes in one pass (issue 20): from the unit phasors
+    xi = exp(i phi) (:func:`phasors`: xr_ + i xi_), the Markov (equal gaps: KMS) recursion
+    y_0 = xi_0, y_j = rho y_(j-1) + s xi_j along the nodes with the coefficient row of gap j - 1,
+    and spec[j, k + 1] = scale (amp_k y_jk), with numpy's bits (turbulence.synthesize): a real
+    times a complex as numpy forms it (the real cast to complex: (a x_r - 0 x_i, a x_i + 0 x_r)).
+    xr_, xi_ (n_nodes, n_freq); rho_rows, s_rows (n_rows, n_freq); row_of_gap (n_nodes - 1,);
+    amp (n_freq,); spec (n_nodes, >= n_freq + 1) complex, zero outside columns 1 .. n_freq."""
+    n_nodes, n_freq = xr_.shape
     pr = np.empty(n_freq)
     pi = np.empty(n_freq)
     for j in range(n_nodes):
         g = row_of_gap[j - 1] if j > 0 else 0
         for k in range(n_freq):
-            p = phases[j, k]
-            xr = np.cos(p)
-            xi = np.sin(p)
+            xr = xr_[j, k]
+            xi = xi_[j, k]
             if j == 0:
                 yr = xr
                 yi = xi

@@ -163,26 +163,43 @@ def _spectrum_test(fn) -> bool:
     for y, r, g in cases:
         ref = fft_input(y, amp, m)
         got = np.zeros_like(ref)
-        fn(phases, r, np.sqrt(np.maximum(1.0 - r * r, 0.0)), g, amp, 0.5 * m, got)
+        xr, xi = np.empty_like(phases), np.empty_like(phases)
+        _state["fns"].phasors(phases, xr, xi)
+        fn(xr, xi, r, np.sqrt(np.maximum(1.0 - r * r, 0.0)), g, amp, 0.5 * m, got)
         ok &= bool(np.array_equal(got.view(float), ref.view(float))
                    and np.array_equal(np.signbit(got.view(float)), np.signbit(ref.view(float))))
     return ok
 
 
-def coherent_spectrum(phases: np.ndarray, rho_rows: np.ndarray, row_of_gap: np.ndarray, amp: np.ndarray,
+def phasors(phases: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """The unit phasors (cos phi, sin phi) of phases [rad] (n_nodes, n_freq), compiled (the
+    values :func:`coherent_spectrum` uses), or None when the kernel is not loaded or its spectrum
+    did not give numpy's bits at load.  They depend on the seed, the realization, the nodes and
+    the grid only, so a scan's positions can share them (turbulence.unit_phases)."""
+    if not (use(0.0) and _state.get("spectrum")):
+        return None
+    phases = np.ascontiguousarray(phases, dtype=float)
+    xr, xi = np.empty_like(phases), np.empty_like(phases)
+    _state["fns"].phasors(phases, xr, xi)
+    return xr, xi
+
+
+def coherent_spectrum(phases, rho_rows: np.ndarray, row_of_gap: np.ndarray, amp: np.ndarray,
                       m: int) -> np.ndarray | None:
     """The synthesis spectrum of ordered nodes (turbulence.synthesize, issue 20), compiled, or None
     when the kernel is not loaded (or did not give numpy's bits at load).
 
-    phases [rad] (n_nodes, n_freq); rho_rows [-] neighbour coherence rows (n_rows, n_freq) and
-    the row of every gap (n_nodes - 1,) (equal gaps: one row); amp [-] cosine amplitudes
-    (n_freq,); m the FFT length.  Returns (n_nodes, m // 2 + 1) complex: column k + 1 =
-    (m/2) amp_k y_k with y the KMS / Markov recursion of the unit phasors (Deodatis 1996)."""
+    phases [rad] (n_nodes, n_freq), or their :func:`phasors` (cos, sin) already computed;
+    rho_rows [-] neighbour coherence rows (n_rows, n_freq) and the row of every gap (n_nodes - 1,)
+    (equal gaps: one row); amp [-] cosine amplitudes (n_freq,); m the FFT length.  Returns
+    (n_nodes, m // 2 + 1) complex: column k + 1 = (m/2) amp_k y_k with y the KMS / Markov
+    recursion of the unit phasors (Deodatis 1996)."""
     if not (use(0.0) and _state.get("spectrum")):
         return None
+    xr, xi = phases if isinstance(phases, tuple) else phasors(phases)
     rho_rows = np.ascontiguousarray(rho_rows, dtype=float)
-    spec = np.zeros((phases.shape[0], m // 2 + 1), dtype=complex)
-    _state["fns"].coherent_spectrum(np.ascontiguousarray(phases), rho_rows,
+    spec = np.zeros((xr.shape[0], m // 2 + 1), dtype=complex)
+    _state["fns"].coherent_spectrum(xr, xi, rho_rows,
                                     np.sqrt(np.maximum(1.0 - rho_rows * rho_rows, 0.0)),
                                     np.ascontiguousarray(row_of_gap, dtype=np.int64),
                                     np.ascontiguousarray(amp, dtype=float), 0.5 * m, spec)

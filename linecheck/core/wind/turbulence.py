@@ -342,15 +342,28 @@ def _uniform_spacing(x: np.ndarray) -> float | None:
     return None
 
 
-def synthesize(x: np.ndarray, grid: SpectralGrid, phases: np.ndarray, decay: float, v_mean: float,
-               method: str = "auto") -> np.ndarray:
+@dataclass(frozen=True, eq=False)
+class UnitPhases:
+    """The random phases of one realization [rad] (n_nodes, n_freq) and, when the compiled kernel
+    computed them, their unit phasors (cos, sin) as its spectrum pass reads them (else None)."""
+
+    phases: np.ndarray
+    phasors: tuple[np.ndarray, np.ndarray] | None
+
+
+def synthesize(x: np.ndarray, grid: SpectralGrid, phases: np.ndarray | UnitPhases, decay: float,
+               v_mean: float, method: str = "auto") -> np.ndarray:
     """Unit-variance field at points x [m] for given phases [rad]: shape (n_steps, n_nodes).
 
-    phases shape (n_nodes, n_freq).  ``method``: "kms" (equal spacing required), "markov"
-    (ordered x at any spacing), "general" (dense factor per frequency) or "auto" (KMS when x is
-    equally spaced, else Markov when x is non-decreasing, else general).
+    phases shape (n_nodes, n_freq) (or :class:`UnitPhases` with their phasors computed).
+    ``method``: "kms" (equal spacing required), "markov" (ordered x at any spacing), "general"
+    (dense factor per frequency) or "auto" (KMS when x is equally spaced, else Markov when x is
+    non-decreasing, else general).
     u_j(t_n) = sum_k A_k Re[(L_k e^(i phi_k))_j e^(i 2 pi f_k t_n)] (Deodatis 1996), by inverse FFT.
     """
+    given = phases
+    if isinstance(phases, UnitPhases):
+        phases, given = phases.phases, (phases.phasors if phases.phasors is not None else phases.phases)
     x = np.asarray(x, dtype=float)
     n_nodes = x.size
     if phases.shape != (n_nodes, grid.n_freq):
@@ -366,12 +379,12 @@ def synthesize(x: np.ndarray, grid: SpectralGrid, phases: np.ndarray, decay: flo
         rho = davenport_coherence(grid.freq, spacing, decay, v_mean)  # coherence of neighbours: C_jk = rho^|j-k|
         # the phasors, the recursion and the scaling below in one compiled pass when the kernel
         # is loaded (the same bits, checked at load; issue 20)
-        spec = kernel.coherent_spectrum(phases, rho[None, :], np.zeros(max(n_nodes - 1, 0), dtype=np.int64),
+        spec = kernel.coherent_spectrum(given, rho[None, :], np.zeros(max(n_nodes - 1, 0), dtype=np.int64),
                                         grid.amplitude, m)
         if spec is None:
             y = kms_apply(rho, np.exp(1j * phases))
     elif method == "markov":
-        spec = kernel.coherent_spectrum(phases, *gap_rows(x, grid.freq, decay, v_mean), grid.amplitude, m)
+        spec = kernel.coherent_spectrum(given, *gap_rows(x, grid.freq, decay, v_mean), grid.amplitude, m)
         if spec is None:
             y = markov_apply(x, grid.freq, np.exp(1j * phases), decay, v_mean)
     elif method == "general":
@@ -401,8 +414,39 @@ def unit_field(case: Case, system: LineSystem, n_steps: int, dt: float, realizat
         raise CaseError("value 0.0 is not allowed for turbulence synthesis: expected v_ref > 0",
                         file=str(case.source) if case.source else None, key="wind.v_ref")
     grid = spectral_grid(int(n_steps), float(dt), length_scale(case), v, case.wind.fft_length == "fast")
-    phases = random_phases(case.analysis.seed, realization, x.size, grid.n_freq)
-    return synthesize(x, grid, phases, case.wind.coherence_decay, v)
+    return synthesize(x, grid, unit_phases(case.analysis.seed, realization, x.size, grid.n_freq),
+                      case.wind.coherence_decay, v)
+
+
+_phase_memo: "dict[tuple, UnitPhases]" = {}
+
+
+def unit_phases(seed: int, realization: int, n_nodes: int, n_freq: int) -> UnitPhases:
+    """:func:`random_phases` and, with the compiled kernel loaded, their unit phasors, remembered
+    per process like the unit fields (:data:`UNIT_FIELD_MEMO_BYTES`, least recently used first
+    out).  They depend on the seed, the realization, the node count and the grid only: the
+    positions of a one-storm scan, whose unit fields differ (V_ref at p changes the spectrum and
+    coherence), share them (issue 20: the sines and cosines were ≈ 0.1 s of a ten-realization
+    position), and so do cases of a batch with the same seed, nodes and record.  The same bits
+    as computing them afresh (deterministic)."""
+    key = (int(seed), int(realization), int(n_nodes), int(n_freq))
+    with _memo_lock:
+        got = _phase_memo.pop(key, None)
+        if got is not None:
+            _phase_memo[key] = got  # most recently used last
+            return got
+    phases = random_phases(seed, realization, n_nodes, n_freq)
+    out = UnitPhases(phases, kernel.phasors(phases))
+    if out.phasors is None:  # the numpy path: its complex exponential is not kept
+        return out
+    for arr in (phases, *out.phasors):
+        arr.setflags(write=False)
+    if 3 * phases.nbytes <= UNIT_FIELD_MEMO_BYTES / 8:
+        with _memo_lock:
+            _phase_memo[key] = out
+            while 3 * sum(p.phases.nbytes for p in _phase_memo.values()) > UNIT_FIELD_MEMO_BYTES / 2:
+                _phase_memo.pop(next(iter(_phase_memo)))
+    return out
 
 
 def modulation(case: Case, system: LineSystem, time: np.ndarray) -> np.ndarray:

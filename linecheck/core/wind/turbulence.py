@@ -45,7 +45,7 @@ from __future__ import annotations
 import math
 import os
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -430,11 +430,9 @@ def unit_phases(seed: int, realization: int, n_nodes: int, n_freq: int) -> UnitP
     position), and so do cases of a batch with the same seed, nodes and record.  The same bits
     as computing them afresh (deterministic)."""
     key = (int(seed), int(realization), int(n_nodes), int(n_freq))
-    with _memo_lock:
-        got = _phase_memo.pop(key, None)
-        if got is not None:
-            _phase_memo[key] = got  # most recently used last
-            return got
+    got = _memo_get(_phase_memo, key)
+    if got is not None:
+        return got
     phases = random_phases(seed, realization, n_nodes, n_freq)
     out = UnitPhases(phases, kernel.phasors(phases))
     if out.phasors is None:  # the numpy path: its complex exponential is not kept
@@ -442,10 +440,7 @@ def unit_phases(seed: int, realization: int, n_nodes: int, n_freq: int) -> UnitP
     for arr in (phases, *out.phasors):
         arr.setflags(write=False)
     if 3 * phases.nbytes <= UNIT_FIELD_MEMO_BYTES / 8:
-        with _memo_lock:
-            _phase_memo[key] = out
-            while 3 * sum(p.phases.nbytes for p in _phase_memo.values()) > UNIT_FIELD_MEMO_BYTES / 2:
-                _phase_memo.pop(next(iter(_phase_memo)))
+        _memo_put(_phase_memo, key, out, lambda p: 3 * p.phases.nbytes, UNIT_FIELD_MEMO_BYTES / 2)
     return out
 
 
@@ -512,16 +507,29 @@ def _unit_field_memo(case: Case, system: LineSystem, n_steps: int, dt: float, re
     x = system.node_station if system.is_section else system.node_x0
     key = (x.tobytes(), bool(system.is_section), float(case.wind.v_ref), float(length_scale(case)),
            float(case.wind.coherence_decay), int(case.analysis.seed), realization, n_steps, dt, case.wind.fft_length)
-    with _memo_lock:
-        got = _memo.pop(key, None)
-        if got is not None:
-            _memo[key] = got  # most recently used last
-            return got
+    got = _memo_get(_memo, key)
+    if got is not None:
+        return got
     u = unit_field(case, system, n_steps, dt, realization)
     if u.nbytes <= UNIT_FIELD_MEMO_BYTES / 4:
         u.setflags(write=False)
-        with _memo_lock:
-            _memo[key] = u
-            while sum(v.nbytes for v in _memo.values()) > UNIT_FIELD_MEMO_BYTES:
-                _memo.pop(next(iter(_memo)))
+        _memo_put(_memo, key, u, lambda v: v.nbytes, UNIT_FIELD_MEMO_BYTES)
     return u
+
+
+def _memo_get(memo: dict, key: tuple):
+    """A per-process memo's value for ``key`` (made the most recently used), or None."""
+    with _memo_lock:
+        got = memo.pop(key, None)
+        if got is not None:
+            memo[key] = got  # most recently used last
+        return got
+
+
+def _memo_put(memo: dict, key: tuple, value, nbytes: Callable, limit: float) -> None:
+    """Keep ``value`` under ``key``, dropping the least recently used entries while the memo's
+    ``nbytes`` total exceeds ``limit`` [bytes]."""
+    with _memo_lock:
+        memo[key] = value
+        while sum(nbytes(v) for v in memo.values()) > limit:
+            memo.pop(next(iter(memo)))

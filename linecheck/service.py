@@ -517,22 +517,17 @@ def record_wind(case: Case, st: StaticResult, t: np.ndarray) -> tuple[np.ndarray
     the span nodes and the global nodes together (the two sets differ in the last bit at some
     nodes), instead of once for each (issue 20: ≈ 0.07 s of a six-span run); the field is
     evaluated point by point, so the values are the same bits (tested)."""
-    from .core.wind.mean import _equal_span_downburst, downburst_field, span_node_x
+    from .core.wind.mean import equal_span_downburst_both
     from .core.wind.turbulence import modulation
 
     system = st.system
     if case.wind.type != "downburst" or system.is_section:
         vn, vl = record_mean_wind(case, st, t)
         return vn, vl, modulation(case, system, t)
-    xs = span_node_x(system).ravel()
-    xu, inv = np.unique(np.concatenate([xs, system.node_x0]), return_inverse=True)
-    vx, vy = _equal_span_downburst(case, downburst_field(case), xu, t)
-    shape = (t.size, system.n_spans, system.ne + 1)
-    span, node = inv[:xs.size], inv[xs.size:]
-    vn = to_global_nodes(system, vy[:, span].reshape(shape))  # as record_mean_wind via mean_wind
-    vl = to_global_nodes(system, vx[:, span].reshape(shape))
-    a = case.wind.turbulence_intensity * np.hypot(vx[:, node], vy[:, node])  # as modulation
-    return vn, vl, a
+    vx_s, vy_s, vx_n, vy_n = equal_span_downburst_both(case, system, t)
+    # as record_mean_wind (via mean_wind) and modulation (via mean_speed_at_nodes)
+    return (to_global_nodes(system, vy_s), to_global_nodes(system, vx_s),
+            case.wind.turbulence_intensity * np.hypot(vx_n, vy_n))
 
 
 def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: np.ndarray, vn: np.ndarray,

@@ -143,7 +143,7 @@ def _rowdot_test(rowdot) -> bool:
     return ok
 
 
-def _spectrum_test(fn) -> bool:
+def _spectrum_test(fns) -> bool:
     """The compiled spectrum gives the numpy forms' bits, signs of zeros included (glibc's sin and
     cos for numpy's complex exp; numpy's real-times-complex products): equal gaps (the KMS
     recursion) and unequal ones (the Markov recursion, a coefficient row per gap); else numpy's."""
@@ -164,8 +164,8 @@ def _spectrum_test(fn) -> bool:
         ref = fft_input(y, amp, m)
         got = np.zeros_like(ref)
         xr, xi = np.empty_like(phases), np.empty_like(phases)
-        _state["fns"].phasors(phases, xr, xi)
-        fn(xr, xi, r, np.sqrt(np.maximum(1.0 - r * r, 0.0)), g, amp, 0.5 * m, got)
+        fns.phasors(phases, xr, xi)
+        fns.coherent_spectrum(xr, xi, r, np.sqrt(np.maximum(1.0 - r * r, 0.0)), g, amp, 0.5 * m, got)
         ok &= bool(np.array_equal(got.view(float), ref.view(float))
                    and np.array_equal(np.signbit(got.view(float)), np.signbit(ref.view(float))))
     return ok
@@ -374,7 +374,7 @@ def available() -> bool:
             _state["fns"] = fns if ok else None
             _state["rotate"] = rot
             _state["rowdot"] = dot
-            _state["spectrum"] = ok and _spectrum_test(fns.coherent_spectrum)
+            _state["spectrum"] = ok and _spectrum_test(fns)
             _state["loads"] = ok and _loads_test(fns.drag_loads)
             _state["span"] = ok and _span_test(fns.span_terms)
             _state["reductions"] = ok and _reductions_test(fns.history_reductions)

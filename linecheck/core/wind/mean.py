@@ -993,6 +993,22 @@ def _equal_span_downburst(case: Case, field: DownburstField, x: np.ndarray,
     return field.velocity_at(x, np.zeros_like(x), time, np.full(x.size, float(case.line.height)))
 
 
+def equal_span_downburst_both(case: Case, system: LineSystem,
+                              time: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """An equal-span downburst's running-mean (v_x, v_y) [m/s] at the span nodes, each
+    (n_t, n_spans, ne+1) (as :func:`mean_wind`), and at the global nodes, each (n_t, n_nodes) (as
+    :func:`mean_speed_at_nodes`), from one evaluation of the field at the distinct stations of
+    both sets (they differ in the last bit at some nodes of a single span).  The field is
+    evaluated point by point, so the values are the same bits as evaluating each set (issue 20)."""
+    time = np.atleast_1d(np.asarray(time, dtype=float))
+    xs = span_node_x(system).ravel()
+    xu, inv = np.unique(np.concatenate([xs, system.node_x0]), return_inverse=True)
+    vx, vy = _equal_span_downburst(case, downburst_field(case), xu, time)
+    span, node = inv[:xs.size], inv[xs.size:]
+    shape = (time.size, system.n_spans, system.ne + 1)
+    return vx[:, span].reshape(shape), vy[:, span].reshape(shape), vx[:, node], vy[:, node]
+
+
 def mean_wind(case: Case, system: LineSystem, times: np.ndarray | None = None) -> MeanWind:
     """Running-mean wind at the FE nodes at ``times`` [s].
 

@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import math
+import re
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -247,3 +250,34 @@ def test_one_storm_scan_positions_share_the_phases_bit_for_bit(monkeypatch):
     assert len(tb._memo) == 0 and len(tb._phase_memo) == 0
     assert not np.array_equal(tb.unit_field(moved[0], system, t.size, 0.05, 0),
                               tb.unit_field(moved[1], system, t.size, 0.05, 0))  # the spectra differ
+
+
+@pytest.mark.parametrize("name, toi, options", [
+    ("paper/case01-six", 4, 'drag = "linear"\ntension = "linear"\n'),  # a downburst's 40 mean states
+    ("paper/case01-six", 1, 'drag = "quadratic"\ntension = "second-order"\n'),  # a strain tower: direct loads
+    ("examples/section-12span", 5, 'drag = "quadratic"\ntension = "second-order"\n'),  # an 18 deg angle-strain tower
+])
+def test_run_tower_equals_run_case_at_the_tower_of_interest(tmp_path, name, toi, options):
+    """Issue 20: a scan's steps 1-3 compute the tower of interest's reactions alone (service.run_tower:
+    its rows of G, of the direct loads and of the second-order forms; its own frame); every
+    statistic there is the same bits as run_case's, the gust factors' definedness included (it is
+    decided against the whole section's largest mean)."""
+    from linecheck.service import run_case, run_tower
+
+    src = CASES / f"{name}.toml"
+    if (CASES / f"{name}.csv").exists():
+        shutil.copy(CASES / f"{name}.csv", tmp_path)
+    path = write_short_case(src, tmp_path, realizations=2, duration=30.0)
+    text = re.sub(r'(?m)^\s*(tower_of_interest\s*=\s*\d+|(drag|tension)\s*=\s*").*$', "", path.read_text(encoding="utf-8"))
+    text = text.replace("[analysis]", f"[analysis]\nmean_states = 40\n{options}", 1)
+    text = text.replace("[line]", f"[line]\ntower_of_interest = {toi}", 1)
+    path.write_text(text, encoding="utf-8")
+    case = load_case(path)
+    assert case.line.tower_of_interest == toi and (case.analysis.tension == "second-order") == ("second" in options)
+    full = run_case(case, realizations=[0, 1], spectral_check=False)
+    one = run_tower(case, realizations=[0, 1])
+    for f in dataclasses.fields(one.stats):
+        a, b = getattr(full.stats, f.name)[:, toi - 1], getattr(one.stats, f.name)
+        assert b.shape == (2, 1, 3)
+        assert np.array_equal(a, b[:, 0], equal_nan=True), f.name
+    assert np.isfinite(one.stats.peak_dynamic).all() and not np.isnan(one.stats.GF_Dy[:, 0, 1]).any()

@@ -181,16 +181,16 @@ def scan_point(case: Case, distance: float, angle: float, jet_diameter: float,
     ``v_max``: hold the storm's V_max [m/s] fixed (:func:`fixed_jet_case`); ``None``
     keeps the case's V_ref at point p of every configuration.
     """
-    from ..service import run_case, static_analysis
+    from ..service import run_tower, static_analysis
 
     c = apply_changes(case, scan_changes(distance, angle, jet_diameter))
     if v_max is not None:
         c = fixed_jet_case(c, v_max)
     j = c.line.tower_of_interest - 1
     if dynamic_realizations > 0:
-        res = run_case(c, realizations=list(range(dynamic_realizations)), spectral_check=False)
+        res = run_tower(c, realizations=list(range(dynamic_realizations)))  # the tower of interest's reactions only
         st = res.static
-        dyn = res.stats.peak_dynamic[:, j, :].mean(axis=0)
+        dyn = res.stats.peak_dynamic[:, 0, :].mean(axis=0)
     else:
         st = static_analysis(c)
     rw = st.system.to_tower_frames(st.mean.reactions_wind)[:, j, :]  # (n_t, 3), the tower's own frame

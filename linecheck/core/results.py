@@ -123,6 +123,7 @@ def compute_statistics(
     still_air: np.ndarray,
     g_yp_L: float | np.ndarray,
     window: int | None = None,
+    scale: float | None = None,
 ) -> Statistics:
     """Statistics of Eqs 15-17 from response histories.
 
@@ -140,8 +141,11 @@ def compute_statistics(
         g_yp_L: [N] normalising force g*_yp L_x (Eq. 17): a number, or one per tower (n_towers,)
             (a section: L_x the mean of the tower's two adjacent spans).
         window: samples per peak window (None: the whole record).
+        scale: [N] the largest |M| that decides which gust factors are defined (a mean below
+            ``ZERO_MEAN_RTOL`` of it has none); None: max |mean| (pass the whole section's when
+            ``mean`` holds some of its towers only).
     """
-    scale = max(float(np.abs(mean).max()), 1e-300)
+    scale = max(float(np.abs(mean).max()), 1e-300) if scale is None else scale
     n_real, n_t = background.shape[:2]
     if window is not None and 0 < window < n_t - 1:
         n_w = (n_t - 1) // window  # n_t samples span n_t - 1 steps

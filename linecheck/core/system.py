@@ -193,15 +193,16 @@ class LineSystem:
         the equal-span form, or a section without angle towers (inclined spans allowed)."""
         return not self.is_section or not np.any(self.tower_angles)
 
-    def to_tower_frames(self, R: np.ndarray) -> np.ndarray:
+    def to_tower_frames(self, R: np.ndarray, towers: slice = slice(None)) -> np.ndarray:
         """Reactions (..., n_towers, 3) from the global frame (x, y, z down) to every tower's own
         frame: x along its mean heading psi_j, y = x turned +90 deg in plan, z down.
 
         R'_x = R_x cos psi + R_y sin psi, R'_y = -R_x sin psi + R_y cos psi, R'_z = R_z.  Returns
-        ``R`` itself (no copy) when every tower frame is the global frame."""
+        ``R`` itself (no copy) when every tower frame is the global frame.  ``towers``: R holds
+        the reactions of these towers only (a slice of the towers)."""
         if self.straight_in_plan:
             return R
-        c, s = np.cos(self.tower_headings), np.sin(self.tower_headings)
+        c, s = np.cos(self.tower_headings[towers]), np.sin(self.tower_headings[towers])
         out = np.array(R, dtype=float, copy=True)
         out[..., 0] = R[..., 0] * c + R[..., 1] * s
         out[..., 1] = -R[..., 0] * s + R[..., 1] * c

@@ -120,9 +120,14 @@ def test_damping_and_steppers_stacked_bit_identical(which, damping, zeta, reques
     assert not np.array_equal(one[0], one[-1])
     nm = Newmark(case.analysis.time_step)
     T, Kr, Cr = _rotated_stack(models, many)
+    system = st.system  # a section's loads along its node normals (as service.run_case passes them)
+    ld = None if system.straight_in_plan else system.node_normals[models[0].dofs.free_nodes]
+    stacked = _Stepper.stack(models, T, Kr, Cr, nm, ld)  # all operators in vectorised passes
     for k, m in enumerate(models):
-        ref = _Stepper.build(m, one[k], nm)
-        assert stepper_fields_identical(ref, _Stepper.from_bases(m, T[k], Kr[k], Cr[k], nm)), f"state {k}"
+        ref = _Stepper.build(m, one[k], nm, ld)
+        assert stepper_fields_identical(ref, _Stepper.from_bases(m, T[k], Kr[k], Cr[k], nm, ld)), f"state {k}"
+        assert stepper_fields_identical(ref, stacked[k]), f"state {k}, stacked"
+        assert np.array_equal(ref.cols, stacked[k].cols) and ref.a1 == stacked[k].a1 and ref.r2 == stacked[k].r2
         assert (ref.rest is not None) == (zeta > 0)
 
 

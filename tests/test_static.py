@@ -116,3 +116,34 @@ def test_vectorised_tridiagonal_solve_matches_dense():
     for i in range(n_b):
         A = np.diag(diag[i]) + np.diag(off[i], 1) + np.diag(off[i], -1)
         np.testing.assert_allclose(A @ x[i], b[i], rtol=0, atol=1e-13)
+
+
+def test_final_states_are_batch_invariant_and_hang_from_the_attachments():
+    """Issue 20: the deformed shapes and element tensions of many converged states in one
+    vectorised pass (static._final_states): a state's arrays are the same bits alone as in the
+    batch; the shape starts and ends at the attachment points, and every element's tension is at
+    least the span's horizontal tension (T = H ds/dx)."""
+    from linecheck.core.static import _final_states, _Spans, solve_static_batch
+
+    system = LineSystem(paper_line(6))
+    g = drag_intensity(np.array([10.0, 25.0, 40.0, 32.0]), 1.25, 1.0, 0.022)
+    gy = np.stack([span_loads_uniform(system, gi * np.linspace(0.6, 1.0, system.n_spans)) for gi in g])
+    states = solve_static_batch(system, gy, labels=[f"s{k}" for k in range(g.size)])
+    sp = _Spans(system, gy)
+    d, H, R, Rres = (np.stack([getattr(s, f) for s in states])
+                     for f in ("displacement", "tension", "reactions", "insulator_force"))
+    it = np.array([s.iterations for s in states])
+    res = np.array([s.residual for s in states])
+    for j, s in enumerate(states):
+        one = _final_states(system, sp.Lu, sp.my_hat[j:j + 1], sp.mz_hat, d[j:j + 1], H[j:j + 1], R[j:j + 1],
+                            Rres[j:j + 1], it[j:j + 1], res[j:j + 1], [f"s{j}"])[0]
+        assert np.array_equal(one.nodes, s.nodes) and np.array_equal(one.element_tension, s.element_tension)
+        ends = s.nodes[::system.ne]  # the span ends: the attachment points (tower x + d)
+        att = np.column_stack([system.tower_x, np.zeros(system.n_towers), np.zeros(system.n_towers)]) + s.displacement
+        assert np.allclose(ends, att, rtol=0.0, atol=1e-9)
+        assert np.all(s.element_tension >= np.repeat(s.tension, system.ne) * (1.0 - 1e-15))
+    assert not np.array_equal(states[0].nodes, states[2].nodes)
+    with pytest.raises(ConvergenceError, match="s2: no admissible equilibrium"):
+        big = H.copy()
+        big[2] *= 1e4  # a strain far above MAX_STRAIN
+        _final_states(system, sp.Lu, sp.my_hat, sp.mz_hat, d, big, R, Rres, it, res, [f"s{k}" for k in range(g.size)])

@@ -160,6 +160,21 @@ def band_to_csr(ab: np.ndarray) -> CSRArrays:
     return CSRArrays(indptr, cols[keep].astype(np.int32), vals[keep], (n, n))
 
 
+def band_to_csr_stack(ab: np.ndarray) -> list[CSRArrays]:
+    """:func:`band_to_csr` of many band matrices of one size, shape (n_k, u + 1, n), gathered in
+    one vectorised pass (issue 20: a downburst's 250 mean states); the same arrays."""
+    n_k, u, n = ab.shape[0], ab.shape[1] - 1, ab.shape[2]
+    offs = np.arange(-u, u + 1)
+    rows = np.arange(n)[:, None]
+    cols = rows + offs
+    inside = (cols >= 0) & (cols < n)
+    vals = np.where(inside, ab[:, u - np.abs(offs), np.clip(np.where(offs >= 0, cols, rows), 0, n - 1)], 0.0)
+    keep = vals != 0.0  # (n_k, n, 2u + 1)
+    indptr = np.zeros((n_k, n + 1), dtype=np.int32)
+    np.cumsum(keep.sum(axis=2), axis=1, out=indptr[:, 1:])
+    return [CSRArrays(indptr[k], cols[keep[k]].astype(np.int32), vals[k][keep[k]], (n, n)) for k in range(n_k)]
+
+
 def band_to_sparse(ab: np.ndarray):
     """Upper banded storage to a symmetric scipy CSR matrix (no dense intermediate;
     :func:`band_to_csr`)."""

@@ -400,48 +400,51 @@ def _fig6_iteration(
             f"{labels[j]}: step-1 static solver did not converge in {max_iter} iterations "
             f"(last displacement change {change[j]:.3g} m, out-of-balance force {residual[j]:.3g} N)"
         )
-    return [_final_state(system, sp.Lu, sp.my_hat[j], sp.mz_hat, out_d[j], out_H[j], out_R[j], out_Rres[j],
-                         int(out_it[j]), float(out_res[j]), labels[j]) for j in range(n_s)]
+    return _final_states(system, sp.Lu, sp.my_hat, sp.mz_hat, out_d, out_H, out_R, out_Rres, out_it, out_res, labels)
 
 
-def _final_state(system: LineSystem, Lu: np.ndarray, my_hat: np.ndarray, mz_hat: np.ndarray, d: np.ndarray,
-                 H: np.ndarray, R: np.ndarray, Rres: np.ndarray, it: int, residual: float, label: str) -> StaticState:
-    """Strain check and deformed shape of one converged equilibrium (shallow cable:
-    y = chord + M_y/H, z = chord - M_z/H; element tension T = H ds/dx)."""
+def _final_states(system: LineSystem, Lu: np.ndarray, my_hat: np.ndarray, mz_hat: np.ndarray, d: np.ndarray,
+                  H: np.ndarray, R: np.ndarray, Rres: np.ndarray, it: np.ndarray, residual: np.ndarray,
+                  labels: list[str]) -> list[StaticState]:
+    """Strain check and deformed shape of converged equilibria, on a leading axis of n_s states
+    (shallow cable: y = chord + M_y/H, z = chord - M_z/H; element tension T = H ds/dx).  Every
+    operation is elementwise along the states (issue 20: one pass for a downburst's 250 states
+    instead of one call each), so a state's arrays do not depend on the others (tested).
+
+    Args: Lu [m] (n_spans,); my_hat [N m/m] (n_s, n_spans, ne+1); mz_hat (ne+1,); d [m]
+        (n_s, n_towers, 3); H [N] (n_s, n_spans); R [N] (n_s, n_towers, 3); Rres [N] (n_s, n_towers);
+        it, residual [N] (n_s,); labels (n_s).
+    """
     line = system.line
     L = system.span_lengths
-    strain = H.max() / line.ea
-    if strain > MAX_STRAIN or not np.isfinite(strain):
+    n_s = d.shape[0]
+    strain = H.max(axis=1) / line.ea
+    bad = (strain > MAX_STRAIN) | ~np.isfinite(strain)
+    if bad.any():
+        j = int(np.flatnonzero(bad)[0])
         raise ConvergenceError(
-            f"{label}: no admissible equilibrium: conductor strain {strain:.3g} exceeds {MAX_STRAIN:g} "
-            f"(horizontal tension {H.max():.4g} N, out-of-balance force {residual:.3g} N); check the loads"
+            f"{labels[j]}: no admissible equilibrium: conductor strain {strain[j]:.3g} exceeds {MAX_STRAIN:g} "
+            f"(horizontal tension {H[j].max():.4g} N, out-of-balance force {residual[j]:.3g} N); check the loads"
         )
-    l = L + np.diff(d[:, 0])
+    l = L + np.diff(d[..., 0], axis=-1)  # (n_s, n_spans)
     s = system.node_s
-    xA = system.tower_x[:-1] + d[:-1, 0]
-    X = xA[:, None] + s[None, :] * l[:, None]
-    scale = (Lu * l / H)[:, None]
-    Y = d[:-1, 1][:, None] + s * np.diff(d[:, 1])[:, None] + scale * my_hat
-    Z = d[:-1, 2][:, None] + s * np.diff(d[:, 2])[:, None] - scale * mz_hat[None, :]
+    xA = system.tower_x[:-1] + d[:, :-1, 0]
+    X = xA[..., None] + s * l[..., None]
+    scale = (Lu * l / H)[..., None]
+    Y = d[:, :-1, 1][..., None] + s * np.diff(d[..., 1], axis=-1)[..., None] + scale * my_hat
+    Z = d[:, :-1, 2][..., None] + s * np.diff(d[..., 2], axis=-1)[..., None] - scale * mz_hat
     ne = system.ne
-    nodes = np.empty((system.n_nodes, 3))
+    nodes = np.empty((n_s, system.n_nodes, 3))
     for c, A in enumerate((X, Y, Z)):
-        nodes[:-1, c] = A[:, :-1].reshape(-1)
-        nodes[-1, c] = A[-1, -1]
-    seg = np.diff(nodes, axis=0)  # (n_elements, 3)
-    seg_len = np.linalg.norm(seg, axis=1)
-    H_el = np.repeat(H, ne)
-    element_tension = H_el * seg_len / np.abs(seg[:, 0])  # T = H ds/dx (shallow cable)
-    return StaticState(
-        displacement=d,
-        reactions=R,
-        tension=H,
-        insulator_force=Rres,
-        nodes=nodes,
-        element_tension=element_tension,
-        iterations=it,
-        residual=residual,
-    )
+        nodes[:, :-1, c] = A[..., :-1].reshape(n_s, -1)
+        nodes[:, -1, c] = A[:, -1, -1]
+    seg = np.diff(nodes, axis=1)  # (n_s, n_elements, 3)
+    seg_len = np.linalg.norm(seg, axis=-1)
+    H_el = np.repeat(H, ne, axis=1)
+    element_tension = H_el * seg_len / np.abs(seg[..., 0])  # T = H ds/dx (shallow cable)
+    return [StaticState(displacement=d[j], reactions=R[j], tension=H[j], insulator_force=Rres[j], nodes=nodes[j],
+                        element_tension=element_tension[j], iterations=int(it[j]), residual=float(residual[j]))
+            for j in range(n_s)]
 
 
 def section_loads(system: LineSystem, gy: np.ndarray) -> np.ndarray:

@@ -175,3 +175,28 @@ def test_band_to_sparse_gives_scipys_csr_arrays(n, u):
             assert getattr(got, f).dtype == getattr(ref, f).dtype and np.array_equal(getattr(got, f), getattr(ref, f)), f
     got = band_to_sparse(ab)
     assert np.array_equal(got.toarray(), band_to_dense(ab))
+
+
+def test_stacked_steppers_where_the_sparsity_patterns_differ(downburst_six):
+    """_Stepper.stack builds each state by from_bases when the states' reaction maps touch
+    different coordinates (here one state's G with a node's columns set to exact zeros): the
+    same operators as state by state, each with its own reaction coordinates."""
+    import dataclasses
+
+    from linecheck.core.damping import aerodynamic_damping_stack
+    from linecheck.core.dynamics import Newmark, _rotated_stack, _Stepper
+
+    case, st, states = downburst_six
+    models = build_models(st.system, states[:4])
+    G = models[1].G.copy()
+    node = int(np.flatnonzero(np.any(G.reshape(G.shape[0], -1, 3) != 0.0, axis=(0, 2)))[0])
+    G[:, 3 * node:3 * node + 3] = 0.0
+    models[1] = dataclasses.replace(models[1], G=G)
+    vn = service.to_global_nodes(st.system, st.wind.normal)[:4]
+    c = aerodynamic_damping_stack(case, models, vn, np.stack([s.nodes for s in states[:4]]))
+    nm = Newmark(case.analysis.time_step)
+    T, Kr, Cr = _rotated_stack(models, c)
+    stacked = _Stepper.stack(models, T, Kr, Cr, nm)
+    for k, m in enumerate(models):
+        assert stepper_fields_identical(_Stepper.from_bases(m, T[k], Kr[k], Cr[k], nm), stacked[k]), f"state {k}"
+    assert stacked[1].nz.size < stacked[0].nz.size

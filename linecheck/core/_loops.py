@@ -286,7 +286,26 @@ def rowdot(X, BT, out):  # pragma: no cover - compiled
     """out = X @ BT, every row summed over d in order from zero (numpy's einsum "rd,dk->rk")."""
     m, n = X.shape
     q = BT.shape[1]
-    for r in range(m):
+    r0 = 0
+    if q <= 8:  # few columns (a scan's one tower): four rows' sums at once, each in the same order
+        while r0 + 4 <= m:
+            for k in range(q):
+                s0 = 0.0
+                s1 = 0.0
+                s2 = 0.0
+                s3 = 0.0
+                for d in range(n):
+                    b = BT[d, k]
+                    s0 += X[r0, d] * b
+                    s1 += X[r0 + 1, d] * b
+                    s2 += X[r0 + 2, d] * b
+                    s3 += X[r0 + 3, d] * b
+                out[r0, k] = s0
+                out[r0 + 1, k] = s1
+                out[r0 + 2, k] = s2
+                out[r0 + 3, k] = s3
+            r0 += 4
+    for r in range(r0, m):
         o = out[r]
         for k in range(q):
             o[k] = 0.0

@@ -135,7 +135,7 @@ def _rowdot_test(rowdot) -> bool:
 
     rng = np.random.default_rng(22)
     ok = True
-    for m, n, q in ((480, 59, 21), (7, 177, 9), (33, 3, 40)):
+    for m, n, q in ((480, 59, 21), (7, 177, 9), (33, 3, 40), (482, 55, 3), (6, 10, 2)):
         X, BT = rng.standard_normal((m, n)), rng.standard_normal((n, q))
         out = np.empty((m, q))
         rowdot(X, BT, out)

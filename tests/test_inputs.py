@@ -240,11 +240,27 @@ def test_with_values_keeps_large_legal_case_refused_by_the_guard_not_the_schema(
     # realizations in chunks of 1 GB / (12001 steps x 8 bytes x (3 x 11 nodes + 24 x 2 towers)) = 128
     # (issue 20): 4 arrays x 8 bytes x 128 x 12001 x 11 nodes + 8 x 8 x 12001 x 11, what the result
     # keeps of all 1e4 (6 doubles per step, 45 statistics per tower), + 100 MB + one state of
-    # 27 DOF (33 less the 6 of the two pinned strain towers) + 7 dense 27 x 27 matrices
+    # 27 DOF (33 less the 6 of the two pinned strain towers) + 7 dense 27 x 27 matrices + the
+    # turbulence memos at their caps (1e4 unit fields of 1.06 MB: 256 MB; phases and phasors of
+    # 3 x 11 x 6000 doubles: 128 MB)
     assert budget.realization_chunk(case, 12001) == 128
     expect = (4 * 8 * 128 * 12001 * 11 + 8 * 8 * 12001 * 11 + 6 * 8 * 1e4 * 12001 + 45 * 8 * 1e4 * 2
-              + 100e6 + (20 * 8 * 27 + 3e3) + 7 * 27**2 * 8)
+              + 100e6 + (20 * 8 * 27 + 3e3) + 7 * 27**2 * 8 + 256e6 + 128e6)
     assert est.memory == pytest.approx(expect, rel=1e-12)
+
+
+def test_the_estimate_counts_the_turbulence_memos():
+    """The per-process memos of unit fields and phases (issue 20) are in the estimate: n_real
+    fields of n_steps x n_nodes doubles and 3 n_nodes n_freq doubles of phases each, up to their
+    caps; a field above a quarter of the cap (a long line) is not kept, so not counted."""
+    six = load_case(PAPER / "case09-six.toml")
+    est = budget.estimate(six, realizations=3)
+    n = est.n_steps
+    assert budget.memo_bytes(3, n, 61) == 3 * 8 * n * 61 + 3 * 3 * 8 * (n // 2) * 61
+    assert budget.memo_bytes(1000, n, 61) == 256e6 + 128e6  # the caps
+    assert budget.memo_bytes(10, n, 2001) == 0.0  # 200 spans: 192 MB a field, 288 MB of phases: not kept
+    few = budget.estimate(six, realizations=1)
+    assert est.memory - few.memory >= 2 * (8 * n * 61 + 3 * 8 * (n // 2) * 61)
 
 
 def test_check_warns_between_half_the_limit_and_the_limit(monkeypatch):

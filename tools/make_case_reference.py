@@ -65,7 +65,9 @@ or the environment variable `LINECHECK_MAX_MEMORY` (every command, and the local
 workers) says otherwise (`8GB`, `512MB`, `1.5GiB` or bytes; Dask workers read their own
 environment). Above half the limit, or above an estimated 10 minutes, a one-line warning is
 printed and the job runs. In a batch or a scan each task checks its own estimate (a batch
-task holds one chunk of realizations), and a task above the limit fails that case only. The
+task holds one chunk of realizations), and a task above the limit fails that case only. The estimate includes
+what a process keeps of the turbulence for reuse (unit fields and random phases, up to 384 MB;
+docs/wind.md). The
 estimate is rough (within about a factor of 2 on the paper
 cases, see docs/performance.md); command-line overrides (`-n`, `--seed`) are checked against
 the same ranges as the file and the message names the option.

@@ -212,12 +212,29 @@ def estimate(case: Case, job: str = "run", *, realizations: int | None = None, b
     if job == "wind":
         parts["time histories"] = STEP_ARRAYS * F8 * n_steps * n_nodes
         secs += n_steps * T_SYNTH * n_nodes
+    if job in ("run", "wind"):
+        parts["turbulence memo"] = memo_bytes(1 if job == "wind" else n_real, n_steps, n_nodes)
     if job == "spectral" or (job == "run" and synoptic and spectral_check):
         n_check = n_dense // 3 if windowed else n_nodes
         secs += T_SPECTRAL * SPECTRAL_POINTS * float(n_check) ** 2 * (3.0 if windowed else 1.0)
     memory = sum(parts.values())
     dominant = max(parts, key=parts.get)
     return Estimate(job, memory, secs, n_steps, n_nodes, n_dof, n_real, n_k, dominant)
+
+
+def memo_bytes(n_real: int, n_steps: int, n_nodes: int) -> float:
+    """[bytes] What the process keeps of ``n_real`` realizations' turbulence for reuse
+    (:mod:`linecheck.core.wind.turbulence`'s per-process memos, issue 20): unit fields
+    (n_steps x n_nodes) of at most a quarter of ``UNIT_FIELD_MEMO_BYTES`` each, up to it in all,
+    and the random phases with their phasors (3 x n_nodes x n_freq, n_freq ≈ n_steps / 2) of at
+    most an eighth each, up to half of it.  An upper bound: the phasors are kept only when the
+    compiled kernel is loaded."""
+    from .wind.turbulence import UNIT_FIELD_MEMO_BYTES as cap
+
+    field = F8 * float(n_steps) * n_nodes
+    phases = 3 * F8 * float(n_steps // 2) * n_nodes
+    kept = min(cap, n_real * field) if field <= cap / 4 else 0.0
+    return kept + (min(cap / 2, n_real * phases) if phases <= cap / 8 else 0.0)
 
 
 def check(est: Estimate, case: Case, warn: Callable[[str], None] | None = None) -> Estimate:

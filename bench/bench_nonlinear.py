@@ -33,7 +33,8 @@ Timing: wall time of ``service.run_case(case, realizations=[0])`` (all three ste
 synthesis, burn-in and frequency-domain check included) against the OpenSeesPy analysis of
 the same record (model, statics, time stepping; the wind it is fed is linecheck's, not timed),
 both in this process, after a warm-up run; ``--repeat N`` takes the best of N of each, the two
-alternating (linecheck, OpenSees, linecheck, ...: the shared machine's speed drifts),
+alternating (linecheck, OpenSees, linecheck, ...: the shared machine's speed drifts), and also
+prints the ratio of every back-to-back pair and their median,
 ``--ensemble N`` also times linecheck with N realizations in one run (best of ``--repeat``);
 ``--threads N`` gives the timed linecheck runs N threads (default 1, as OpenSees; ``linecheck run``
 uses 2); ``--no-check`` times them without the frequency-domain check (an extra estimate OpenSees
@@ -281,12 +282,16 @@ def run_one(name: str, r: int, args) -> dict:
     ne = case.line.elements_per_span
     nl, R_nl = run_nl(case, wind, res, n_el=ne, beta=beta, label=f"{name} OpenSees")
     # best of --repeat of each, the two analyses alternating (the shared VM's speed drifts by up to
-    # 2x within minutes: both bests then come from the same stretch of time)
+    # 2x within minutes: both bests then come from the same stretch of time); also the ratio of
+    # every back-to-back pair, whose median drift moves least
+    pairs = [nl.wall / t_lc]
     for _ in range(args.repeat - 1):  # same record, same answer
         t0 = time.perf_counter()
         service.run_case(case, realizations=[r], threads=args.threads, spectral_check=not args.no_check)
-        t_lc = min(t_lc, time.perf_counter() - t0)
+        t_i = time.perf_counter() - t0
+        t_lc = min(t_lc, t_i)
         again, _r = run_nl(case, wind, res, n_el=ne, beta=beta, label=f"{name} OpenSees (timing)")
+        pairs.append(again.wall / t_i)
         if again.wall < nl.wall:
             nl = again
     M_nl = None if synoptic else nl_mean_history(case, res, wind, ne)
@@ -302,7 +307,8 @@ def run_one(name: str, r: int, args) -> dict:
         "case": name, "realization": r + 1, "type": case.wind.type, "spans": case.line.spans, "v_ref": case.wind.v_ref,
         "tower": case.line.tower_of_interest, "record_s": float(res.time[-1] - res.time[0]),
         "burn_in_s": burn, "steps": int(wind.time.size), "beta": beta,
-        "time_linecheck_s": t_lc, "threads": args.threads, "check": not args.no_check, "time_opensees_s": nl.wall, "ratio": nl.wall / t_lc,
+        "time_linecheck_s": t_lc, "threads": args.threads, "check": not args.no_check,
+        "pair_ratios": pairs, "ratio_pairs_median": float(np.median(pairs)), "time_opensees_s": nl.wall, "ratio": nl.wall / t_lc,
         "time_opensees_solver_s": nl.solver_wall,
         "newton_iterations_per_step": float(nl.iterations[1:].mean()),
         "stats": {
@@ -350,6 +356,9 @@ def run_one(name: str, r: int, args) -> dict:
         print(f"  linecheck with {args.ensemble} realizations: {te:.2f} s; {args.ensemble} OpenSees records "
               f"~{args.ensemble * nl.wall:.0f} s: ratio {entry['ratio_ensemble']:.0f}x", flush=True)
     print_case(entry)
+    if len(pairs) > 1:
+        print(f"  back-to-back pairs (OpenSees / linecheck): {', '.join(f'{p:.1f}' for p in pairs)}; "
+              f"median {np.median(pairs):.1f}x", flush=True)
     print(f"  time: linecheck {t_lc:.2f} s ({args.threads} thread(s){', no check' if args.no_check else ''}), OpenSees {nl.wall:.1f} s (of which analyze {nl.solver_wall:.1f} s; "
           f"{entry['steps']} steps, "
           f"{entry['newton_iterations_per_step']:.1f} Newton iterations/step): ratio {entry['ratio']:.1f}x",

@@ -497,14 +497,16 @@ class DownburstField:
         z [m] (broadcast shapes; None: ``height`` everywhere)."""
         if z is not None:
             return self._shape_z(r, t, z)
-        r, t = np.broadcast_arrays(np.asarray(r, dtype=float), np.asarray(t, dtype=float))
+        t0 = np.asarray(t, dtype=float)
+        r, t = np.broadcast_arrays(np.asarray(r, dtype=float), t0)
         if self.ring is not None:
             # issue 15: non-separable ring vortex + image + wall jet, per unit V_j
             return self.ring.shape(r, self.height, t)
         if self.table is None:
-            # issue 3: V = V_max f_r(r) f_z(z) Pi(t)
+            # issue 3: V = V_max f_r(r) f_z(z) Pi(t); Pi on the given instants (e.g. (n_t, 1)), not on
+            # the broadcast grid: the same values, n_x times fewer exponentials
             return (radial_profile(r, self.r_max, self.radial_decay)
-                    * float(vertical_profile(self.height, self.delta)) * intensity(t, self.t1, self.t_f))
+                    * float(vertical_profile(self.height, self.delta)) * intensity(t0, self.t1, self.t_f))
         return _table_slice(self.table, self.height / self.jet_diameter)(r / self.jet_diameter, t, self.table.path)
 
     def _shape_z(self, r: np.ndarray, t: np.ndarray, z: np.ndarray) -> np.ndarray:

@@ -708,10 +708,10 @@ def run_tower(case: Case, *, realizations: list[int] | np.ndarray | None = None,
               cancel: threading.Event | None = None) -> TowerRun:
     """:func:`run_case` (no frequency-domain check, one thread) computing the dynamic
     reactions of the tower of interest only: a scan ranks positions by them (issue 20), and the
-    other towers' reactions, statistics and frame rotations cost ≈ 15 % of a six-span
-    downburst position (1.34 → 1.13 s, docs/performance.md).  Each reaction is the same arithmetic as in :func:`run_case` (every reaction
-    is a sum of its own, in a fixed order), so the statistics are bit-identical to
-    ``run_case(...).stats`` at that tower (tested)."""
+    other towers' reactions, statistics and frame rotations cost ≈ 15 % of a six-span downburst
+    position (1.34 → 1.13 s, docs/performance.md).  Each reaction is the same arithmetic as in
+    :func:`run_case` (every reaction is a sum of its own, in a fixed order), so the statistics
+    are bit-identical to ``run_case(...).stats`` at that tower (tested)."""
     return _run(case, realizations=realizations, interpolate_states=False, spectral_check=False,
                 progress=None, cancel=cancel, warn=None, threads=1, tower_only=True)
 
@@ -814,24 +814,21 @@ def _run(case: Case, *, realizations, interpolate_states: bool, spectral_check: 
     gL = case.g_yp * system.eq17_lengths if system.is_section else case.g_yp_L  # Eq. 17 per tower (issue 17)
     j = case.line.tower_of_interest - 1
     still_air = system.to_tower_frames(mean.still_air.reactions)
-    towers = slice(None)  # the towers whose reactions steps 2-3 compute
-    scale = None  # the statistics' max |M| (defined gust factors): the whole section's
-    if tower_only:  # the tower of interest's reactions alone (each is a sum of its own: same bits)
-        scale = max(float(np.abs(M[keep]).max()), 1e-300)
-        towers = slice(j, j + 1)
-        M, still_air = M[:, towers], still_air[towers]
-        gL = gL[towers] if np.ndim(gL) else gL
-    jr = j - (towers.start or 0)  # the tower of interest in the computed reactions
     vn, vl, a_turb = record_wind(case, st, t)  # a_turb: the turbulence's I V_m(x, t), shared by the chunks
     second = None
     if case.analysis.tension == "second-order":
         from .core.second_order import second_order_operator
 
         second = [second_order_operator(m, mean.state(k)) for k, m in enumerate(models)]
-    if tower_only:  # the tower of interest's rows of G (and columns of the second-order forms)
-        rows = slice(3 * j, 3 * j + 3)
-        models = [dataclasses.replace(m, G=m.G[rows]) for m in models]
-        if second is not None:
+    towers = slice(None)  # the towers whose reactions steps 2-3 compute
+    scale = None  # the statistics' max |M| (defined gust factors): the whole section's
+    if tower_only:  # the tower of interest's reactions alone (each is a sum of its own: same bits)
+        scale = max(float(np.abs(M[keep]).max()), 1e-300)
+        towers, rows = slice(j, j + 1), slice(3 * j, 3 * j + 3)
+        M, still_air = M[:, towers], still_air[towers]
+        gL = gL[towers] if np.ndim(gL) else gL
+        models = [dataclasses.replace(m, G=m.G[rows]) for m in models]  # its rows of G
+        if second is not None:  # and columns of the second-order forms
             second = [dataclasses.replace(so, A=np.ascontiguousarray(so.A[:, rows]),
                                           W=np.ascontiguousarray(so.W[:, rows])) for so in second]
     load_dirs = None if system.straight_in_plan else system.node_normals[models[0].dofs.free_nodes]
@@ -891,6 +888,7 @@ def _run(case: Case, *, realizations, interpolate_states: bool, spectral_check: 
                                system.to_tower_frames(resp.background, towers))
         Bk, Rk = resp.background[:, keep], resp.resonant[:, keep]
         del resp
+        jr = 0 if tower_only else j  # the tower of interest among the computed reactions
         return (compute_statistics(M_keep, Bk, Rk, still_air, gL, window=window, scale=scale),
                 Bk[:, :, jr, :].copy(), Rk[:, :, jr, :].copy())
 

@@ -29,7 +29,7 @@ from scipy.linalg import lapack
 
 from . import kernel
 from .errors import Cancelled, NumericalError
-from .model import CSRArrays, LinearModel, band_blocks, band_to_csr, band_to_csr_stack, rotate_band
+from .model import CSRArrays, LinearModel, band_blocks, band_to_csr_stack, rotate_band
 
 _dpbtrf = lapack.dpbtrf
 _dpbtrs = lapack.dpbtrs
@@ -481,50 +481,23 @@ class _Stepper:
     def from_bases(model: LinearModel, T: np.ndarray, Kr: np.ndarray, Cr: np.ndarray, nm: Newmark,
                    load_dirs: np.ndarray | None = None) -> "_Stepper":
         """The operator from the node bases T (n_nodes, 3, 3) and the rotated stiffness and
-        damping bands K~ = T^T K T, C~ = T^T C T (:func:`_rotated_stack` for many states)."""
-        axial = model.axial_dof + 2  # (t1, t2, a): the axis is the third local coordinate
-        dm = model.mass.copy()
-        dm[axial] = 0.0  # rigid insulator: no inertia along its axis (model.M_band)
-        dc = Cr[-1].copy()
-        dc[axial] = 0.0  # nor damping (project_axial)
-        off = Cr.copy()
-        off[-1] = 0.0
-        scale = float(np.abs(dc).max()) if dc.size else 0.0
-        if np.abs(off).max() <= 1e-12 * scale:  # only rounding of the rotation
-            off[:] = 0.0
-            rest = None
-        else:
-            rest = band_to_csr(off)
-        used = off.copy()
-        used[-1] = dc
-        chat = _factor(Kr, nm.a0 * dm, "effective stiffness", band_add=nm.a1 * used)
-        # G T node by node, only over the nodes G touches (a few per tower): the same einsum on
-        # those nodes, so bit-identical to the full product (whose other columns are zero)
-        G3 = model.G.reshape(model.G.shape[0], -1, 3)
-        touched = np.flatnonzero(np.any(G3 != 0.0, axis=(0, 2)))
-        Gr = np.zeros(G3.shape)
-        Gr[:, touched] = np.einsum("rna,naj->rnj", G3[:, touched], T[touched])
-        Gr = Gr.reshape(model.G.shape)
-        nz, GT, cols = _sparse_rows(Gr)
-        return _Stepper(T, chat, dm, nm.a0 * dm + nm.a1 * dc, nm.a2 * dm + dc, rest, nm.a1, 2.0 / nm.dt,
-                        np.ascontiguousarray(T[:, 1, :] if load_dirs is None else np.einsum("naj,na->nj", T, load_dirs)),
-                        axial, nz, GT, cols)
+        damping bands K~ = T^T K T, C~ = T^T C T (:meth:`stack` of one state)."""
+        return _Stepper.stack([model], T[None], Kr[None], Cr[None], nm, load_dirs)[0]
 
     @staticmethod
     def stack(models: list[LinearModel], T: np.ndarray, Kr: np.ndarray, Cr: np.ndarray, nm: Newmark,
               load_dirs: np.ndarray | None = None) -> list["_Stepper"]:
-        """:meth:`from_bases` of many mean states of one system (T, Kr, Cr of
-        :func:`_rotated_stack`, each with a leading axis of n_k) in vectorised passes (issue 20:
-        ≈ 0.7 ms per state built one by one, 250 states in a downburst run): the same arithmetic
-        on stacked arrays, one ``dpbtrf`` per state; bit-identical (tested).  Where the states'
-        sparsity patterns (reaction coordinates, touched nodes) differ, each state is built by
-        :meth:`from_bases`."""
+        """The operators of many mean states of one system from their node bases T and rotated
+        bands K~, C~ (:func:`_rotated_stack`, each with a leading axis of n_k), in vectorised passes
+        over the states (issue 20: ≈ 0.7 ms per state built one by one, 250 states in a downburst
+        run) and one ``dpbtrf`` per state; elementwise along the states, so a state's operator
+        does not depend on the others (tested)."""
         n_k = len(models)
-        axial = models[0].axial_dof + 2
+        axial = models[0].axial_dof + 2  # (t1, t2, a): the axis is the third local coordinate
         dm = np.stack([m.mass for m in models])
-        dm[:, axial] = 0.0
+        dm[:, axial] = 0.0  # rigid insulator: no inertia along its axis (model.M_band)
         dc = Cr[:, -1].copy()
-        dc[:, axial] = 0.0
+        dc[:, axial] = 0.0  # nor damping (project_axial)
         off = Cr.copy()
         off[:, -1] = 0.0
         scale = np.abs(dc).max(axis=1) if dc.shape[1] else np.zeros(n_k)
@@ -533,39 +506,25 @@ class _Stepper:
         rests = band_to_csr_stack(off)
         used = off.copy()
         used[:, -1] = dc
-        ab = Kr + nm.a1 * used  # as _factor(Kr, a0 dm, band_add=a1 used)
-        ab[:, -1] += nm.a0 * dm
-        G = np.stack([m.G for m in models])
-        G3 = G.reshape(n_k, G.shape[1], -1, 3)
-        hit = np.any(G3 != 0.0, axis=(1, 3))  # (n_k, n_nodes)
-        if not (hit == hit[:1]).all():
-            return [_Stepper.from_bases(m, T[k], Kr[k], Cr[k], nm, load_dirs) for k, m in enumerate(models)]
-        touched = np.flatnonzero(hit[0])
+        # G T node by node, only over the nodes G touches (a few per tower): the same einsum on
+        # those nodes, so bit-identical to the full product (whose other columns are zero)
+        G3 = np.stack([m.G for m in models]).reshape(n_k, models[0].G.shape[0], -1, 3)
         Gr = np.zeros(G3.shape)
-        for k in range(n_k):  # the einsum of from_bases, state by state (its bits)
+        for k in range(n_k):
+            touched = np.flatnonzero(np.any(G3[k] != 0.0, axis=(0, 2)))
             Gr[k][:, touched] = np.einsum("rna,naj->rnj", G3[k][:, touched], T[k][touched])
-        Gr = Gr.reshape(G.shape)
-        on_nz = np.any(Gr != 0.0, axis=1)  # (n_k, n_dof)
-        if not (on_nz == on_nz[:1]).all():
-            return [_Stepper.from_bases(m, T[k], Kr[k], Cr[k], nm, load_dirs) for k, m in enumerate(models)]
-        nz = np.flatnonzero(on_nz[0])
-        GT = np.ascontiguousarray(Gr.transpose(0, 2, 1)[:, nz])  # (n_k, n_nz, n_r)
-        on = GT != 0.0
-        c0 = np.argmax(on, axis=2)
-        c1 = GT.shape[2] - np.argmax(on[:, :, ::-1], axis=2)
-        cols = np.stack([c0, c1], axis=2)
-        ycoef = (np.ascontiguousarray(T[:, :, 1, :]) if load_dirs is None else  # from_bases' einsum per state
+        Gr = Gr.reshape(n_k, G3.shape[1], -1)
+        rows = _sparse_rows_stack(Gr)
+        rows_of = ((lambda k: (rows[0], rows[1][k], rows[2][k])) if rows is not None
+                   else (lambda k: _sparse_rows(Gr[k])))  # the states' reaction coordinates differ
+        ycoef = (np.ascontiguousarray(T[:, :, 1, :]) if load_dirs is None else
                  np.stack([np.einsum("naj,na->nj", T[k], load_dirs) for k in range(n_k)]))
         cu = nm.a0 * dm + nm.a1 * dc
         cv = nm.a2 * dm + dc
-        out = []
-        for k in range(n_k):
-            c, info = _dpbtrf(ab[k], lower=0, overwrite_ab=1)
-            if info != 0:
-                raise NumericalError(f"effective stiffness: matrix is not positive definite (LAPACK dpbtrf info {info})")
-            out.append(_Stepper(T[k], c, dm[k], cu[k], cv[k], None if small[k] else rests[k], nm.a1, 2.0 / nm.dt,
-                                ycoef[k], axial, nz, GT[k], cols[k]))
-        return out
+        return [_Stepper(T[k], _factor(Kr[k], nm.a0 * dm[k], "effective stiffness", band_add=nm.a1 * used[k]),
+                         dm[k], cu[k], cv[k], None if small[k] else rests[k], nm.a1, 2.0 / nm.dt, ycoef[k],
+                         axial, *rows_of(k))
+                for k in range(n_k)]
 
     def reactions(self, U: np.ndarray) -> np.ndarray:
         """[N] G u for rotated vectors U (..., n_dof) -> (..., n_r) (:func:`_sparse_reactions`)."""
@@ -607,12 +566,22 @@ def _sparse_rows(G: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The coordinates a reaction map G (n_r, n_dof) touches, (n_nz,); its rows there, G^T
     (n_nz, n_r); and per such row the column range [c0, c1) of its non-zeros (the reactions of
     the tower(s) next to that coordinate), (n_nz, 2)."""
-    nz = np.flatnonzero(np.any(G != 0.0, axis=0))
-    GT = np.ascontiguousarray(G.T[nz])
+    nz, GT, cols = _sparse_rows_stack(G[None])
+    return nz, GT[0], cols[0]
+
+
+def _sparse_rows_stack(G: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """:func:`_sparse_rows` of the reaction maps G (n_k, n_r, n_dof) of states that touch the same
+    coordinates: (nz, GT (n_k, n_nz, n_r), cols (n_k, n_nz, 2)); None where their coordinates differ."""
+    on_nz = np.any(G != 0.0, axis=1)  # (n_k, n_dof)
+    if not (on_nz == on_nz[:1]).all():
+        return None
+    nz = np.flatnonzero(on_nz[0])
+    GT = np.ascontiguousarray(G.transpose(0, 2, 1)[:, nz])
     on = GT != 0.0
-    c0 = np.argmax(on, axis=1)
-    c1 = GT.shape[1] - np.argmax(on[:, ::-1], axis=1)
-    return nz, GT, np.stack([c0, c1], axis=1)
+    c0 = np.argmax(on, axis=2)
+    c1 = GT.shape[2] - np.argmax(on[:, :, ::-1], axis=2)
+    return nz, GT, np.stack([c0, c1], axis=2)
 
 
 def _sparse_reactions(U: np.ndarray, nz: np.ndarray, GT: np.ndarray, cols: np.ndarray) -> np.ndarray:

@@ -146,28 +146,19 @@ def band_to_csr(ab: np.ndarray) -> CSRArrays:
     """Upper banded storage (LAPACK 'U', ab[u + i - j, j] = A[i, j]) of a symmetric matrix to
     its CSR arrays: those of scipy's ``dia_matrix(...).tocsr()`` (explicit zeros dropped, each
     row's columns ascending, int32 indices), gathered in one vectorised pass (issue 20; the same
-    arrays, tested)."""
-    u, n = ab.shape[0] - 1, ab.shape[1]
+    arrays, tested; :func:`band_to_csr_stack` of one matrix)."""
+    return band_to_csr_stack(ab[None])[0]
+
+
+def band_to_csr_stack(ab: np.ndarray) -> list[CSRArrays]:
+    """:func:`band_to_csr` of many band matrices of one size, shape (n_k, u + 1, n), in one
+    vectorised pass (issue 20: a downburst's 250 mean states)."""
+    n_k, u, n = ab.shape[0], ab.shape[1] - 1, ab.shape[2]
     offs = np.arange(-u, u + 1)
     rows = np.arange(n)[:, None]
     cols = rows + offs  # (n, 2u + 1): row i's possible columns, ascending
     inside = (cols >= 0) & (cols < n)
     # A[i, i + k] = ab[u - k, i + k] (k >= 0) and A[i, i + k] = A[i + k, i] = ab[u + k, i] (k < 0)
-    vals = np.where(inside, ab[u - np.abs(offs), np.clip(np.where(offs >= 0, cols, rows), 0, n - 1)], 0.0)
-    keep = vals != 0.0
-    indptr = np.zeros(n + 1, dtype=np.int32)
-    np.cumsum(keep.sum(axis=1), out=indptr[1:])
-    return CSRArrays(indptr, cols[keep].astype(np.int32), vals[keep], (n, n))
-
-
-def band_to_csr_stack(ab: np.ndarray) -> list[CSRArrays]:
-    """:func:`band_to_csr` of many band matrices of one size, shape (n_k, u + 1, n), gathered in
-    one vectorised pass (issue 20: a downburst's 250 mean states); the same arrays."""
-    n_k, u, n = ab.shape[0], ab.shape[1] - 1, ab.shape[2]
-    offs = np.arange(-u, u + 1)
-    rows = np.arange(n)[:, None]
-    cols = rows + offs
-    inside = (cols >= 0) & (cols < n)
     vals = np.where(inside, ab[:, u - np.abs(offs), np.clip(np.where(offs >= 0, cols, rows), 0, n - 1)], 0.0)
     keep = vals != 0.0  # (n_k, n, 2u + 1)
     indptr = np.zeros((n_k, n + 1), dtype=np.int32)

@@ -178,8 +178,8 @@ def test_band_to_sparse_gives_scipys_csr_arrays(n, u):
 
 
 def test_stacked_steppers_where_the_sparsity_patterns_differ(downburst_six):
-    """_Stepper.stack builds each state by from_bases when the states' reaction maps touch
-    different coordinates (here one state's G with a node's columns set to exact zeros): the
+    """_Stepper.stack takes each state's sparse reaction rows by itself when the states' reaction
+    maps touch different coordinates (here one state's G with a node's columns set to exact zeros): the
     same operators as state by state, each with its own reaction coordinates."""
     import dataclasses
 

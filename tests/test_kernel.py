@@ -71,6 +71,61 @@ def test_banded_solve_is_lapack_dpbtrs_bit_for_bit(m):
 
 
 @needs_kernel
+@pytest.mark.parametrize("n", [3, 6, 47])
+def test_one_vector_solve_is_lapack_dpbtrs_bit_for_bit(n):
+    """The one-realization solve (the five unknowns a row reads held in registers from row 5 on;
+    shorter systems take the general loop) against dpbtrs itself, right-hand sides over twelve
+    decades."""
+    from linecheck.core import _loops
+
+    rng = np.random.default_rng(n)
+    kd = BANDWIDTH
+    ab = np.zeros((kd + 1, n))
+    for off in range(1, kd + 1):
+        ab[kd - off, off:] = rng.uniform(-1.0, 1.0, max(n - off, 0))
+    ab[kd] = 2.0 * kd + rng.uniform(0.0, 1.0, n)
+    c, info = lapack.dpbtrf(ab, lower=0)
+    assert info == 0
+    for scale in 10.0 ** np.arange(-6, 7, 3):
+        b = rng.standard_normal(n) * scale
+        ref, info = lapack.dpbtrs(c, b, lower=0)
+        got = b.copy()
+        _loops.band_solve_1(c, got)
+        assert info == 0 and np.array_equal(got, ref)
+
+
+@needs_kernel
+def test_structural_damping_remainder_by_diagonals_is_the_csr_product():
+    """The compiled C~_off w by diagonals (``rest_product``) against scipy's CSR product of the
+    same stepper's remainder (the numpy loop's ``csr_matvecs``), bit for bit, for one vector and
+    four lanes; and ``rest_band`` rebuilds the diagonals from CSR arrays that lack them."""
+    from linecheck.core import _loops
+    from linecheck.core.dynamics import _Stepper, Newmark
+    from linecheck.core.model import CSRArrays
+
+    case = _short(CASES / "paper" / "case09-six.toml", damping="quasi-steady")
+    st = service._static_analysis(case)
+    model = service.build_model(st.system, st.mean.state(0))
+    damping = service.damping_matrices(case, st, [model])[0]
+    stepper = _Stepper.build(model, damping, Newmark(case.analysis.time_step))
+    rest = stepper.rest
+    assert rest is not None and rest.data.size > 0
+    band = kernel.rest_band(rest)
+    bare = kernel.rest_band(CSRArrays(rest.indptr, rest.indices, rest.data, rest.shape))
+    assert band is rest.band and np.array_equal(bare, band)
+    rng = np.random.default_rng(7)
+    n = rest.shape[0]
+    for L in (1, 4):
+        W = rng.standard_normal((L, n)) * 1e-3
+        W[:, ::7] = 0.0  # rows of zeros as at the start of a record
+        t = np.empty((L, n))
+        _loops.rest_product(band, np.pad(W, ((0, 0), (BANDWIDTH, BANDWIDTH))), t)
+        ref = rest.tocsr() @ W.T
+        assert np.array_equal(t.T, ref) and np.array_equal(np.signbit(t.T), np.signbit(ref))
+        assert np.abs(ref).max() > 0
+
+
+@needs_kernel
 @pytest.mark.parametrize("reals", [[3], [0, 1, 2, 3, 4]])
 def test_synoptic_with_structural_damping_same_bits(monkeypatch, reals):
     """Quasi-steady damping with structural damping: the inter-node remainder C~_off is used

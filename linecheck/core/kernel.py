@@ -23,7 +23,9 @@ section cases):
 - the right-hand side ((cu u + cv v) + dm a) + F (+ C~_off (a1 u + v)), each product and sum
   rounded separately as numpy's ufuncs round them (no fused multiply-add: compiled without
   ``contract``); F = load × ycoef as numpy forms it; the structural-damping remainder summed
-  row by row from 0 in CSR order, as scipy's ``csr_matvecs`` sums it;
+  row by row from 0 over the columns ascending, as scipy's ``csr_matvecs`` sums the CSR row
+  (the compiled loop runs the rows side by side, by diagonals, :func:`_loops.rest_product`:
+  its extra terms are products with exact zeros, which leave the sums' bits unchanged);
 - the banded Cholesky solve U^T U x = b (upper band storage, LAPACK ``dpbtrs``: two
   ``dtbsv`` calls per right-hand side) with the operation order of OpenBLAS's ``dtbsv`` —
   the transposed solve as a dot product of the (at most BANDWIDTH) earlier unknowns
@@ -51,8 +53,7 @@ import numpy as np
 
 _lock = threading.Lock()
 _state: dict[str, object] = {}
-_NO_INDEX = np.zeros(1, dtype=np.int32)  # the CSR arguments of a stepper without a remainder
-_NO_DATA = np.zeros(1)
+_NO_BAND = np.zeros((1, 1))  # the remainder argument of a stepper without one
 
 
 def _compile():
@@ -65,26 +66,43 @@ def _compile():
     return _loops
 
 
-def _self_test(band_solve) -> bool:
-    """The compiled banded solve gives dpbtrs's bits on a system of the size the core uses."""
+def _self_test(fns) -> bool:
+    """The compiled banded solves give dpbtrs's bits on systems of the sizes the core uses (four
+    lanes; one vector, with the registers of the half-bandwidth 5 and the general loop of a short
+    system), and the remainder by diagonals scipy's CSR product's bits."""
     from scipy.linalg import lapack
 
-    from .model import BANDWIDTH
+    from .model import BANDWIDTH, band_to_csr
 
     rng = np.random.default_rng(20)
-    n, kd = 60, BANDWIDTH
-    ab = np.zeros((kd + 1, n))
-    for off in range(kd + 1):
-        ab[kd - off, off:] = rng.uniform(-1.0, 1.0, n - off)
-    ab[kd] = 4.0 * (kd + 1) + rng.uniform(0.0, 1.0, n)
-    c, info = lapack.dpbtrf(ab, lower=0)
-    if info != 0:  # pragma: no cover - diagonally dominant by construction
-        return False
-    B = rng.standard_normal((4, n))
-    ref, info = lapack.dpbtrs(c, np.asfortranarray(B.T), lower=0)
-    X = np.ascontiguousarray(B.T)[None]  # one group of four lanes
-    band_solve(c, X)
-    return info == 0 and bool(np.array_equal(X[0], ref))
+    ok = True
+    for n in (60, 4):
+        kd = BANDWIDTH
+        ab = np.zeros((kd + 1, n))
+        for off in range(kd + 1):
+            ab[kd - off, off:] = rng.uniform(-1.0, 1.0, max(n - off, 0))
+        ab[kd] = 4.0 * (kd + 1) + rng.uniform(0.0, 1.0, n)
+        c, info = lapack.dpbtrf(ab, lower=0)
+        if info != 0:  # pragma: no cover - diagonally dominant by construction
+            return False
+        B = rng.standard_normal((4, n))
+        ref, info = lapack.dpbtrs(c, np.asfortranarray(B.T), lower=0)
+        ok &= info == 0
+        X = np.ascontiguousarray(B.T)[None]  # one group of four lanes
+        fns.band_solve(c, X)
+        ok &= bool(np.array_equal(X[0], ref))
+        for q in range(4):
+            x = B[q].copy()
+            fns.band_solve_1(c, x)
+            ok &= bool(np.array_equal(x, ref[:, q]))
+        ab[kd] = 0.0  # an off-diagonal remainder, with some exact zeros
+        ab[rng.random(ab.shape) < 0.2] = 0.0
+        rest = band_to_csr(ab)
+        W = rng.standard_normal((4, n))
+        t = np.empty((4, n))
+        fns.rest_product(rest.band, np.pad(W, ((0, 0), (kd, kd))), t)
+        ok &= bool(np.array_equal(t.T, rest.tocsr() @ W.T))
+    return ok
 
 
 #: loading Numba and the cached kernel costs ≈ 0.6 s once per process; below this much work
@@ -365,7 +383,7 @@ def available() -> bool:
         if "ok" not in _state:
             try:
                 fns = _compile()
-                ok = fns is not None and _self_test(fns.band_solve)
+                ok = fns is not None and _self_test(fns)
                 rot = ok and _rotate_test(fns.rotate)
                 dot = ok and _rowdot_test(fns.rowdot)
             except Exception:  # a Numba that cannot compile or cache here: the numpy loop (same bits)
@@ -404,10 +422,25 @@ def newmark_block(U: np.ndarray, V: np.ndarray, A: np.ndarray, loads: np.ndarray
     fns = _state["fns"]
     steps = fns.steps_1 if U.shape[0] == 1 else fns.steps
     if rest is None:
-        steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, False, _NO_INDEX, _NO_INDEX, _NO_DATA, a1, out, nz, GT,
-              cols, R)
+        steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, False, _NO_BAND, a1, out, nz, GT, cols, R)
     else:
-        steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, True, rest.indptr, rest.indices, rest.data, a1, out, nz, GT, cols, R)
+        steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, True, rest_band(rest), a1, out, nz, GT, cols, R)
+
+
+def rest_band(rest) -> np.ndarray:
+    """The structural-damping remainder ``rest`` (CSR arrays) by its diagonals, (2 u + 1, n):
+    ``rest.band`` (:func:`~linecheck.core.model.band_to_csr_stack`), else gathered from the CSR
+    arrays (band[o, i] = C[i, i + o - BANDWIDTH])."""
+    band = getattr(rest, "band", None)
+    if band is not None:
+        return band
+    from .model import BANDWIDTH
+
+    n = rest.shape[0]
+    rows = np.repeat(np.arange(n), np.diff(rest.indptr))
+    band = np.zeros((2 * BANDWIDTH + 1, n))
+    band[rest.indices - rows + BANDWIDTH, rows] = rest.data
+    return band
 
 
 def background(c: np.ndarray, L: np.ndarray, load_dirs: np.ndarray | None, sparse_g) -> np.ndarray:

@@ -24,7 +24,7 @@ directly at pinned nodes: R = G u + D f_pinned.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from collections.abc import Sequence
 from functools import cached_property
 
@@ -131,6 +131,9 @@ class CSRArrays:
     indices: np.ndarray  # int32, (nnz,): each row's columns ascending
     data: np.ndarray  # (nnz,)
     shape: tuple[int, int]
+    #: the same matrix by diagonals, (2 u + 1, n): band[o, i] = A[i, i + o - u], zero outside the
+    #: matrix (what the compiled step loop reads, kernel.newmark_block)
+    band: np.ndarray | None = field(default=None, compare=False, repr=False)
     format = "csr"
 
     def tocsr(self):
@@ -163,7 +166,8 @@ def band_to_csr_stack(ab: np.ndarray) -> list[CSRArrays]:
     keep = vals != 0.0  # (n_k, n, 2u + 1)
     indptr = np.zeros((n_k, n + 1), dtype=np.int32)
     np.cumsum(keep.sum(axis=2), axis=1, out=indptr[:, 1:])
-    return [CSRArrays(indptr[k], cols[keep[k]].astype(np.int32), vals[k][keep[k]], (n, n)) for k in range(n_k)]
+    band = np.ascontiguousarray(vals.transpose(0, 2, 1))  # (n_k, 2u + 1, n): by diagonals
+    return [CSRArrays(indptr[k], cols[keep[k]].astype(np.int32), vals[k][keep[k]], (n, n), band[k]) for k in range(n_k)]
 
 
 def band_to_sparse(ab: np.ndarray):

@@ -126,6 +126,27 @@ def test_structural_damping_remainder_by_diagonals_is_the_csr_product():
 
 
 @needs_kernel
+@pytest.mark.parametrize("name", ["case05-six", "case07-six"])
+def test_downburst_field_same_bits(monkeypatch, name):
+    """The analytic downburst field compiled (kernel.field_velocity) against its numpy form on a
+    paper case's record grid and line points, bit for bit; the field is really evaluated (the
+    outflow passes the line) and the compiled form really ran."""
+    from linecheck.core.wind import mean as wm
+
+    monkeypatch.setenv("LINECHECK_KERNEL", "numba")
+    case = load_case(CASES / "paper" / f"{name}.toml")
+    field = wm.downburst_field(case)
+    st = service._static_analysis(case)
+    x = np.unique(np.concatenate([wm.span_node_x(st.system).ravel(), st.system.node_x0]))
+    t = service.record_time(case)
+    got = kernel.field_velocity(field, x, t)
+    ref = field.velocity_numpy(x, t)
+    assert got is not None
+    assert all(np.array_equal(a, b) for a, b in zip(got, ref))
+    assert np.hypot(*ref).max() > 0.9 * case.wind.v_ref
+
+
+@needs_kernel
 @pytest.mark.parametrize("reals", [[3], [0, 1, 2, 3, 4]])
 def test_synoptic_with_structural_damping_same_bits(monkeypatch, reals):
     """Quasi-steady damping with structural damping: the inter-node remainder C~_off is used

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "drag_loads", "from_lanes", "history_reductions", "phasors", "reactions_into",
+__all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "drag_loads", "field_radius", "field_velocity", "from_lanes", "history_reductions", "phasors", "reactions_into",
            "rest_product", "rotate", "rowdot", "solve_columns", "span_terms", "steps", "steps_1", "to_lanes"]
 
 
@@ -514,3 +514,39 @@ def history_reductions(M, B, R, sa, out):  # pragma: no cover - compiled
             for k in range(nt):
                 for c in range(nc):
                     out[q, i, k, c] = np.sqrt(out[q, i, k, c] / T)
+
+
+@numba.njit(cache=True, nogil=True)
+def field_radius(x, cx, cy, r_max, decay, r, z):  # pragma: no cover - compiled
+    """First pass of DownburstField.velocity (Holmes & Oliver 2000) with numpy's bits: per instant
+    t and line point x, r = hypot(x - cx, 0 - cy) and the Gaussian's exponent
+    z = -(((r - r_max)/decay)^2) (numpy then takes exp(z) on the whole array, as it does now).
+    x (n_x,); cx, cy (n_t,); r, z (n_t, n_x)."""
+    for t in range(cx.size):
+        dy = 0.0 - cy[t]
+        for i in range(x.size):
+            dx = x[i] - cx[t]
+            rr = np.hypot(dx, dy)
+            r[t, i] = rr
+            q = (rr - r_max) / decay
+            z[t, i] = -(q * q)
+
+
+@numba.njit(cache=True, nogil=True)
+def field_velocity(x, cx, cy, r, e, r_max, fz, pi, v_max, tx, ty, vx, vy):  # pragma: no cover - compiled
+    """Second pass: f_r = r/r_max inside r_max else e (= exp(z)), speed = v_max ((f_r f_z) Pi(t)),
+    v = speed d/r + translation (0 + translation at r = 0), with numpy's bits."""
+    for t in range(cx.size):
+        dy = 0.0 - cy[t]
+        p = pi[t]
+        for i in range(x.size):
+            rr = r[t, i]
+            fr = rr / r_max if rr <= r_max else e[t, i]
+            speed = v_max * ((fr * fz) * p)
+            if rr > 0.0:
+                dx = x[i] - cx[t]
+                vx[t, i] = (speed * dx) / rr + tx
+                vy[t, i] = (speed * dy) / rr + ty
+            else:
+                vx[t, i] = 0.0 + tx
+                vy[t, i] = 0.0 + ty

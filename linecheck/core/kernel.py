@@ -264,6 +264,49 @@ def drag_loads(pv: np.ndarray, pq: np.ndarray | None, s2: np.ndarray | None, v: 
     return False
 
 
+def _field_test(fns) -> bool:
+    """The compiled analytic downburst field gives :meth:`DownburstField.velocity`'s numpy bits
+    (points inside and outside r_max, at the centre, before and after the peak of Pi(t))."""
+    from .wind.mean import DownburstField
+
+    field = DownburstField(jet_diameter=600.0, height=15.0, centre=(450.0, -700.0), t_ref=300.0,
+                           translation=(3.0, 8.0), v_max=41.3, point_p=450.0, window=(0.0, 600.0),
+                           r_max=780.0, radial_decay=430.0, z_max=50.0, delta=272.0, t1=300.0, t_f=1200.0)
+    x = np.concatenate([np.linspace(0.0, 1800.0, 37), [712.5]])
+    t = np.concatenate([np.linspace(0.0, 900.0, 41), [387.5]])  # the centre crosses the line at x = 712.5
+    ref = field.velocity_numpy(x, t)
+    got = field_velocity(field, x, t, fns)
+    return got is not None and all(np.array_equal(a, b) for a, b in zip(ref, got))
+
+
+def field_velocity(field, x: np.ndarray, t: np.ndarray, fns=None) -> tuple[np.ndarray, np.ndarray] | None:
+    """:meth:`~linecheck.core.wind.mean.DownburstField.velocity` of the analytic field (Holmes &
+    Oliver 2000 radial profile, Wood et al. 2001 height factor, Chay et al. 2006 Pi(t)) in two
+    compiled passes with the same bits: r and the Gaussian's exponent, numpy's exp on the whole
+    array (as the numpy form takes it), then the profile, the speed and the vector sum with the
+    translation.  None when the kernel is not loaded or did not give the numpy bits at load.
+    x [m] (n_x,), t [s] (n_t,) -> (v_x, v_y) [m/s], each (n_t, n_x)."""
+    if fns is None:
+        if not (use(0.0) and _state.get("field")):
+            return None
+        fns = _state["fns"]
+    from .wind.mean import intensity, vertical_profile
+
+    x = np.ascontiguousarray(x, dtype=float)
+    t = np.ascontiguousarray(t, dtype=float)
+    cx, cy = (np.ascontiguousarray(np.broadcast_to(c, t.shape), dtype=float) for c in field.centre_at(t))
+    r = np.empty((t.size, x.size))
+    z = np.empty_like(r)
+    fns.field_radius(x, cx, cy, float(field.r_max), float(field.radial_decay), r, z)
+    e = np.exp(z, out=z)
+    fz = float(vertical_profile(field.height, field.delta))
+    pi = np.ascontiguousarray(intensity(t, field.t1, field.t_f), dtype=float)
+    vx, vy = np.empty_like(r), np.empty_like(r)
+    fns.field_velocity(x, cx, cy, r, e, float(field.r_max), fz, pi, float(field.v_max),
+                       float(field.translation[0]), float(field.translation[1]), vx, vy)
+    return vx, vy
+
+
 def _span_test(fn) -> bool:
     """The compiled span-tension integrands give :func:`~linecheck.core.static.span_terms`'
     bits (one and several states, with and without e)."""
@@ -396,6 +439,7 @@ def available() -> bool:
             _state["loads"] = ok and _loads_test(fns.drag_loads)
             _state["span"] = ok and _span_test(fns.span_terms)
             _state["reductions"] = ok and _reductions_test(fns.history_reductions)
+            _state["field"] = ok and _field_test(fns)
         return bool(_state["ok"])
 
 

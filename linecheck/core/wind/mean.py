@@ -554,6 +554,16 @@ class DownburstField:
         x shape (n_x,), t shape (n_t,) -> two arrays of shape (n_t, n_x).  Radial outflow
         plus the translation velocity (vector sum, Holmes & Oliver 2000).
         """
+        if self.ring is None and self.table is None:  # the analytic field compiled, same bits (issue 20)
+            from .. import kernel
+
+            fast = kernel.field_velocity(self, np.asarray(x, dtype=float).ravel(), np.asarray(t, dtype=float).ravel())
+            if fast is not None:
+                return fast
+        return self.velocity_numpy(x, t)
+
+    def velocity_numpy(self, x: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`velocity` in numpy (what the compiled form reproduces bit for bit)."""
         x = np.asarray(x, dtype=float)[None, :]
         t = np.asarray(t, dtype=float)[:, None]
         cx, cy = self.centre_at(t)
@@ -1008,7 +1018,10 @@ def equal_span_downburst_both(case: Case, system: LineSystem,
     vx, vy = _equal_span_downburst(case, downburst_field(case), xu, time)
     span, node = inv[:xs.size], inv[xs.size:]
     shape = (time.size, system.n_spans, system.ne + 1)
-    return vx[:, span].reshape(shape), vy[:, span].reshape(shape), vx[:, node], vy[:, node]
+    # np.take along the columns copies the same values as vx[:, span], 3-5x faster (≈ 35 ms of a
+    # six-span downburst realization's four (12,001 x 64) gathers, issue 20)
+    return (np.take(vx, span, axis=1).reshape(shape), np.take(vy, span, axis=1).reshape(shape),
+            np.take(vx, node, axis=1), np.take(vy, node, axis=1))
 
 
 def mean_wind(case: Case, system: LineSystem, times: np.ndarray | None = None) -> MeanWind:

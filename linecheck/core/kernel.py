@@ -6,9 +6,10 @@ realization) to ≈ 60 µs (ten) per step of mostly call overhead.  With the opt
 ``linecheck[fast]`` (Numba) the same recurrence runs here as one compiled loop over the steps
 of a block (:func:`newmark_block`), together with the reactions G u of every step, the change
 of node bases between mean states (:func:`rotate`), step 3's static transfer (:func:`rowdot`)
-and a long line's step 3 (:func:`background`, :func:`solve_columns`), and before the steps the
-wind synthesis' phasors and coherence recursion (:func:`coherent_spectrum`) and the fluctuating drag
-(:func:`drag_loads`), in step 1 the span tension's Newton integrands (:func:`span_terms`: a
+and a long line's step 3 (:func:`background`, :func:`solve_columns`; also each downburst mean
+state's K^-1 G^T), and before the steps the wind synthesis' phasors and coherence recursion
+(:func:`coherent_spectrum`), the analytic downburst field over the record (:func:`field_velocity`)
+and the fluctuating drag (:func:`drag_loads`), in step 1 the span tension's Newton integrands (:func:`span_terms`: a
 downburst's 250 mean states at once, their sums over the Gauss points left to numpy's
 ``matmul``, so the same BLAS sums them), and after the steps the statistics' r.m.s. values and
 peaks over time (:func:`history_reductions`: numpy sums along the time axis one sample after the

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "drag_loads", "field_radius", "field_velocity", "from_lanes", "history_reductions", "phasors", "reactions_into",
+__all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "drag_loads", "field_radius", "field_velocity", "from_lanes", "history_reductions", "phasors", "quad_kms", "reactions_into",
            "rest_product", "rotate", "rowdot", "solve_columns", "span_terms", "steps", "steps_1", "to_lanes"]
 
 
@@ -550,3 +550,39 @@ def field_velocity(x, cx, cy, r, e, r_max, fz, pi, v_max, tx, ty, vx, vy):  # pr
             else:
                 vx[t, i] = 0.0 + tx
                 vy[t, i] = 0.0 + ty
+
+
+@numba.njit(cache=True, nogil=True)
+def quad_kms(w, rho, gap, out):  # pragma: no cover - compiled
+    """spectral._quad_kms_nodes with numpy's bits: w (K, N, F) complex, rho (F,) (``gap`` False)
+    or per gap (N - 1, F); out (K, F) = sum_i |w_i|^2 (summed over the nodes one after the other,
+    as numpy reduces a non-contiguous axis) + 2 sum_j Re(conj(w_j) h_j), h_j = (h_{j-1} + w_{j-1})
+    rho_j, the complex-times-real product written as numpy forms it, (a c - b 0, a 0 + b c)."""
+    K, N, F = w.shape
+    hr = np.empty(F)
+    hi = np.empty(F)
+    cr = np.empty(F)
+    for k in range(K):
+        for f in range(F):
+            x = w[k, 0, f]
+            out[k, f] = x.real * x.real + x.imag * x.imag
+        for j in range(1, N):
+            for f in range(F):
+                x = w[k, j, f]
+                out[k, f] += x.real * x.real + x.imag * x.imag
+        hr[:] = 0.0
+        hi[:] = 0.0
+        cr[:] = 0.0
+        for j in range(1, N):
+            g = j - 1 if gap else 0
+            for f in range(F):
+                y = w[k, j - 1, f]
+                a = hr[f] + y.real
+                b = hi[f] + y.imag
+                c = rho[g, f]
+                hr[f] = a * c - b * 0.0
+                hi[f] = a * 0.0 + b * c
+                x = w[k, j, f]
+                cr[f] += x.real * hr[f] + x.imag * hi[f]
+        for f in range(F):
+            out[k, f] = out[k, f] + 2.0 * cr[f]

@@ -308,6 +308,34 @@ def field_velocity(field, x: np.ndarray, t: np.ndarray, fns=None) -> tuple[np.nd
     return vx, vy
 
 
+def _quad_test(fn) -> bool:
+    """The compiled coherence quadrature gives :func:`~linecheck.core.spectral._quad_kms_nodes`'
+    bits (one coherence for all gaps and one per gap, signs of zeros included)."""
+    from .spectral import _quad_kms_nodes
+
+    rng = np.random.default_rng(27)
+    w = rng.standard_normal((9, 13, 37)) + 1j * rng.standard_normal((9, 13, 37))
+    w[:, 3] = 0.0  # a node without load
+    ok = True
+    for rho in (rng.random(37), rng.random((12, 37))):
+        ref = _quad_kms_nodes(w, rho, compiled=False)
+        got = np.empty(ref.shape)
+        fn(w, np.ascontiguousarray(np.atleast_2d(rho)), rho.ndim == 2, got)
+        ok &= bool(np.array_equal(got, ref) and np.array_equal(np.signbit(got), np.signbit(ref)))
+    return ok
+
+
+def quad_kms(w: np.ndarray, rho: np.ndarray) -> np.ndarray | None:
+    """:func:`~linecheck.core.spectral._quad_kms_nodes` of w (K, N, F) complex in one compiled
+    pass (the same bits; None when the kernel is not loaded or differed at load)."""
+    if not (use(0.0) and _state.get("quad")):
+        return None
+    w = np.ascontiguousarray(w, dtype=complex)
+    out = np.empty((w.shape[0], w.shape[2]))
+    _state["fns"].quad_kms(w, np.ascontiguousarray(np.atleast_2d(rho), dtype=float), rho.ndim == 2, out)
+    return out
+
+
 def _span_test(fn) -> bool:
     """The compiled span-tension integrands give :func:`~linecheck.core.static.span_terms`'
     bits (one and several states, with and without e)."""
@@ -441,6 +469,7 @@ def available() -> bool:
             _state["span"] = ok and _span_test(fns.span_terms)
             _state["reductions"] = ok and _reductions_test(fns.history_reductions)
             _state["field"] = ok and _field_test(fns)
+            _state["quad"] = ok and _quad_test(fns.quad_kms)
         return bool(_state["ok"])
 
 

@@ -487,9 +487,16 @@ def _banded_solve(blocks, omega: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     return out
 
 
-def _quad_kms_nodes(w: np.ndarray, rho: np.ndarray) -> np.ndarray:
+def _quad_kms_nodes(w: np.ndarray, rho: np.ndarray, compiled: bool = True) -> np.ndarray:
     """:func:`_quad_kms` with the node axis second to last and frequency last:
-    w (..., N, n_f) complex, rho (n_f,) or per gap (N-1, n_f) -> (..., n_f) real."""
+    w (..., N, n_f) complex, rho (n_f,) or per gap (N-1, n_f) -> (..., n_f) real (one compiled
+    pass with the same bits when the kernel is loaded, ``kernel.quad_kms``; issue 20)."""
+    if compiled and w.ndim == 3 and w.shape[1] > 0:
+        from . import kernel
+
+        fast = kernel.quad_kms(w, rho)
+        if fast is not None:
+            return fast
     h = np.zeros(w.shape[:-2] + w.shape[-1:], dtype=complex)
     total = np.sum(w.real**2 + w.imag**2, axis=-2)
     cross = np.zeros(total.shape)

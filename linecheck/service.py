@@ -785,13 +785,14 @@ def _run(case: Case, *, realizations, interpolate_states: bool, spectral_check: 
     models = build_models(system, [mean.state(k) for k in range(mean.time.size)])  # one vectorised pass
     synoptic = wind.type == "synoptic"
     windows: dict = {}  # long lines: window models shared by the burn-in and the check (issue 20)
-    if synoptic and windowed(case) and case.analysis.structural_ratio > 0:
-        # the whole line's structural-damping calibration, computed once for it and its windows
+    if synoptic and case.analysis.structural_ratio > 0:
+        # the structural-damping calibration, computed once for the record's models, the synoptic
+        # model of the burn-in and the check (the same state's model) and a long line's windows
         windows["omega1"] = structural_omega1(models[reference_state_index(case, mean)])
     damping = damping_matrices(case, st, models, omega1=windows.get("omega1"))
     # complex modes with eigenvectors: the burn-in tells significant modes apart with them
     # (issue 10) and the frequency-domain check sums them (modal superposition)
-    sm = synoptic_model(case, st) if synoptic and not windowed(case) else None
+    sm = synoptic_model(case, st, omega1=windows.get("omega1")) if synoptic and not windowed(case) else None
     burn = synoptic_burn_in(case, st, sm, windows) if synoptic else BurnIn(
         0.0, 0.0, float("nan"), float("nan"), True, "none: a downburst starts from a weak running mean")
     if burn.seconds > 0:  # the derived burn-in lengthens the record: check the budget again

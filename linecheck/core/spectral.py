@@ -131,7 +131,7 @@ def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None 
     A[n:, :n] = -minv[:, None] * cd.K
     A[n:, n:] = -minv[:, None] * cd.C
     if vectors:
-        lam, vr = eig(A, right=True)
+        lam, vr = eig(A, right=True, overwrite_a=True, check_finite=False)  # A is ours and finite (K, C checked)
         # left eigenvectors from the right ones (symmetric K, M, C): A^T w = lambda w with
         # w = [(lambda M + C) phi; M phi], phi the displacement part of psi (Tisseur &
         # Meerbergen 2001, section 3.4); chi = conj(w) so that chi^H A = lambda chi^H
@@ -139,7 +139,7 @@ def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None 
         w_top = lam[None, :] * (cd.M @ phi) + cd.C @ phi
         vl = np.conj(np.vstack([w_top, cd.M @ phi]))
     else:
-        lam, vl, vr = eig(A, right=False), None, None
+        lam, vl, vr = eig(A, right=False, overwrite_a=True, check_finite=False), None, None
     expansion = nrm = None
     if vectors:
         nrm = np.einsum("ik,ik->k", vl.conj(), vr)  # chi^H psi

@@ -215,9 +215,11 @@ def integrate(
         for k in np.unique(state_of_step):
             c = _factor(models[k].K_band, np.zeros(n_dof), f"stiffness of mean state {k + 1}")
             # static transfer from the y-loads to the reactions, (G K^-1 P)^T = (K^-1 G^T)[y]
-            # K^-1 G^T with dpbtrs' bits, compiled when the kernel is loaded (in place: on a copy of G^T)
-            GT = np.array(models[k].G.T, order="F")
-            TB = np.ascontiguousarray(from_ydof(kernel.solve_columns(c, GT) if compiled else _solve(c, GT)))  # (n_free, n_r)
+            # K^-1 G^T with dpbtrs' bits, compiled when the kernel is loaded (in place, on a copy of
+            # G^T; dpbtrs copies its right-hand sides itself)
+            GT = models[k].G.T
+            TB = np.ascontiguousarray(from_ydof(kernel.solve_columns(c, np.array(GT, order="F")) if compiled
+                                                else _solve(c, np.asfortranarray(GT))))  # (n_free, n_r)
             if second_order is not None:  # (K^-1 P)^T: the y-loads to the quasi-static displacements
                 E = np.zeros((n_dof, n_free), order="F")
                 if load_dirs is None:

@@ -486,7 +486,7 @@ def newmark_block(U: np.ndarray, V: np.ndarray, A: np.ndarray, loads: np.ndarray
         ycoef: [-] local components of each node's unit load, (n_free, 3).
         cu, cv, dm: the diagonal operators of :class:`~linecheck.core.dynamics._Stepper`, (n_dof,).
         r2: [1/s] 2/Δt.  chat: Cholesky factor of K̂ (upper band, (BANDWIDTH + 1, n_dof)).
-        rest: off-diagonal structural damping C~_off (scipy CSR) or None; a1: [1/s] 2/Δt.
+        rest: off-diagonal structural damping C~_off (:class:`~linecheck.core.model.CSRArrays`, read by its diagonals) or None; a1: [1/s] 2/Δt.
         out: receives u after every step, (n_b, n_real, n_dof); with no rows (0, n_real, n_dof)
             nothing is written (only the second-order tension reads the states).
         nz, GT, cols: the stepper's sparse reaction rows (:func:`~linecheck.core.dynamics._sparse_rows`).
@@ -498,23 +498,7 @@ def newmark_block(U: np.ndarray, V: np.ndarray, A: np.ndarray, loads: np.ndarray
     if rest is None:
         steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, False, _NO_BAND, a1, out, nz, GT, cols, R)
     else:
-        steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, True, rest_band(rest), a1, out, nz, GT, cols, R)
-
-
-def rest_band(rest) -> np.ndarray:
-    """The structural-damping remainder ``rest`` (CSR arrays) by its diagonals, (2 u + 1, n):
-    ``rest.band`` (:func:`~linecheck.core.model.band_to_csr_stack`), else gathered from the CSR
-    arrays (band[o, i] = C[i, i + o - BANDWIDTH])."""
-    band = getattr(rest, "band", None)
-    if band is not None:
-        return band
-    from .model import BANDWIDTH
-
-    n = rest.shape[0]
-    rows = np.repeat(np.arange(n), np.diff(rest.indptr))
-    band = np.zeros((2 * BANDWIDTH + 1, n))
-    band[rest.indices - rows + BANDWIDTH, rows] = rest.data
-    return band
+        steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, True, rest.band, a1, out, nz, GT, cols, R)
 
 
 def background(c: np.ndarray, L: np.ndarray, load_dirs: np.ndarray | None, sparse_g) -> np.ndarray:

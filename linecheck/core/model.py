@@ -133,7 +133,7 @@ class CSRArrays:
     shape: tuple[int, int]
     #: the same matrix by diagonals, (2 u + 1, n): band[o, i] = A[i, i + o - u], zero outside the
     #: matrix (what the compiled step loop reads, kernel.newmark_block)
-    band: np.ndarray | None = field(default=None, compare=False, repr=False)
+    band: np.ndarray = field(compare=False, repr=False)
     format = "csr"
 
     def tocsr(self):

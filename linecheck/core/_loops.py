@@ -15,7 +15,8 @@ import numba
 import numpy as np
 
 __all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "drag_loads", "field_radius", "field_velocity", "from_lanes", "history_reductions", "phasors", "quad_kms", "reactions_into",
-           "rest_product", "rotate", "rowdot", "solve_columns", "span_terms", "steps", "steps_1", "to_lanes"]
+           "rest_product", "rotate", "rowdot", "so_frame", "so_nodes", "so_products", "solve_columns", "span_terms",
+           "steps", "steps_1", "to_lanes"]
 
 
 # the banded triangular solves, with contraction as OpenBLAS's Haswell dtbsv forms them.
@@ -586,3 +587,85 @@ def quad_kms(w, rho, gap, out):  # pragma: no cover - compiled
                 cr[f] += x.real * hr[f] + x.imag * hi[f]
         for f in range(F):
             out[k, f] = out[k, f] + 2.0 * cr[f]
+
+
+# the second-order tension's passes (issue 16, second_order._reactions): the 3 x 3 products as
+# OpenBLAS's dgemm kernel forms them (a fused multiply-add chain over k = 0, 1, 2 from a zeroed
+# accumulator, then added to the zeroed C: acc + 0), compiled with ``contract``; starting from
+# 0.0 leaves LLVM one way to fuse each step
+@numba.njit(cache=True, nogil=True, fastmath={"contract"})
+def so_nodes(U, r, T, node_of_free, rotate_, u):  # pragma: no cover - compiled
+    """u[node, k, j] (n_nodes, 3, nb) of the free nodes from the rows j < r of U (m, 3 n_f):
+    (T[f] @ U[j, 3f:3f + 3])[k] with ``rotate_``, else U[j, 3f + k]; zero for j >= r."""
+    nb = u.shape[2]
+    for f in range(node_of_free.size):
+        node = node_of_free[f]
+        for k in range(3):
+            row = u[node, k]
+            if rotate_:
+                t0 = T[f, k, 0]
+                t1 = T[f, k, 1]
+                t2 = T[f, k, 2]
+                for j in range(r):
+                    acc = 0.0 + t0 * U[j, 3 * f]
+                    acc = acc + t1 * U[j, 3 * f + 1]
+                    acc = acc + t2 * U[j, 3 * f + 2]
+                    row[j] = acc + 0.0
+            else:
+                for j in range(r):
+                    row[j] = U[j, 3 * f + k]
+            for j in range(r, nb):
+                row[j] = 0.0
+
+
+@numba.njit(cache=True, nogil=True, fastmath={"contract"})
+def so_frame(u, ins_nodes, frame, li):  # pragma: no cover - compiled
+    """li[s] (3, nb) = frame[s] (3 x 3) @ u[ins_nodes[s]] (3, nb), dgemm's chain (above)."""
+    nb = u.shape[2]
+    for s in range(ins_nodes.size):
+        x = u[ins_nodes[s]]
+        for k in range(3):
+            f0 = frame[s, k, 0]
+            f1 = frame[s, k, 1]
+            f2 = frame[s, k, 2]
+            for j in range(nb):
+                acc = 0.0 + f0 * x[0, j]
+                acc = acc + f1 * x[1, j]
+                acc = acc + f2 * x[2, j]
+                li[s, k, j] = acc + 0.0
+
+
+@numba.njit(cache=True, nogil=True)
+def so_products(u, li, P, d):  # pragma: no cover - compiled
+    """P (6 n_el + 3 n_s, nb) of second_order._reactions: every cable element's six products of
+    du = u[e + 1] - u[e] (xx, yy, zz, xy, yz, xz), every insulator's a s, a w, s^2 + w^2 from
+    li = (a, s, w); each product and sum rounded by itself, as numpy's ufuncs (no contraction).
+    d: scratch (3, nb) (one row of P at a time vectorises; measured 2x the six rows at once)."""
+    n_el = u.shape[0] - 1
+    nb = u.shape[2]
+    for e in range(n_el):
+        for c in range(3):
+            for j in range(nb):
+                d[c, j] = u[e + 1, c, j] - u[e, c, j]
+        b = 6 * e
+        for j in range(nb):
+            P[b, j] = d[0, j] * d[0, j]
+        for j in range(nb):
+            P[b + 1, j] = d[1, j] * d[1, j]
+        for j in range(nb):
+            P[b + 2, j] = d[2, j] * d[2, j]
+        for j in range(nb):
+            P[b + 3, j] = d[0, j] * d[1, j]
+        for j in range(nb):
+            P[b + 4, j] = d[1, j] * d[2, j]
+        for j in range(nb):
+            P[b + 5, j] = d[0, j] * d[2, j]
+    b0 = 6 * n_el
+    for s in range(li.shape[0]):
+        b = b0 + 3 * s
+        for j in range(nb):
+            P[b, j] = li[s, 0, j] * li[s, 1, j]
+        for j in range(nb):
+            P[b + 1, j] = li[s, 0, j] * li[s, 2, j]
+        for j in range(nb):
+            P[b + 2, j] = li[s, 1, j] * li[s, 1, j] + li[s, 2, j] * li[s, 2, j]

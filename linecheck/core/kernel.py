@@ -13,7 +13,10 @@ and the fluctuating drag (:func:`drag_loads`), in step 1 the span tension's Newt
 downburst's 250 mean states at once, their sums over the Gauss points left to numpy's
 ``matmul``, so the same BLAS sums them), and after the steps the statistics' r.m.s. values and
 peaks over time (:func:`history_reductions`: numpy sums along the time axis one sample after the
-other, and so does the loop); without it (or with ``LINECHECK_KERNEL=numpy``) the numpy code runs.
+other, and so does the loop), and the second-order tension's elementwise passes per block of rows
+(:func:`second_order_passes`: the rotation out of the node bases, the insulators' frames and the
+products P of :func:`linecheck.core.second_order.reaction_form`, their 3 × 3 products as the fused
+multiply-add chain of OpenBLAS's dgemm kernel; the products P W stay BLAS's); without it (or with ``LINECHECK_KERNEL=numpy``) the numpy code runs.
 Each compiled function is compared with its numpy form when the kernel loads; one that differs
 here is not used.
 
@@ -420,6 +423,49 @@ def history_reductions(M: np.ndarray, background: np.ndarray, resonant: np.ndarr
     return tuple(np.array(o) for o in out)  # seven arrays of their own, as numpy's
 
 
+def _second_order_test(fns) -> bool:
+    """The compiled second-order passes give the numpy form's bits through
+    :func:`~linecheck.core.second_order.second_order_reactions` (in node bases and global) and
+    ``second_order_of_loads``, on an operator of random numbers with two runs of free nodes,
+    insulators, rows of zeros and a padded last block; else the numpy passes are used (their 3 x 3
+    products are OpenBLAS's, whose kernels may round differently on another machine)."""
+    from types import SimpleNamespace
+
+    from .second_order import second_order_of_loads, second_order_reactions
+
+    rng = np.random.default_rng(28)
+    n_nodes, n_s, n_r = 21, 3, 7
+    free = np.r_[1:10, 11:20]  # nodes 0, 10 and 20 pinned
+    n_el = n_nodes - 1
+    op = SimpleNamespace(
+        n_nodes=n_nodes, c=np.ones(n_el + n_s), runs=((1, 10, 0), (11, 20, 9)),
+        ins_nodes=np.array([5, 12, 17]), ins_frame=np.linalg.qr(rng.standard_normal((n_s, 3, 3)))[0],
+        W=rng.standard_normal((6 * n_el + 3 * n_s, n_r)) * 1e3)
+    T = np.linalg.qr(rng.standard_normal((free.size, 3, 3)))[0]
+    U = rng.standard_normal((300, 3 * free.size)) * 0.2
+    U[[0, 7, 150]] = 0.0
+    U[:, 4] = -0.0
+    L = rng.standard_normal((150, free.size))
+    X = rng.standard_normal((3 * free.size, free.size)) * 1e-3
+    ok = True
+    for t in (T, None):
+        ref = second_order_reactions(op, U, t, passes=None)
+        got = second_order_reactions(op, U, t, passes=fns)
+        ok &= bool(np.array_equal(ref, got) and np.array_equal(np.signbit(ref), np.signbit(got)))
+    ref = second_order_of_loads(op, L, X, passes=None)
+    got = second_order_of_loads(op, L, X, passes=fns)
+    return ok and bool(np.array_equal(ref, got) and np.array_equal(np.signbit(ref), np.signbit(got)))
+
+
+def second_order_passes():
+    """The compiled elementwise passes of the second-order tension (issue 16; ``so_nodes``,
+    ``so_frame``, ``so_products`` of :mod:`linecheck.core._loops`) when the kernel is loaded and
+    they gave the numpy form's bits at load, else None (the numpy passes run)."""
+    if not (use(0.0) and _state.get("second_order")):
+        return None
+    return _state["fns"]
+
+
 def rowdot(X: np.ndarray, BT: np.ndarray) -> np.ndarray:
     """X (m, n) @ BT (n, q) with the bits of :func:`~linecheck.core.dynamics._rowdot` (compiled
     when that was verified at load)."""
@@ -470,6 +516,7 @@ def available() -> bool:
             _state["reductions"] = ok and _reductions_test(fns.history_reductions)
             _state["field"] = ok and _field_test(fns)
             _state["quad"] = ok and _quad_test(fns.quad_kms)
+            _state["second_order"] = ok and _second_order_test(fns)
         return bool(_state["ok"])
 
 

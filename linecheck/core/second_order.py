@@ -182,7 +182,19 @@ SINGLE_THREAD_WORK = 4 * 65536  # rows x W.size up to OpenBLAS' multithreading t
 BLOCK_ROWS = 128  # rows of one block of elementwise passes (their arrays stay in cache)
 
 
-def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None = None) -> np.ndarray:
+_AUTO = object()  # passes: the compiled kernel's when loaded and verified (kernel.second_order_passes)
+
+
+def _passes(passes):
+    if passes is _AUTO:
+        from . import kernel
+
+        return kernel.second_order_passes()
+    return passes
+
+
+def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None = None, *,
+                           passes=_AUTO) -> np.ndarray:
     """[N] R_2 at every tower for free displacements U [m], shape (m, n_dof) -> (m, n_r).
 
     With ``T`` (per-node bases as columns, (n_free_nodes, 3, 3)) U holds the components u~ in
@@ -193,7 +205,10 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
     the members' du by one slice difference, their products into P (transposed, (6 n_el +
     3 n_s, rows)), and P W by BLAS: a dozen numpy calls per block with ``out=`` instead of the
     ~45 elementwise passes of building f2 and multiplying by A; results equal the latter to
-    rounding (tests).
+    rounding (tests).  With the optional compiled kernel (``passes``: the kernel's by default
+    when it is loaded, None for numpy) a block's elementwise work is three compiled calls with
+    the same bits (:func:`linecheck.core._loops.so_nodes`, ``so_frame``, ``so_products``; the
+    3 x 3 products in the fused order of OpenBLAS's dgemm, verified when the kernel loads).
 
     Rows are processed in blocks of a fixed size that depends on the operator only (the last
     block padded with zeros), so every BLAS product always has the same shape: a row's result
@@ -203,6 +218,16 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
     """
     n_f = U.shape[1] // 3
     pad = None
+    fns = _passes(passes)
+    if fns is not None:
+        Uc = np.ascontiguousarray(U, dtype=float)
+        node_of_free = np.concatenate([np.arange(lo, hi) for lo, hi, _ in sorted(op.runs, key=lambda x: x[2])])
+        Tc = np.zeros((1, 3, 3)) if T is None else np.ascontiguousarray(T, dtype=float)
+
+        def fill(u: np.ndarray, i0: int, r: int) -> None:
+            fns.so_nodes(Uc[i0:i0 + r], r, Tc, node_of_free, T is not None, u)
+
+        return _reactions(op, U.shape[0], fill, fns=fns)
 
     def fill(u: np.ndarray, i0: int, r: int) -> None:
         nonlocal pad
@@ -226,12 +251,13 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
     return _reactions(op, U.shape[0], fill)
 
 
-def second_order_of_loads(op: SecondOrder, L: np.ndarray, X: np.ndarray) -> np.ndarray:
+def second_order_of_loads(op: SecondOrder, L: np.ndarray, X: np.ndarray, *, passes=_AUTO) -> np.ndarray:
     """[N] R_2 of the quasi-static displacements u = X l of loads L [N], shape (m, n_l) ->
     (m, n_r); X [m/N] (n_dof, n_l) maps the loads to the free displacements (x, y, z per free
     node).  As :func:`second_order_reactions` of L X^T, without that history: each block's
     displacements are computed node-major, X L_block^T, straight into the work array, by BLAS
-    products of a fixed shape (16 loads rows, whole micro-kernel tiles, one thread)."""
+    products of a fixed shape (16 loads rows, whole micro-kernel tiles, one thread); the rest of
+    a block as there (``passes``)."""
     ch = max(16, SINGLE_THREAD_WORK // X.size // 16 * 16)
     zero = np.zeros((ch, L.shape[1]))
 
@@ -250,12 +276,13 @@ def second_order_of_loads(op: SecondOrder, L: np.ndarray, X: np.ndarray) -> np.n
             for lo, hi, f0 in op.runs:
                 np.matmul(X[3 * f0:3 * (f0 + hi - lo)], Lc.T, out=u[lo:hi].reshape(3 * (hi - lo), nb)[:, j0:j1])
 
-    return _reactions(op, L.shape[0], fill, multiple=ch)
+    return _reactions(op, L.shape[0], fill, multiple=ch, fns=_passes(passes))
 
 
-def _reactions(op: SecondOrder, m: int, fill, multiple: int = 1) -> np.ndarray:
+def _reactions(op: SecondOrder, m: int, fill, multiple: int = 1, fns=None) -> np.ndarray:
     """R_2 (m, n_r) of m rows of displacements that ``fill(u, i0, r)`` writes node-major into
-    u[:, :, :r] (global x, y, z; (n_nodes, 3, nb)), zeroing u[:, :, r:] (docstrings above)."""
+    u[:, :, :r] (global x, y, z; (n_nodes, 3, nb)), zeroing u[:, :, r:] (docstrings above);
+    ``fns`` the compiled passes or None (numpy, the same bits)."""
     W = op.W
     n_el = op.n_nodes - 1
     n_s = op.c.size - n_el
@@ -264,27 +291,36 @@ def _reactions(op: SecondOrder, m: int, fill, multiple: int = 1) -> np.ndarray:
     nb = max(1, BLOCK_ROWS // chunk) * chunk  # rows of one elementwise pass: arrays stay in cache
     nb = -(-nb // multiple) * multiple
     u = np.zeros((op.n_nodes, 3, nb))  # pinned nodes stay zero
-    d = np.empty((n_el, 3, nb))
     P = np.zeros((W.shape[0], nb))  # padding columns stay zero
-    Pq = P[:6 * n_el].reshape(n_el, 6, nb)  # cable elements: the six products
-    Pi = P[6 * n_el:].reshape(n_s, 3, nb)  # insulators: a s, a w, s^2 + w^2
-    di = np.empty((n_s, 3, nb))
     li = np.empty((n_s, 3, nb))
-    sq = np.empty((n_s, 2, nb))
+    if fns is None:
+        d = np.empty((n_el, 3, nb))
+        Pq = P[:6 * n_el].reshape(n_el, 6, nb)  # cable elements: the six products
+        Pi = P[6 * n_el:].reshape(n_s, 3, nb)  # insulators: a s, a w, s^2 + w^2
+        di = np.empty((n_s, 3, nb))
+        sq = np.empty((n_s, 2, nb))
+    else:
+        d = np.empty((3, nb))
+        ins_nodes = np.ascontiguousarray(op.ins_nodes, dtype=np.int64)
+        frame = np.ascontiguousarray(op.ins_frame, dtype=float)
     out = np.empty((m, W.shape[1]))
     for i0 in range(0, m, nb):
         i1 = min(i0 + nb, m)
         r = i1 - i0
         fill(u, i0, r)
-        np.subtract(u[1:], u[:-1], out=d)  # cable elements: u_b - u_a
-        np.multiply(d, d, out=Pq[:, :3])  # cable elements: products of du's components (_PAIRS)
-        np.multiply(d[:, :2], d[:, 1:], out=Pq[:, 3:5])
-        np.multiply(d[:, 0], d[:, 2], out=Pq[:, 5])
-        np.take(u, op.ins_nodes, axis=0, out=di)  # insulators: the fixed point does not move
-        np.matmul(op.ins_frame, di, out=li)  # (a, s, w) in the insulator's frame
-        np.multiply(li[:, :1], li[:, 1:], out=Pi[:, :2])  # a s, a w
-        np.multiply(li[:, 1:], li[:, 1:], out=sq)
-        np.add(sq[:, 0], sq[:, 1], out=Pi[:, 2])  # s^2 + w^2
+        if fns is not None:  # the same operations, compiled (_loops.so_frame, so_products)
+            fns.so_frame(u, ins_nodes, frame, li)
+            fns.so_products(u, li, P, d)
+        else:
+            np.subtract(u[1:], u[:-1], out=d)  # cable elements: u_b - u_a
+            np.multiply(d, d, out=Pq[:, :3])  # cable elements: products of du's components (_PAIRS)
+            np.multiply(d[:, :2], d[:, 1:], out=Pq[:, 3:5])
+            np.multiply(d[:, 0], d[:, 2], out=Pq[:, 5])
+            np.take(u, op.ins_nodes, axis=0, out=di)  # insulators: the fixed point does not move
+            np.matmul(op.ins_frame, di, out=li)  # (a, s, w) in the insulator's frame
+            np.multiply(li[:, :1], li[:, 1:], out=Pi[:, :2])  # a s, a w
+            np.multiply(li[:, 1:], li[:, 1:], out=sq)
+            np.add(sq[:, 0], sq[:, 1], out=Pi[:, 2])  # s^2 + w^2
         for j0 in range(0, r, chunk):
             j1 = j0 + chunk
             if j1 <= r:

@@ -61,7 +61,6 @@ def main() -> None:
     st = service.static_analysis(case)
     system, mean = st.system, st.mean
     states = [mean.state(k) for k in range(mean.time.size)]
-    vn = service.to_global_nodes(system, st.wind.normal)
     nm = dynamics.Newmark(case.analysis.time_step)
     zs = case.analysis.structural_ratio
 

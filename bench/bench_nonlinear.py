@@ -243,7 +243,7 @@ def main(argv: list[str] | None = None) -> int:
     # warm-up: imports and first-call costs of both codes, on a tiny record
     warm = with_analysis(load_case(ROOT / "cases" / "paper" / "case10-single.toml"), duration=5.0,
                          damping="quasi-steady")
-    wres = service.run_case(warm, realizations=[0])
+    service.run_case(warm, realizations=[0])
     service.run_case(warm, realizations=[0, 1])  # the several-realization loop loaded too (--ensemble)
     NonlinearLine(warm).run(field_wind(warm, 0))
 

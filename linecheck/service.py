@@ -14,6 +14,7 @@ import dataclasses
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -28,6 +29,11 @@ from .core.results import Statistics, compute_statistics
 from .core.static import MeanStates, drag_intensity, solve_mean_states
 from .core.system import LineSystem
 from .core.wind.mean import MeanWind, mean_wind
+
+if TYPE_CHECKING:  # names of annotations only
+    from .core.modes import Modes
+    from .core.results import ResultSummary
+    from .core.spectral import DavenportEstimate, SpectralEstimate
 
 Progress = Callable[[str, int, int], None]
 Warn = Callable[[str], None]
@@ -140,7 +146,6 @@ def to_global_nodes(system: LineSystem, span_local: np.ndarray) -> np.ndarray:
 
     A tower node shared by two spans takes the mean of both sides.
     """
-    ne = system.ne
     head = span_local[..., :, :-1].reshape(span_local.shape[:-2] + (-1,))
     out = np.concatenate([head, span_local[..., -1:, -1]], axis=-1)
     if system.n_spans > 1:

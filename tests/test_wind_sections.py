@@ -252,6 +252,7 @@ def test_downburst_on_section_is_placed_in_the_tower_frame_and_evaluated_at_each
     # V_max from V_ref at p at z_ref = the mean clamp height above ground (stationary: the peak is at T1):
     # V_ref = V_max f_r(R cos Theta) f_z(z_ref) Pi(T1), Pi(T1) = 1 (Holmes & Oliver 2000; Wood 2001; Chay 2006)
     dj, r_max, r_dec, z_max = 600.0, 720.0, 300.0, 15.0
+    assert f.jet_diameter == pytest.approx(dj, rel=1e-14)
     delta = z_max / wm.ETA_PEAK
     z_ref = float(np.mean([float(t["height"]) for t in _towers()]))
     assert wm.reference_height(case) == pytest.approx(z_ref, rel=1e-14)

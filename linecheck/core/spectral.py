@@ -571,7 +571,6 @@ def random_vibration(
             place the refined frequency points.
     """
     system = model.system
-    n_dof = model.mass.size
     free = model.dofs.free_nodes
     Gt = tower_rows(model, model.G, tower)  # (3, n_dof), in the tower's frame
     Dt = tower_rows(model, reaction_matrix_direct(system), tower)  # (3, n_nodes)

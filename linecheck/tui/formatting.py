@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass
 from typing import Any
 
 from ..core.case import SCHEMA, Case, FieldSpec

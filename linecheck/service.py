@@ -553,6 +553,14 @@ def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: n
     sigma^2 is in step 1, :func:`mean_loads`).
     """
     line, wind = case.line, case.wind
+    shape = vn.shape  # (n_steps, n_nodes)
+    # a synoptic record holds its mean (rows broadcast, stride 0): the per-node factors below are
+    # elementwise, so they are computed on one row and viewed over the record (the same values;
+    # ≈ 20 ms less per chunk with the quadratic drag)
+    held = vn.ndim == 2 and vn.strides[0] == 0 and (vl is None or vl.strides[0] == 0)
+    if held:
+        vn = vn[:1]
+        vl = None if vl is None else vl[:1]
     if vl is None:
         cos_n = np.ones_like(vn)
     else:
@@ -573,6 +581,13 @@ def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: n
         # 1/2 rho C_d D L V_n|V_n| / |V|^2 per unit (v^2 - sigma^2); sigma^2 = ratio |V|^2
         per_q = 0.5 * coef * model.tributary[None, :] * vn * np.abs(vn) * inv
         sig2 = ratio * speed2
+    if held:  # writeable views (np.broadcast_to's are read-only: another type for the compiled drag)
+        def over_record(a: np.ndarray) -> np.ndarray:
+            return np.lib.stride_tricks.as_strided(a, shape=shape, strides=(0, a.strides[1]))
+
+        per_v = over_record(per_v)
+        if quad:
+            per_q, sig2 = over_record(per_q), over_record(sig2)
     free = model.dofs.free_nodes
     pinned = system.tower_nodes[~system.suspension]
     n_real = v.shape[0]
@@ -583,8 +598,8 @@ def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: n
     sel = slice(int(free[0]), int(free[0]) + free.size) if run else free
     pv, pv_p = per_v[:, sel], per_v[:, pinned]
     if quad:
-        pq, s2 = np.broadcast_to(per_q, vn.shape)[:, sel], np.broadcast_to(sig2, vn.shape)[:, sel]
-        pq_p, s2_p = np.broadcast_to(per_q, vn.shape)[:, pinned], np.broadcast_to(sig2, vn.shape)[:, pinned]
+        pq, s2 = np.broadcast_to(per_q, shape)[:, sel], np.broadcast_to(sig2, shape)[:, sel]
+        pq_p, s2_p = np.broadcast_to(per_q, shape)[:, pinned], np.broadcast_to(sig2, shape)[:, pinned]
     # the same elementwise products as on every node, written straight into the loads (one
     # compiled pass when the kernel is loaded: the same bits, issue 20)
     kernel.drag_loads(pv, pq if quad else None, s2 if quad else None, v, sel, loads)

@@ -25,6 +25,26 @@ def paper(name: str, **analysis):
 
 
 # --------------------------------------------------------------------------- quadratic drag
+@pytest.mark.parametrize("direction", [0.0, 25.0])
+def test_synoptic_loads_from_the_held_mean_row(direction):
+    """A synoptic record's mean is one row viewed over the record (stride 0): fluctuating_loads
+    computes its per-node factors on that row; the loads must be those of the materialised record
+    (linear and quadratic drag, normal and oblique wind)."""
+    for drag in ("linear", "quadratic"):
+        case = paper("case09-six", drag=drag)
+        case = dataclasses.replace(case, wind=dataclasses.replace(case.wind, direction=direction))
+        st = service.static_analysis(case)
+        model = service.synoptic_model(case, st, vectors=False).model
+        t = np.arange(400) * case.analysis.time_step
+        vn, vl = service.record_mean_wind(case, st, t)
+        assert vn.strides[0] == 0 and (vl is None) == (direction == 0.0)
+        v = np.random.default_rng(7).standard_normal((2, t.size, st.system.n_nodes)) * 5.0
+        held = service.fluctuating_loads(case, st.system, model, t, v, vn, vl)
+        full = service.fluctuating_loads(case, st.system, model, t, v, np.array(vn), None if vl is None else np.array(vl))
+        for a, b in zip(held, full):
+            assert np.array_equal(a, b)
+
+
 @pytest.mark.parametrize("name", ["case09-single", "case10-six", "case05-single"])
 def test_quadratic_drag_mean_rises_by_I2(name):
     """The mean of 1/2 rho C_d D (V + v)^2 is 1/2 rho C_d D V^2 (1 + I^2): the step-1 mean R_y

@@ -200,12 +200,14 @@ def test_downburst_one_realization_same_bits(monkeypatch):
 def test_section_second_order_same_bits(monkeypatch):
     """A 12-span section (load directions along the span normals) with second-order tension."""
     case = _short(CASES / "examples" / "section-12span.toml", duration=60.0, tension="second-order")
-    got = []
-    passes = kernel.second_order_passes
+    got, fps = [], []
+    passes, dgemm = kernel.second_order_passes, kernel.second_order_dgemm
     monkeypatch.setattr(kernel, "second_order_passes", lambda: got.append(passes()) or got[-1])
+    monkeypatch.setattr(kernel, "second_order_dgemm", lambda: fps.append(dgemm()) or fps[-1])
     fast, slow = _both(monkeypatch, case, realizations=[0, 1])
     n_compiled = sum(p is not None for p in got)
     assert n_compiled > 0 and n_compiled < len(got)  # the compiled passes ran in the first run only
+    assert fps and (kernel._state.get("dgemm") is None or all(fp is not None for fp in fps))  # and the block loop
     assert np.array_equal(fast.resonant, slow.resonant)
     assert np.array_equal(fast.background, slow.background)
 
@@ -213,9 +215,10 @@ def test_section_second_order_same_bits(monkeypatch):
 @needs_kernel
 def test_second_order_passes_same_bits():
     """The compiled second-order passes (issue 16: rotation out of the node bases, insulator
-    frames, the products P) give the numpy passes' bits on case09-six's operator: the Newmark
-    history in node bases, global displacements, and the quasi-static displacements of loads,
-    with a padded last block, rows of zeros and negative zeros."""
+    frames, the products P) and the compiled block loop with numpy's own cblas_dgemm give the numpy
+    passes' bits on case09-six's operator: the Newmark history in node bases, global
+    displacements, and the quasi-static displacements of loads, with a padded last block, rows of
+    zeros and negative zeros, all reactions and a tower's three."""
     from linecheck.core.second_order import second_order_of_loads, second_order_operator, second_order_reactions
 
     case = _short(CASES / "paper" / "case09-six.toml", tension="second-order")
@@ -230,15 +233,27 @@ def test_second_order_passes_same_bits():
     U[[0, 500]] = 0.0
     U[:, 7] = -0.0
     T = np.linalg.qr(rng.standard_normal((n_dof // 3, 3, 3)))[0]
-    for t in (T, None):
-        ref = second_order_reactions(op, U, t, passes=None)
-        got = second_order_reactions(op, U, t, passes=fns)
-        assert np.array_equal(got, ref) and np.array_equal(np.signbit(got), np.signbit(ref))
+    # numpy's own wheels (scipy-openblas, 64-bit integers): the whole block loop is compiled too
+    blas = np.show_config(mode="dicts")["Build Dependencies"]["blas"]
+    dgemm = kernel.second_order_dgemm()
+    if blas.get("name") == "scipy-openblas" and "USE64BITINT" in str(blas.get("openblas configuration")):
+        assert dgemm is not None
     L = rng.standard_normal((700, n_dof // 3)) * 50.0
     X = rng.standard_normal((n_dof, n_dof // 3)) * 1e-4
-    ref = second_order_of_loads(op, L, X, passes=None)
-    assert np.array_equal(second_order_of_loads(op, L, X, passes=fns), ref)
-    assert np.abs(ref).max() > 0.0
+    for fp in (None, dgemm) if dgemm is not None else (None,):
+        for t in (T, None):
+            ref = second_order_reactions(op, U, t, passes=None, dgemm=None)
+            got = second_order_reactions(op, U, t, passes=fns, dgemm=fp)
+            assert np.array_equal(got, ref) and np.array_equal(np.signbit(got), np.signbit(ref))
+        ref = second_order_of_loads(op, L, X, passes=None, dgemm=None)
+        assert np.array_equal(second_order_of_loads(op, L, X, passes=fns, dgemm=fp), ref)
+        assert np.abs(ref).max() > 0.0
+        # a tower of interest's three columns (a scan): other chunk and block sizes
+        op3 = dataclasses.replace(op, A=np.ascontiguousarray(op.A[:, 9:12]), W=np.ascontiguousarray(op.W[:, 9:12]))
+        ref = second_order_reactions(op3, U, T, passes=None, dgemm=None)
+        assert np.array_equal(second_order_reactions(op3, U, T, passes=fns, dgemm=fp), ref)
+        ref = second_order_of_loads(op3, L, X, passes=None, dgemm=None)
+        assert np.array_equal(second_order_of_loads(op3, L, X, passes=fns, dgemm=fp), ref)
 
 
 @needs_kernel

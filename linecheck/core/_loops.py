@@ -13,9 +13,12 @@ from __future__ import annotations
 
 import numba
 import numpy as np
+from llvmlite import ir
+from numba import types
+from numba.extending import intrinsic
 
 __all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "drag_loads", "field_radius", "field_velocity", "from_lanes", "history_reductions", "phasors", "quad_kms", "reactions_into",
-           "rest_product", "rotate", "rowdot", "so_frame", "so_nodes", "so_products", "solve_columns", "span_terms",
+           "rest_product", "rotate", "rowdot", "so_frame", "so_history", "so_nodes", "so_products", "solve_columns", "span_terms",
            "steps", "steps_1", "to_lanes"]
 
 
@@ -669,3 +672,78 @@ def so_products(u, li, P, d):  # pragma: no cover - compiled
             P[b + 1, j] = li[s, 0, j] * li[s, 2, j]
         for j in range(nb):
             P[b + 2, j] = li[s, 1, j] * li[s, 1, j] + li[s, 2, j] * li[s, 2, j]
+
+
+@intrinsic
+def _dgemm64(typingctx, fp, ta, tb, m, n, k, a, lda, b, ldb, c, ldc):  # pragma: no cover - compiled
+    """cblas_dgemm(RowMajor, ta, tb, m, n, k, 1.0, a, lda, b, ldb, 0.0, c, ldc) of an ILP64 CBLAS
+    (64-bit sizes) through its address ``fp``: the call numpy's ``matmul`` makes (kernel.py)."""
+    sig = types.void(types.intp, types.int32, types.int32, types.int64, types.int64, types.int64,
+                     types.voidptr, types.int64, types.voidptr, types.int64, types.voidptr, types.int64)
+
+    def codegen(context, builder, signature, args):
+        i32, i64, dbl, vp = ir.IntType(32), ir.IntType(64), ir.DoubleType(), ir.IntType(8).as_pointer()
+        fnty = ir.FunctionType(ir.VoidType(), [i32, i32, i32, i64, i64, i64, dbl, vp, i64, vp, i64, dbl, vp, i64])
+        fn = builder.inttoptr(args[0], fnty.as_pointer())
+        builder.call(fn, [ir.Constant(i32, 101), args[1], args[2], args[3], args[4], args[5], ir.Constant(dbl, 1.0),
+                          args[6], args[7], args[8], args[9], ir.Constant(dbl, 0.0), args[10], args[11]])
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+_NO_TRANS = np.int32(111)
+_TRANS = np.int32(112)
+
+
+@numba.njit(cache=True, nogil=True)
+def so_history(fp, of_loads, U, T, rotate_, node_of_free, L, X, run_lo, run_hi, run_f0, ch, Lpad,
+               ins_nodes, frame, W, chunk, u, li, P, d, tmp, out):  # pragma: no cover - compiled
+    """second_order._reactions in one call (issue 16): per block of nb = u.shape[2] rows the
+    displacements (``of_loads``: X L_block^T by the BLAS at ``fp`` in ch-row chunks, the last one
+    padded from Lpad, one call per run of free nodes; else so_nodes of U), so_frame, so_products
+    and P W by that BLAS in ``chunk``-row products (a padded last one through ``tmp``) — every
+    BLAS call with the arguments numpy's ``matmul`` passes for the same arrays, so the same bits."""
+    m = out.shape[0]
+    nb = u.shape[2]
+    nr = W.shape[1]
+    npw = W.shape[0]
+    nl = L.shape[1]
+    for i0 in range(0, m, nb):
+        i1 = min(i0 + nb, m)
+        r = i1 - i0
+        if not of_loads:
+            so_nodes(U[i0:i1], r, T, node_of_free, rotate_, u)
+        else:
+            for j0 in range(0, nb, ch):
+                j1 = j0 + ch
+                if j0 >= r:
+                    for a in range(u.shape[0]):
+                        for c in range(3):
+                            for j in range(j0, nb):
+                                u[a, c, j] = 0.0
+                    break
+                if j1 > r:
+                    for q in range(ch):
+                        for c in range(nl):
+                            Lpad[q, c] = L[i0 + j0 + q, c] if q < r - j0 else 0.0
+                    src = Lpad
+                else:
+                    src = L[i0 + j0:i0 + j1]
+                for g in range(run_lo.size):
+                    lo = run_lo[g]
+                    hi = run_hi[g]
+                    _dgemm64(fp, _NO_TRANS, _TRANS, 3 * (hi - lo), ch, nl, X[3 * run_f0[g]:].ctypes.data, nl,
+                             src.ctypes.data, nl, u[lo:hi, :, j0:].ctypes.data, nb)
+        so_frame(u, ins_nodes, frame, li)
+        so_products(u, li, P, d)
+        for j0 in range(0, r, chunk):
+            if j0 + chunk <= r:
+                _dgemm64(fp, _TRANS, _NO_TRANS, chunk, nr, npw, P[:, j0:].ctypes.data, nb, W.ctypes.data, nr,
+                         out[i0 + j0:].ctypes.data, nr)
+            else:
+                _dgemm64(fp, _TRANS, _NO_TRANS, chunk, nr, npw, P[:, j0:].ctypes.data, nb, W.ctypes.data, nr,
+                         tmp.ctypes.data, nr)
+                for q in range(r - j0):
+                    for c in range(nr):
+                        out[i0 + j0 + q, c] = tmp[q, c]

@@ -423,12 +423,13 @@ def history_reductions(M: np.ndarray, background: np.ndarray, resonant: np.ndarr
     return tuple(np.array(o) for o in out)  # seven arrays of their own, as numpy's
 
 
-def _second_order_test(fns) -> bool:
+def _second_order_test(fns, dgemm: int | None = None) -> bool:
     """The compiled second-order passes give the numpy form's bits through
     :func:`~linecheck.core.second_order.second_order_reactions` (in node bases and global) and
     ``second_order_of_loads``, on an operator of random numbers with two runs of free nodes,
     insulators, rows of zeros and a padded last block; else the numpy passes are used (their 3 x 3
-    products are OpenBLAS's, whose kernels may round differently on another machine)."""
+    products are OpenBLAS's, whose kernels may round differently on another machine).  With
+    ``dgemm`` (numpy's cblas_dgemm) the whole block loop of ``_loops.so_history`` is compared."""
     from types import SimpleNamespace
 
     from .second_order import second_order_of_loads, second_order_reactions
@@ -449,12 +450,54 @@ def _second_order_test(fns) -> bool:
     X = rng.standard_normal((3 * free.size, free.size)) * 1e-3
     ok = True
     for t in (T, None):
-        ref = second_order_reactions(op, U, t, passes=None)
-        got = second_order_reactions(op, U, t, passes=fns)
+        ref = second_order_reactions(op, U, t, passes=None, dgemm=None)
+        got = second_order_reactions(op, U, t, passes=fns, dgemm=dgemm)
         ok &= bool(np.array_equal(ref, got) and np.array_equal(np.signbit(ref), np.signbit(got)))
-    ref = second_order_of_loads(op, L, X, passes=None)
-    got = second_order_of_loads(op, L, X, passes=fns)
+    ref = second_order_of_loads(op, L, X, passes=None, dgemm=None)
+    got = second_order_of_loads(op, L, X, passes=fns, dgemm=dgemm)
     return ok and bool(np.array_equal(ref, got) and np.array_equal(np.signbit(ref), np.signbit(got)))
+
+
+def _numpy_cblas_dgemm() -> int | None:
+    """The address of the ``cblas_dgemm`` that numpy's ``matmul`` calls, when numpy is built on
+    scipy-openblas with 64-bit integers (numpy's own wheels: the symbol ``scipy_cblas_dgemm64_``
+    of the OpenBLAS library numpy loaded), else None.  The library is the one already in the
+    process (Linux: /proc/self/maps; else the folder numpy's wheels bundle it in), so the kernel
+    selected for this CPU is numpy's too; the load test then checks the bits."""
+    import ctypes
+    import glob
+
+    try:
+        blas = np.show_config(mode="dicts")["Build Dependencies"]["blas"]
+        if blas.get("name") != "scipy-openblas" or "USE64BITINT" not in str(blas.get("openblas configuration", "")):
+            return None
+    except Exception:  # pragma: no cover - a numpy without the dict form of its build configuration
+        return None
+    paths = []
+    try:
+        with open("/proc/self/maps") as f:
+            paths = [line.split()[-1] for line in f if "openblas" in line and "/" in line]
+    except OSError:  # pragma: no cover - not Linux
+        pass
+    here = os.path.dirname(np.__file__)
+    for pattern in ("../numpy.libs/*openblas*", ".dylibs/*openblas*"):
+        paths += glob.glob(os.path.join(here, pattern))
+    for path in dict.fromkeys(paths):
+        try:
+            fn = ctypes.CDLL(path).scipy_cblas_dgemm64_
+        except (OSError, AttributeError):
+            continue
+        return int(ctypes.cast(fn, ctypes.c_void_p).value)
+    return None
+
+
+def second_order_dgemm() -> int | None:
+    """The address of numpy's ``cblas_dgemm`` for :func:`linecheck.core._loops.so_history` (the
+    second-order tension's whole block loop compiled, BLAS calls included, without the GIL) when the
+    kernel is loaded and that loop gave the numpy form's bits at load, else None."""
+    if not (use(0.0) and _state.get("so_history")):
+        return None
+    return _state["dgemm"]
 
 
 def second_order_passes():
@@ -517,6 +560,8 @@ def available() -> bool:
             _state["field"] = ok and _field_test(fns)
             _state["quad"] = ok and _quad_test(fns.quad_kms)
             _state["second_order"] = ok and _second_order_test(fns)
+            _state["dgemm"] = _numpy_cblas_dgemm() if _state["second_order"] else None
+            _state["so_history"] = _state["dgemm"] is not None and _second_order_test(fns, _state["dgemm"])
         return bool(_state["ok"])
 
 

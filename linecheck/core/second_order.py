@@ -193,8 +193,46 @@ def _passes(passes):
     return passes
 
 
+def _dgemm(dgemm, fns):
+    if fns is None:
+        return None
+    if dgemm is _AUTO:
+        from . import kernel
+
+        return kernel.second_order_dgemm()
+    return dgemm
+
+
+def _history(op: SecondOrder, fns, dgemm: int, m: int, U=None, T=None, L=None, X=None) -> np.ndarray:
+    """R_2 (m, n_r) by the compiled block loop (:func:`linecheck.core._loops.so_history`): the
+    same blocks, chunks and BLAS calls as :func:`_reactions` (with numpy's own cblas_dgemm, called
+    with the arguments its ``matmul`` passes), without the GIL and the per-block Python calls."""
+    W = np.ascontiguousarray(op.W, dtype=float)
+    n_el = op.n_nodes - 1
+    n_s = op.c.size - n_el
+    chunk = max(16, SINGLE_THREAD_WORK // W.size // 16 * 16)
+    nb = max(1, BLOCK_ROWS // chunk) * chunk
+    ch = 1
+    if L is not None:
+        ch = max(16, SINGLE_THREAD_WORK // X.size // 16 * 16)
+        nb = -(-nb // ch) * ch
+    runs = sorted(op.runs, key=lambda x: x[2])
+    node_of_free = np.concatenate([np.arange(lo, hi) for lo, hi, _ in runs])
+    run_lo, run_hi, run_f0 = (np.array([x[i] for x in runs], dtype=np.int64) for i in range(3))
+    Lc = np.zeros((1, 1)) if L is None else L
+    out = np.empty((m, W.shape[1]))
+    fns.so_history(dgemm, L is not None, np.zeros((1, 3)) if U is None else U,
+                   np.zeros((1, 3, 3)) if T is None else np.ascontiguousarray(T, dtype=float), T is not None,
+                   node_of_free, Lc, np.zeros((1, 1)) if X is None else X, run_lo, run_hi, run_f0, ch,
+                   np.zeros((ch, Lc.shape[1])), np.ascontiguousarray(op.ins_nodes, dtype=np.int64),
+                   np.ascontiguousarray(op.ins_frame, dtype=float), W, chunk, np.zeros((op.n_nodes, 3, nb)),
+                   np.empty((n_s, 3, nb)), np.zeros((W.shape[0], nb)), np.empty((3, nb)),
+                   np.empty((chunk, W.shape[1])), out)
+    return out
+
+
 def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None = None, *,
-                           passes=_AUTO) -> np.ndarray:
+                           passes=_AUTO, dgemm=_AUTO) -> np.ndarray:
     """[N] R_2 at every tower for free displacements U [m], shape (m, n_dof) -> (m, n_r).
 
     With ``T`` (per-node bases as columns, (n_free_nodes, 3, 3)) U holds the components u~ in
@@ -208,7 +246,9 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
     rounding (tests).  With the optional compiled kernel (``passes``: the kernel's by default
     when it is loaded, None for numpy) a block's elementwise work is three compiled calls with
     the same bits (:func:`linecheck.core._loops.so_nodes`, ``so_frame``, ``so_products``; the
-    3 x 3 products in the fused order of OpenBLAS's dgemm, verified when the kernel loads).
+    3 x 3 products in the fused order of OpenBLAS's dgemm, verified when the kernel loads), and
+    where numpy's own ``cblas_dgemm`` was found (``dgemm``: its address, the kernel's by default)
+    the whole block loop is one compiled call (:func:`_history`; the same BLAS calls, no GIL).
 
     Rows are processed in blocks of a fixed size that depends on the operator only (the last
     block padded with zeros), so every BLAS product always has the same shape: a row's result
@@ -219,6 +259,9 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
     n_f = U.shape[1] // 3
     pad = None
     fns = _passes(passes)
+    fp = _dgemm(dgemm, fns)
+    if fp is not None:
+        return _history(op, fns, fp, U.shape[0], U=np.ascontiguousarray(U, dtype=float), T=T)
     if fns is not None:
         Uc = np.ascontiguousarray(U, dtype=float)
         node_of_free = np.concatenate([np.arange(lo, hi) for lo, hi, _ in sorted(op.runs, key=lambda x: x[2])])
@@ -251,13 +294,18 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
     return _reactions(op, U.shape[0], fill)
 
 
-def second_order_of_loads(op: SecondOrder, L: np.ndarray, X: np.ndarray, *, passes=_AUTO) -> np.ndarray:
+def second_order_of_loads(op: SecondOrder, L: np.ndarray, X: np.ndarray, *, passes=_AUTO, dgemm=_AUTO) -> np.ndarray:
     """[N] R_2 of the quasi-static displacements u = X l of loads L [N], shape (m, n_l) ->
     (m, n_r); X [m/N] (n_dof, n_l) maps the loads to the free displacements (x, y, z per free
     node).  As :func:`second_order_reactions` of L X^T, without that history: each block's
     displacements are computed node-major, X L_block^T, straight into the work array, by BLAS
     products of a fixed shape (16 loads rows, whole micro-kernel tiles, one thread); the rest of
-    a block as there (``passes``)."""
+    a block as there (``passes``, ``dgemm``; the compiled block loop only for C-ordered L and X,
+    whose BLAS arguments it reproduces)."""
+    fns = _passes(passes)
+    fp = _dgemm(dgemm, fns)
+    if fp is not None and L.dtype == float and X.dtype == float and L.flags.c_contiguous and X.flags.c_contiguous:
+        return _history(op, fns, fp, L.shape[0], L=L, X=X)
     ch = max(16, SINGLE_THREAD_WORK // X.size // 16 * 16)
     zero = np.zeros((ch, L.shape[1]))
 
@@ -276,7 +324,7 @@ def second_order_of_loads(op: SecondOrder, L: np.ndarray, X: np.ndarray, *, pass
             for lo, hi, f0 in op.runs:
                 np.matmul(X[3 * f0:3 * (f0 + hi - lo)], Lc.T, out=u[lo:hi].reshape(3 * (hi - lo), nb)[:, j0:j1])
 
-    return _reactions(op, L.shape[0], fill, multiple=ch, fns=_passes(passes))
+    return _reactions(op, L.shape[0], fill, multiple=ch, fns=fns)
 
 
 def _reactions(op: SecondOrder, m: int, fill, multiple: int = 1, fns=None) -> np.ndarray:

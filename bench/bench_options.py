@@ -8,7 +8,7 @@ Run from the repository root:
 ``service.run_case`` of the six-span synoptic case (all 10 realizations, the paper's 600 s
 record, wind synthesis, burn-in and frequency-domain check included) with every combination of
 the two keys, timed in this process, interleaved in rounds (ABBA order, so that the machine's load affects all
-alike), ``--repeat`` rounds.  Ratios are to the paper's linear/linear run of the same case: the
+alike), ``--repeat`` rounds, on one thread and on the CLI's default threads (``--threads``).  Ratios are to the paper's linear/linear run of the same case: the
 ratio of the best times, and the median over the rounds of each round's ratio (the verdict).
 All four runs analyse the same record: the burn-in is derived once (linear/linear) and imposed
 (the derived burn-in can move by one step with the mean state, which changes the wind
@@ -40,6 +40,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from linecheck import service  # noqa: E402
+from linecheck.batch.executors import default_jobs  # noqa: E402
 from linecheck.core.case import load_case  # noqa: E402
 
 COMBOS = (("linear", "linear"), ("quadratic", "linear"), ("linear", "second-order"), ("quadratic", "second-order"))
@@ -51,6 +52,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--case", default="case09-six")
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--damping", default="quasi-steady", choices=("quasi-steady", "paper"))
+    ap.add_argument("--threads", type=int, nargs="+", default=[1, default_jobs()],
+                    help="realization threads of run_case; default: 1 and the CLI's default (the CPUs)")
     args = ap.parse_args(argv)
     base = load_case(ROOT / "cases" / "paper" / f"{args.case}.toml")
     ref = dataclasses.replace(base, analysis=dataclasses.replace(base.analysis, damping=args.damping))
@@ -64,18 +67,27 @@ def main(argv: list[str] | None = None) -> int:
           f"{os.getloadavg()[0]:.1f}; python {platform.python_version()}, numpy {np.__version__}")
     print(f"{args.case}: {base.analysis.realizations} realizations, damping = \"{args.damping}\", {args.repeat} rounds")
     service.run_case(cases[COMBOS[-1]], realizations=[0])  # warm-up (imports, first calls)
+    for threads in args.threads:
+        bench(cases, args.repeat, threads)
+    return 0
+
+
+def bench(cases: dict, repeat: int, threads: int) -> float:
+    """Time the four combinations in ``repeat`` rounds with ``threads``; print the table and the
+    verdict; return the median ratio of both options."""
     best = {c: np.inf for c in COMBOS}
     rounds = []  # per round: each combination's time over the linear run's of the same round
-    for r in range(args.repeat):
+    for r in range(repeat):
         order = COMBOS if r % 2 == 0 else COMBOS[::-1]  # ABBA: a drift of the machine's speed cancels
         times = {}
         for c in order:
             t0 = time.perf_counter()
-            service.run_case(cases[c])
+            service.run_case(cases[c], threads=threads)
             times[c] = time.perf_counter() - t0
             best[c] = min(best[c], times[c])
         rounds.append({c: times[c] / times[COMBOS[0]] for c in COMBOS})
     ref = best[COMBOS[0]]
+    print(f"\nthreads = {threads}:")
     print("| drag | tension | best time [s] | ratio of best | median ratio of the rounds (range) |")
     print("| --- | --- | ---: | ---: | ---: |")
     for c in COMBOS:
@@ -86,10 +98,10 @@ def main(argv: list[str] | None = None) -> int:
     # the verdict rests on the median of the paired ratios: the runs of a round are adjacent in
     # time, so a phase of this shared VM affects both; the ratio of two best times pairs runs
     # from different phases (docs/performance.md: the same code read +1 % and +29 % that way)
-    print(f"both options: +{100 * (both - 1):.1f} % (median of {args.repeat} rounds; target <= "
+    print(f"both options, {threads} thread(s): +{100 * (both - 1):.1f} % (median of {repeat} rounds; target <= "
           f"+{100 * (TARGET - 1):.0f} %): {'met' if both <= TARGET else 'NOT met'}; "
           f"load average now {os.getloadavg()[0]:.1f}")
-    return 0
+    return both
 
 
 if __name__ == "__main__":

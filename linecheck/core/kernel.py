@@ -16,7 +16,10 @@ peaks over time (:func:`history_reductions`: numpy sums along the time axis one 
 other, and so does the loop), and the second-order tension's elementwise passes per block of rows
 (:func:`second_order_passes`: the rotation out of the node bases, the insulators' frames and the
 products P of :func:`linecheck.core.second_order.reaction_form`, their 3 × 3 products as the fused
-multiply-add chain of OpenBLAS's dgemm kernel; the products P W stay BLAS's); without it (or with ``LINECHECK_KERNEL=numpy``) the numpy code runs.
+multiply-add chain of OpenBLAS's dgemm kernel; where numpy's own ``cblas_dgemm`` is found,
+:func:`second_order_dgemm`, the whole block loop with its BLAS products P W and X Lᵀ, called with
+the arguments numpy's ``matmul`` passes: the same bits, without the GIL that ``matmul`` keeps
+during a 2-D product); without it (or with ``LINECHECK_KERNEL=numpy``) the numpy code runs.
 Each compiled function is compared with its numpy form when the kernel loads; one that differs
 here is not used.
 

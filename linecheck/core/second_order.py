@@ -193,8 +193,10 @@ def _passes(passes):
     return passes
 
 
-def _dgemm(dgemm, fns):
-    if fns is None:
+def _dgemm(dgemm, fns, W: np.ndarray):
+    """numpy's cblas_dgemm for the compiled block loop, or None; only with a C-ordered float W
+    (the loop passes the leading dimension numpy's ``matmul`` takes for that layout)."""
+    if fns is None or W.dtype != float or not W.flags.c_contiguous:
         return None
     if dgemm is _AUTO:
         from . import kernel
@@ -207,7 +209,7 @@ def _history(op: SecondOrder, fns, dgemm: int, m: int, U=None, T=None, L=None, X
     """R_2 (m, n_r) by the compiled block loop (:func:`linecheck.core._loops.so_history`): the
     same blocks, chunks and BLAS calls as :func:`_reactions` (with numpy's own cblas_dgemm, called
     with the arguments its ``matmul`` passes), without the GIL and the per-block Python calls."""
-    W = np.ascontiguousarray(op.W, dtype=float)
+    W = op.W  # C-ordered float (_dgemm)
     n_el = op.n_nodes - 1
     n_s = op.c.size - n_el
     chunk = max(16, SINGLE_THREAD_WORK // W.size // 16 * 16)
@@ -259,7 +261,7 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
     n_f = U.shape[1] // 3
     pad = None
     fns = _passes(passes)
-    fp = _dgemm(dgemm, fns)
+    fp = _dgemm(dgemm, fns, op.W)
     if fp is not None:
         return _history(op, fns, fp, U.shape[0], U=np.ascontiguousarray(U, dtype=float), T=T)
     if fns is not None:
@@ -303,7 +305,7 @@ def second_order_of_loads(op: SecondOrder, L: np.ndarray, X: np.ndarray, *, pass
     a block as there (``passes``, ``dgemm``; the compiled block loop only for C-ordered L and X,
     whose BLAS arguments it reproduces)."""
     fns = _passes(passes)
-    fp = _dgemm(dgemm, fns)
+    fp = _dgemm(dgemm, fns, op.W)
     if fp is not None and L.dtype == float and X.dtype == float and L.flags.c_contiguous and X.flags.c_contiguous:
         return _history(op, fns, fp, L.shape[0], L=L, X=X)
     ch = max(16, SINGLE_THREAD_WORK // X.size // 16 * 16)

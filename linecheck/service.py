@@ -581,7 +581,8 @@ def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: n
         # 1/2 rho C_d D L V_n|V_n| / |V|^2 per unit (v^2 - sigma^2); sigma^2 = ratio |V|^2
         per_q = 0.5 * coef * model.tributary[None, :] * vn * np.abs(vn) * inv
         sig2 = ratio * speed2
-    if held:  # writeable views (np.broadcast_to's are read-only: another type for the compiled drag)
+    if held:  # writeable views, as the materialised factors (np.broadcast_to's are read-only: another
+        # array type, i.e. another specialisation of the compiled drag)
         def over_record(a: np.ndarray) -> np.ndarray:
             return np.lib.stride_tricks.as_strided(a, shape=shape, strides=(0, a.strides[1]))
 
@@ -598,8 +599,8 @@ def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: n
     sel = slice(int(free[0]), int(free[0]) + free.size) if run else free
     pv, pv_p = per_v[:, sel], per_v[:, pinned]
     if quad:
-        pq, s2 = np.broadcast_to(per_q, shape)[:, sel], np.broadcast_to(sig2, shape)[:, sel]
-        pq_p, s2_p = np.broadcast_to(per_q, shape)[:, pinned], np.broadcast_to(sig2, shape)[:, pinned]
+        pq, s2 = per_q[:, sel], sig2[:, sel]  # (n_steps, n_nodes), as per_v
+        pq_p, s2_p = per_q[:, pinned], sig2[:, pinned]
     # the same elementwise products as on every node, written straight into the loads (one
     # compiled pass when the kernel is loaded: the same bits, issue 20)
     kernel.drag_loads(pv, pq if quad else None, s2 if quad else None, v, sel, loads)

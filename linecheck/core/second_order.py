@@ -205,6 +205,14 @@ def _dgemm(dgemm, fns, W: np.ndarray):
     return dgemm
 
 
+def _free_layout(op: SecondOrder) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The global node of every free node (n_free_nodes,) and the runs' first node, end node and
+    first free index (n_runs,) each, as int64 arrays for the compiled passes."""
+    runs = sorted(op.runs, key=lambda x: x[2])
+    node_of_free = np.concatenate([np.arange(lo, hi) for lo, hi, _ in runs])
+    return (node_of_free,) + tuple(np.array([x[i] for x in runs], dtype=np.int64) for i in range(3))
+
+
 def _history(op: SecondOrder, fns, dgemm: int, m: int, U=None, T=None, L=None, X=None) -> np.ndarray:
     """R_2 (m, n_r) by the compiled block loop (:func:`linecheck.core._loops.so_history`): the
     same blocks, chunks and BLAS calls as :func:`_reactions` (with numpy's own cblas_dgemm, called
@@ -218,9 +226,7 @@ def _history(op: SecondOrder, fns, dgemm: int, m: int, U=None, T=None, L=None, X
     if L is not None:
         ch = max(16, SINGLE_THREAD_WORK // X.size // 16 * 16)
         nb = -(-nb // ch) * ch
-    runs = sorted(op.runs, key=lambda x: x[2])
-    node_of_free = np.concatenate([np.arange(lo, hi) for lo, hi, _ in runs])
-    run_lo, run_hi, run_f0 = (np.array([x[i] for x in runs], dtype=np.int64) for i in range(3))
+    node_of_free, run_lo, run_hi, run_f0 = _free_layout(op)
     Lc = np.zeros((1, 1)) if L is None else L
     out = np.empty((m, W.shape[1]))
     fns.so_history(dgemm, L is not None, np.zeros((1, 3)) if U is None else U,
@@ -266,7 +272,7 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
         return _history(op, fns, fp, U.shape[0], U=np.ascontiguousarray(U, dtype=float), T=T)
     if fns is not None:
         Uc = np.ascontiguousarray(U, dtype=float)
-        node_of_free = np.concatenate([np.arange(lo, hi) for lo, hi, _ in sorted(op.runs, key=lambda x: x[2])])
+        node_of_free = _free_layout(op)[0]
         Tc = np.zeros((1, 3, 3)) if T is None else np.ascontiguousarray(T, dtype=float)
 
         def fill(u: np.ndarray, i0: int, r: int) -> None:

@@ -239,21 +239,26 @@ def test_second_order_passes_same_bits():
     if blas.get("name") == "scipy-openblas" and "USE64BITINT" in str(blas.get("openblas configuration")):
         assert dgemm is not None
     L = rng.standard_normal((700, n_dof // 3)) * 50.0
-    X = rng.standard_normal((n_dof, n_dof // 3)) * 1e-4
+    L[[0, 300]] = 0.0
+    c = lapack.dpbtrf(model.K_band, lower=0)[0]
+    dirs = rng.standard_normal((n_dof // 3, 3))
+    dirs /= np.linalg.norm(dirs, axis=1)[:, None]
     for fp in (None, dgemm) if dgemm is not None else (None,):
         for t in (T, None):
             ref = second_order_reactions(op, U, t, passes=None, dgemm=None)
             got = second_order_reactions(op, U, t, passes=fns, dgemm=fp)
             assert np.array_equal(got, ref) and np.array_equal(np.signbit(got), np.signbit(ref))
-        ref = second_order_of_loads(op, L, X, passes=None, dgemm=None)
-        assert np.array_equal(second_order_of_loads(op, L, X, passes=fns, dgemm=fp), ref)
-        assert np.abs(ref).max() > 0.0
+        for d in (None, dirs):
+            ref = second_order_of_loads(op, L, c, d, passes=None, dgemm=None)
+            got = second_order_of_loads(op, L, c, d, passes=fns, dgemm=fp)
+            assert np.array_equal(got, ref) and np.array_equal(np.signbit(got), np.signbit(ref))
+            assert np.abs(ref).max() > 0.0
         # a tower of interest's three columns (a scan): other chunk and block sizes
         op3 = dataclasses.replace(op, A=np.ascontiguousarray(op.A[:, 9:12]), W=np.ascontiguousarray(op.W[:, 9:12]))
         ref = second_order_reactions(op3, U, T, passes=None, dgemm=None)
         assert np.array_equal(second_order_reactions(op3, U, T, passes=fns, dgemm=fp), ref)
-        ref = second_order_of_loads(op3, L, X, passes=None, dgemm=None)
-        assert np.array_equal(second_order_of_loads(op3, L, X, passes=fns, dgemm=fp), ref)
+        ref = second_order_of_loads(op3, L, c, dirs, passes=None, dgemm=None)
+        assert np.array_equal(second_order_of_loads(op3, L, c, dirs, passes=fns, dgemm=fp), ref)
 
 
 @needs_kernel

@@ -18,7 +18,7 @@ from numba import types
 from numba.extending import intrinsic
 
 __all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "drag_loads", "field_radius", "field_velocity", "from_lanes", "history_reductions", "phasors", "quad_kms", "reactions_into",
-           "rest_product", "rotate", "rowdot", "so_frame", "so_history", "so_nodes", "so_products", "solve_columns", "span_terms",
+           "rest_product", "rotate", "rowdot", "so_frame", "so_history", "so_nodes", "so_products", "so_solve", "solve_columns", "span_terms",
            "steps", "steps_1", "to_lanes"]
 
 
@@ -639,31 +639,44 @@ def so_frame(u, ins_nodes, frame, li):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, nogil=True)
-def so_products(u, li, P, d):  # pragma: no cover - compiled
-    """P (6 n_el + 3 n_s, nb) of second_order._reactions: every cable element's six products of
-    du = u[e + 1] - u[e] (xx, yy, zz, xy, yz, xz), every insulator's a s, a w, s^2 + w^2 from
-    li = (a, s, w); each product and sum rounded by itself, as numpy's ufuncs (no contraction).
-    d: scratch (3, nb) (one row of P at a time vectorises; measured 2x the six rows at once)."""
+def so_products(u, ec, li, P, d):  # pragma: no cover - compiled
+    """P (3 n_el + 3 n_s, nb) of second_order._reactions: every cable element's second-order
+    force per unit c, a d + q e (d = u[e + 1] - u[e], a = e.d, q = |d|^2/2 - 3 a^2/2; ec (n_el, 3)
+    the unit chords), every insulator's a s, a w, s^2 + w^2 from li = (a, s, w); each product
+    and sum rounded by itself in the numpy form's order (no contraction).  d: scratch (5, nb)
+    for d, a and q: one output row per loop vectorises (a loop writing three rows did not: too
+    many possible overlaps for LLVM's run-time checks; measured 2.5x)."""
     n_el = u.shape[0] - 1
     nb = u.shape[2]
+    d0 = d[0]
+    d1 = d[1]
+    d2 = d[2]
+    a = d[3]
+    q = d[4]
     for e in range(n_el):
+        e0 = ec[e, 0]
+        e1 = ec[e, 1]
+        e2 = ec[e, 2]
         for c in range(3):
+            ua = u[e, c]
+            ub = u[e + 1, c]
+            dc = d[c]
             for j in range(nb):
-                d[c, j] = u[e + 1, c, j] - u[e, c, j]
-        b = 6 * e
+                dc[j] = ub[j] - ua[j]
         for j in range(nb):
-            P[b, j] = d[0, j] * d[0, j]
+            a[j] = d0[j] * e0 + d1[j] * e1 + d2[j] * e2
         for j in range(nb):
-            P[b + 1, j] = d[1, j] * d[1, j]
+            q[j] = 0.5 * (d0[j] * d0[j] + d1[j] * d1[j] + d2[j] * d2[j]) - 1.5 * (a[j] * a[j])
+        p = P[3 * e]
         for j in range(nb):
-            P[b + 2, j] = d[2, j] * d[2, j]
+            p[j] = a[j] * d0[j] + q[j] * e0
+        p = P[3 * e + 1]
         for j in range(nb):
-            P[b + 3, j] = d[0, j] * d[1, j]
+            p[j] = a[j] * d1[j] + q[j] * e1
+        p = P[3 * e + 2]
         for j in range(nb):
-            P[b + 4, j] = d[1, j] * d[2, j]
-        for j in range(nb):
-            P[b + 5, j] = d[0, j] * d[2, j]
-    b0 = 6 * n_el
+            p[j] = a[j] * d2[j] + q[j] * e2
+    b0 = 3 * n_el
     for s in range(li.shape[0]):
         b = b0 + 3 * s
         for j in range(nb):
@@ -672,6 +685,97 @@ def so_products(u, li, P, d):  # pragma: no cover - compiled
             P[b + 1, j] = li[s, 0, j] * li[s, 2, j]
         for j in range(nb):
             P[b + 2, j] = li[s, 1, j] * li[s, 1, j] + li[s, 2, j] * li[s, 2, j]
+
+
+@numba.njit(cache=True, nogil=True)
+def so_solve(c, inv, L, dirs, straight, i0, r, y, s):  # pragma: no cover - compiled
+    """The quasi-static displacements of the load rows i0 <= i < i0 + r of L (m, n_free) into
+    y (n_dof, nb), lane j = row i0 + j (lanes >= r solve zeros): the right-hand sides (global y,
+    or along ``dirs`` (n_free, 3) when not ``straight``), then U^T U x = b by rows of lanes (c
+    the upper band of dpbtrf, inv = 1 / its diagonal; s scratch (nb,)); every operation rounded
+    by itself in second_order._band_solve_rows' order (no contraction), so the same bits.  The
+    rows with the core's full half-bandwidth (5) in one pass, the band's sum in a register
+    (2-D indexing: with row views LLVM's overlap checks kept it 3x slower, measured)."""
+    kd = c.shape[0] - 1
+    n = c.shape[1]
+    nb = y.shape[1]
+    nf = L.shape[1]
+    for i in range(nf):  # the right-hand sides: L's rows into lanes, in tiles of 8 rows (L1)
+        for q in range(3):
+            if straight and q != 1:
+                for j in range(nb):
+                    y[3 * i + q, j] = 0.0
+            else:
+                for j in range(r, nb):
+                    y[3 * i + q, j] = 0.0
+    for j0 in range(0, r, 8):
+        j1 = min(j0 + 8, r)
+        for i in range(nf):
+            if straight:
+                for j in range(j0, j1):
+                    y[3 * i + 1, j] = L[i0 + j, i]
+            else:
+                for q in range(3):
+                    dq = dirs[i, q]
+                    for j in range(j0, j1):
+                        y[3 * i + q, j] = L[i0 + j, i] * dq
+    # the rows that read five unknowns in the register form: j >= j5 forward, j <= jb back
+    # (loop bounds, not a flag: a loop under ``if flag:`` did not vectorise, measured 2.8x)
+    j5 = 5 if kd == 5 and n > 5 else n
+    jb = n - 6 if j5 < n else -1
+    for j in range(j5):  # U^T y = b
+        k = min(j, kd)
+        w = inv[j]
+        if k > 0:
+            cij = c[kd - k, j]
+            for l in range(nb):
+                s[l] = cij * y[j - k, l]
+            for t in range(1, k):
+                cij = c[kd - k + t, j]
+                for l in range(nb):
+                    s[l] = s[l] + cij * y[j - k + t, l]
+            for l in range(nb):
+                y[j, l] = (y[j, l] - s[l]) * w
+        else:
+            for l in range(nb):
+                y[j, l] = y[j, l] * w
+    for j in range(j5, n):
+        c0 = c[0, j]
+        c1 = c[1, j]
+        c2 = c[2, j]
+        c3 = c[3, j]
+        c4 = c[4, j]
+        w = inv[j]
+        for l in range(nb):
+            y[j, l] = (y[j, l] - (c0 * y[j - 5, l] + c1 * y[j - 4, l] + c2 * y[j - 3, l] + c3 * y[j - 2, l]
+                                  + c4 * y[j - 1, l])) * w
+    for j in range(n - 1, jb, -1):  # U x = y
+        k = min(n - 1 - j, kd)
+        w = inv[j]
+        if k > 0:
+            cji = c[kd - 1, j + 1]
+            for l in range(nb):
+                s[l] = cji * y[j + 1, l]
+            for t in range(2, k + 1):
+                cji = c[kd - t, j + t]
+                for l in range(nb):
+                    s[l] = s[l] + cji * y[j + t, l]
+            for l in range(nb):
+                y[j, l] = (y[j, l] - s[l]) * w
+        else:
+            for l in range(nb):
+                y[j, l] = y[j, l] * w
+    for jj in range(jb + 1):
+        j = jb - jj
+        c0 = c[4, j + 1]
+        c1 = c[3, j + 2]
+        c2 = c[2, j + 3]
+        c3 = c[1, j + 4]
+        c4 = c[0, j + 5]
+        w = inv[j]
+        for l in range(nb):
+            y[j, l] = (y[j, l] - (c0 * y[j + 1, l] + c1 * y[j + 2, l] + c2 * y[j + 3, l] + c3 * y[j + 4, l]
+                                  + c4 * y[j + 5, l])) * w
 
 
 @intrinsic
@@ -697,46 +801,33 @@ _TRANS = np.int32(112)
 
 
 @numba.njit(cache=True, nogil=True)
-def so_history(fp, of_loads, U, T, rotate_, node_of_free, L, X, run_lo, run_hi, run_f0, ch, Lpad,
-               ins_nodes, frame, W, chunk, u, li, P, d, tmp, out):  # pragma: no cover - compiled
+def so_history(fp, of_loads, U, T, rotate_, node_of_free, L, c, inv, dirs, straight, y, sc, run_lo, run_hi,
+               run_f0, ins_nodes, frame, ec, W, chunk, u, li, P, d, tmp, out):  # pragma: no cover - compiled
     """second_order._reactions in one call (issue 16): per block of nb = u.shape[2] rows the
-    displacements (``of_loads``: X L_block^T by the BLAS at ``fp`` in ch-row chunks, the last one
-    padded from Lpad, one call per run of free nodes; else so_nodes of U), so_frame, so_products
-    and P W by that BLAS in ``chunk``-row products (a padded last one through ``tmp``) — every
-    BLAS call with the arguments numpy's ``matmul`` passes for the same arrays, so the same bits."""
+    displacements (``of_loads``: so_solve of the block's loads into y, copied run by run of free
+    nodes; else so_nodes of U), so_frame, so_products and P W by the BLAS at ``fp`` in
+    ``chunk``-row products (a padded last one through ``tmp``) — every BLAS call with the
+    arguments numpy's ``matmul`` passes for the same arrays, so the same bits."""
     m = out.shape[0]
     nb = u.shape[2]
     nr = W.shape[1]
     npw = W.shape[0]
-    nl = L.shape[1]
     for i0 in range(0, m, nb):
         i1 = min(i0 + nb, m)
         r = i1 - i0
         if not of_loads:
             so_nodes(U[i0:i1], r, T, node_of_free, rotate_, u)
         else:
-            for j0 in range(0, nb, ch):
-                j1 = j0 + ch
-                if j0 >= r:
-                    for a in range(u.shape[0]):
-                        for c in range(3):
-                            for j in range(j0, nb):
-                                u[a, c, j] = 0.0
-                    break
-                if j1 > r:
-                    for q in range(ch):
-                        for c in range(nl):
-                            Lpad[q, c] = L[i0 + j0 + q, c] if q < r - j0 else 0.0
-                    src = Lpad
-                else:
-                    src = L[i0 + j0:i0 + j1]
-                for g in range(run_lo.size):
-                    lo = run_lo[g]
-                    hi = run_hi[g]
-                    _dgemm64(fp, _NO_TRANS, _TRANS, 3 * (hi - lo), ch, nl, X[3 * run_f0[g]:].ctypes.data, nl,
-                             src.ctypes.data, nl, u[lo:hi, :, j0:].ctypes.data, nb)
+            so_solve(c, inv, L, dirs, straight, i0, r, y, sc)
+            for g in range(run_lo.size):
+                for a in range(run_hi[g] - run_lo[g]):
+                    for k in range(3):
+                        src = y[3 * (run_f0[g] + a) + k]
+                        dst = u[run_lo[g] + a, k]
+                        for j in range(nb):
+                            dst[j] = src[j]
         so_frame(u, ins_nodes, frame, li)
-        so_products(u, li, P, d)
+        so_products(u, ec, li, P, d)
         for j0 in range(0, r, chunk):
             if j0 + chunk <= r:
                 _dgemm64(fp, _TRANS, _NO_TRANS, chunk, nr, npw, P[:, j0:].ctypes.data, nb, W.ctypes.data, nr,
@@ -745,5 +836,5 @@ def so_history(fp, of_loads, U, T, rotate_, node_of_free, L, X, run_lo, run_hi, 
                 _dgemm64(fp, _TRANS, _NO_TRANS, chunk, nr, npw, P[:, j0:].ctypes.data, nb, W.ctypes.data, nr,
                          tmp.ctypes.data, nr)
                 for q in range(r - j0):
-                    for c in range(nr):
-                        out[i0 + j0 + q, c] = tmp[q, c]
+                    for cc in range(nr):
+                        out[i0 + j0 + q, cc] = tmp[q, cc]

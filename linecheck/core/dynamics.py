@@ -220,14 +220,6 @@ def integrate(
             GT = models[k].G.T
             TB = np.ascontiguousarray(from_ydof(kernel.solve_columns(c, np.array(GT, order="F")) if compiled
                                                 else _solve(c, np.asfortranarray(GT))))  # (n_free, n_r)
-            if second_order is not None:  # (K^-1 P)^T: the y-loads to the quasi-static displacements
-                E = np.zeros((n_dof, n_free), order="F")
-                if load_dirs is None:
-                    E[ydof, np.arange(n_free)] = 1.0
-                else:
-                    for comp in range(3):
-                        E[3 * np.arange(n_free) + comp, np.arange(n_free)] = load_dirs[:, comp]
-                X = np.ascontiguousarray(_solve(c, E))  # (n_dof, n_free)
             all_steps = np.flatnonzero(state_of_step == k)
             for i0 in range(0, all_steps.size, chunk):
                 steps = all_steps[i0:i0 + chunk]
@@ -235,8 +227,9 @@ def integrate(
                     loads[steps].reshape(-1, n_free), TB).reshape(steps.size, n_real, n_r)
                 sk = steps[steps >= second_order_start]
                 if second_order is not None and sk.size:  # the quasi-static displacements themselves
-                    R_B[sk] += second_order_of_loads(second_order[k], loads[sk].reshape(-1, n_free), X).reshape(
-                        sk.size, n_real, n_r)
+                    # the quasi-static displacements K^-1 (loads along y or load_dirs) by the band factor
+                    R_B[sk] += second_order_of_loads(second_order[k], loads[sk].reshape(-1, n_free), c,
+                                                     load_dirs).reshape(sk.size, n_real, n_r)
     else:
         for n in range(n_steps):
             m, _ = model_of(n)

@@ -14,12 +14,14 @@ downburst's 250 mean states at once, their sums over the Gauss points left to nu
 ``matmul``, so the same BLAS sums them), and after the steps the statistics' r.m.s. values and
 peaks over time (:func:`history_reductions`: numpy sums along the time axis one sample after the
 other, and so does the loop), and the second-order tension's elementwise passes per block of rows
-(:func:`second_order_passes`: the rotation out of the node bases, the insulators' frames and the
-products P of :func:`linecheck.core.second_order.reaction_form`, their 3 × 3 products as the fused
-multiply-add chain of OpenBLAS's dgemm kernel; where numpy's own ``cblas_dgemm`` is found,
-:func:`second_order_dgemm`, the whole block loop with its BLAS products P W and X Lᵀ, called with
-the arguments numpy's ``matmul`` passes: the same bits, without the GIL that ``matmul`` keeps
-during a 2-D product); without it (or with ``LINECHECK_KERNEL=numpy``) the numpy code runs.
+(:func:`second_order_passes`: the rotation out of the node bases, the insulators' frames, the
+terms P of :func:`linecheck.core.second_order.reaction_form` and step 3's banded solve of the
+loads by rows of lanes (``_loops.so_solve``, the order of ``second_order._band_solve_rows``), their
+3 × 3 products as the fused multiply-add chain of OpenBLAS's dgemm kernel; where numpy's own
+``cblas_dgemm`` is found, :func:`second_order_dgemm`, the whole block loop with its BLAS products
+P W, called with the arguments numpy's ``matmul`` passes: the same bits, without the GIL that
+``matmul`` keeps during a 2-D product); without it (or with ``LINECHECK_KERNEL=numpy``) the numpy
+code runs.
 Each compiled function is compared with its numpy form when the kernel loads; one that differs
 here is not used.
 
@@ -435,30 +437,42 @@ def _second_order_test(fns, dgemm: int | None = None) -> bool:
     ``dgemm`` (numpy's cblas_dgemm) the whole block loop of ``_loops.so_history`` is compared."""
     from types import SimpleNamespace
 
+    from scipy.linalg import lapack
+
     from .second_order import second_order_of_loads, second_order_reactions
 
     rng = np.random.default_rng(28)
     n_nodes, n_s, n_r = 21, 3, 7
     free = np.r_[1:10, 11:20]  # nodes 0, 10 and 20 pinned
     n_el = n_nodes - 1
+    e = rng.standard_normal((n_el + n_s, 3))
     op = SimpleNamespace(
         n_nodes=n_nodes, c=np.ones(n_el + n_s), runs=((1, 10, 0), (11, 20, 9)),
+        e=(e / np.linalg.norm(e, axis=1)[:, None]).ravel(),
         ins_nodes=np.array([5, 12, 17]), ins_frame=np.linalg.qr(rng.standard_normal((n_s, 3, 3)))[0],
-        W=rng.standard_normal((6 * n_el + 3 * n_s, n_r)) * 1e3)
+        W=rng.standard_normal((3 * n_el + 3 * n_s, n_r)) * 1e3)
     T = np.linalg.qr(rng.standard_normal((free.size, 3, 3)))[0]
     U = rng.standard_normal((300, 3 * free.size)) * 0.2
     U[[0, 7, 150]] = 0.0
     U[:, 4] = -0.0
     L = rng.standard_normal((150, free.size))
-    X = rng.standard_normal((3 * free.size, free.size)) * 1e-3
+    L[[3, 90]] = 0.0
+    kd, n = 5, 3 * free.size  # a banded stiffness's factor (dpbtrf, upper)
+    ab = rng.uniform(-1.0, 1.0, (kd + 1, n)) * 1e3
+    ab[kd] = 1e4 * (kd + 1) * (1.0 + rng.uniform(0.0, 1.0, n))
+    c = lapack.dpbtrf(ab, lower=0)[0]
+    dirs = rng.standard_normal((free.size, 3))
+    dirs /= np.linalg.norm(dirs, axis=1)[:, None]
     ok = True
     for t in (T, None):
         ref = second_order_reactions(op, U, t, passes=None, dgemm=None)
         got = second_order_reactions(op, U, t, passes=fns, dgemm=dgemm)
         ok &= bool(np.array_equal(ref, got) and np.array_equal(np.signbit(ref), np.signbit(got)))
-    ref = second_order_of_loads(op, L, X, passes=None, dgemm=None)
-    got = second_order_of_loads(op, L, X, passes=fns, dgemm=dgemm)
-    return ok and bool(np.array_equal(ref, got) and np.array_equal(np.signbit(ref), np.signbit(got)))
+    for d in (None, dirs):
+        ref = second_order_of_loads(op, L, c, d, passes=None, dgemm=None)
+        got = second_order_of_loads(op, L, c, d, passes=fns, dgemm=dgemm)
+        ok &= bool(np.array_equal(ref, got) and np.array_equal(np.signbit(ref), np.signbit(got)))
+    return ok
 
 
 def _numpy_cblas_dgemm() -> int | None:

@@ -56,8 +56,8 @@ class SecondOrder:
         ins_free: index among the free nodes of every suspension attachment, (n_s,).
         A: [-] member second-order forces -> reactions: the support terms S f2 minus the
             p_2 -> G K^-1 p_2 transfer (Z = K^-1 G^T, module docstring), shape (3 n_m, n_r).
-        W: [N/m^2] the same map from products of the members' du: R_2 = P W, shape
-            (6 n_el + 3 n_s, n_r) (:func:`reaction_form`).
+        W: [N/m^2] the same map from the members' second-order terms P: R_2 = P W, shape
+            (3 n_el + 3 n_s, n_r) (:func:`reaction_form`).
         ins_nodes: global node of every suspension attachment, (n_s,).
         ins_frame: [-] rows (e, t1, t2) of every insulator's orthonormal frame, (n_s, 3, 3).
     """
@@ -129,41 +129,31 @@ def second_order_operator(model: LinearModel, state: StaticState) -> SecondOrder
                        np.ascontiguousarray(A), W, system.tower_nodes[sus].copy(), frame)
 
 
-_PAIRS = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2))  # products of du's components in P
-
-
 def reaction_form(e: np.ndarray, c: np.ndarray, A: np.ndarray, n_el: int) -> tuple[np.ndarray, np.ndarray]:
-    """[N/m^2] W (6 n_el + 3 n_s, n_r) such that R_2 = P W, and the insulators' frames.
+    """[N/m^2] W (3 n_el + 3 n_s, n_r) such that R_2 = P W, and the insulators' frames.
 
-    P holds per row, member-major: for every cable element the six products (xx, yy, zz, xy,
-    yz, xz; _PAIRS) of its du's components; for every insulator (a s, a w, s^2 + w^2), with
-    (a, s, w) = F du its components in its frame F = (e, t1, t2) (rows; returned, (n_s, 3, 3)).
+    P holds per row, member-major: for every cable element its second-order force per unit c,
+    f2/c = a du + q e (x, y, z; a = e.du, q = |du|^2/2 - 3 a^2/2, the module docstring's f2);
+    for every insulator (a s, a w, s^2 + w^2), with (a, s, w) = F du its components in its
+    frame F = (e, t1, t2) (rows; returned, (n_s, 3, 3)).
 
-    With g_r a member's 3 rows of A (component-major, (3 n_m, n_r)) and h_r = e.g_r, the
-    module docstring's f2 = c [a du + q e], a = e.du, q = |du|^2/2 - 3 a^2/2, gives
-    f2.g_r = c [a (g_r.du) + q h_r]:
-    * a cable element: the quadratic form du^T Q_r du, Q_r = c [(e g_r^T + g_r e^T)/2
-      + h_r I/2 - 3 h_r e e^T/2] (W: Q_kk for the squares, 2 Q_kl for the cross products);
+    With g_r a member's 3 rows of A (component-major, (3 n_m, n_r)) and h_r = e.g_r:
+    * a cable element: f2.g_r = c (a du + q e).g_r, so its three rows of W are c g_r (paper
+      Eq. 7's element law; the member-force form: 3 rows per element, where the six products
+      of du's components would need 6);
     * an insulator: with du = a e + s t1 + w t2, g_r.du = h_r a + (g_r.t1) s + (g_r.t2) w and
       q = (s^2 + w^2)/2 - a^2, so the a^2 terms cancel exactly:
       f2.g_r = c [(g_r.t1) a s + (g_r.t2) a w + h_r (s^2 + w^2)/2].  Its c is ~10^4 times a
       cable element's (rigid insulator) and a stays ~10^-5 |du| (it swings about its fixed
-      point): the expanded quadratic form in x, y, z would lose that to rounding (~3 times the
-      rounding error of f2 A), the frame keeps a computed first, as f2 A does.
+      point): a du + q e in x, y, z would carry the rounding of q e (~|du|^2) times that c, the
+      frame keeps the products of a instead.
     e: unit chords (n_m, 3); c: (n_m,); the first n_el members are the cable elements.
     """
     n_m = c.size
     g = A.reshape(3, n_m, -1)  # (component, member, reaction)
     h = np.einsum("mk,kmr->mr", e, g)
     el = slice(0, n_el)
-    Wq = np.empty((6, n_el, A.shape[1]))
-    for s, (k, l) in enumerate(_PAIRS):
-        ek, el_ = e[el, k, None], e[el, l, None]
-        if k == l:
-            Wq[s] = ek * g[k, el] + h[el] * (0.5 - 1.5 * ek**2)
-        else:
-            Wq[s] = ek * g[l, el] + el_ * g[k, el] - 3.0 * h[el] * (ek * el_)
-        Wq[s] *= c[el, None]
+    Wq = g[:, el].transpose(1, 0, 2) * c[el, None, None]  # (n_el, 3, n_r): c g_r
     ei = e[n_el:]
     helper = np.where(np.abs(ei[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
     t1 = np.cross(ei, helper)
@@ -174,7 +164,7 @@ def reaction_form(e: np.ndarray, c: np.ndarray, A: np.ndarray, n_el: int) -> tup
     ci = c[n_el:, None]
     Wi = np.stack([ci * np.einsum("sk,ksr->sr", t1, gi), ci * np.einsum("sk,ksr->sr", t2, gi), 0.5 * ci * h[n_el:]],
                   axis=1)  # (n_s, 3, n_r)
-    W = np.concatenate([Wq.transpose(1, 0, 2).reshape(6 * n_el, -1), Wi.reshape(3 * (n_m - n_el), A.shape[1])])
+    W = np.concatenate([Wq.reshape(3 * n_el, -1), Wi.reshape(3 * (n_m - n_el), A.shape[1])])
     return W, frame
 
 
@@ -213,29 +203,34 @@ def _free_layout(op: SecondOrder) -> tuple[np.ndarray, np.ndarray, np.ndarray, n
     return (node_of_free,) + tuple(np.array([x[i] for x in runs], dtype=np.int64) for i in range(3))
 
 
-def _history(op: SecondOrder, fns, dgemm: int, m: int, U=None, T=None, L=None, X=None) -> np.ndarray:
+def _ec(op: SecondOrder) -> np.ndarray:
+    """The cable elements' unit chords (n_el, 3), C-ordered."""
+    return np.ascontiguousarray(op.e[:3 * (op.n_nodes - 1)].reshape(-1, 3))
+
+
+def _history(op: SecondOrder, fns, dgemm: int, m: int, U=None, T=None, loads=None) -> np.ndarray:
     """R_2 (m, n_r) by the compiled block loop (:func:`linecheck.core._loops.so_history`): the
     same blocks, chunks and BLAS calls as :func:`_reactions` (with numpy's own cblas_dgemm, called
-    with the arguments its ``matmul`` passes), without the GIL and the per-block Python calls."""
+    with the arguments its ``matmul`` passes), without the GIL and the per-block Python calls;
+    ``loads`` = (L, c, inv, dirs) of :func:`second_order_of_loads`."""
     W = op.W  # C-ordered float (_dgemm)
     n_el = op.n_nodes - 1
     n_s = op.c.size - n_el
     chunk = max(16, SINGLE_THREAD_WORK // W.size // 16 * 16)
     nb = max(1, BLOCK_ROWS // chunk) * chunk
-    ch = 1
-    if L is not None:
-        ch = max(16, SINGLE_THREAD_WORK // X.size // 16 * 16)
-        nb = -(-nb // ch) * ch
     node_of_free, run_lo, run_hi, run_f0 = _free_layout(op)
-    Lc = np.zeros((1, 1)) if L is None else L
+    if loads is None:
+        L, c, inv, dirs, y = np.zeros((1, 1)), np.zeros((1, 1)), np.zeros(1), np.zeros((1, 3)), np.zeros((1, nb))
+    else:
+        L, c, inv, dirs = loads
+        y = np.empty((c.shape[1], nb))
     out = np.empty((m, W.shape[1]))
-    fns.so_history(dgemm, L is not None, np.zeros((1, 3)) if U is None else U,
+    fns.so_history(dgemm, loads is not None, np.zeros((1, 3)) if U is None else U,
                    np.zeros((1, 3, 3)) if T is None else np.ascontiguousarray(T, dtype=float), T is not None,
-                   node_of_free, Lc, np.zeros((1, 1)) if X is None else X, run_lo, run_hi, run_f0, ch,
-                   np.zeros((ch, Lc.shape[1])), np.ascontiguousarray(op.ins_nodes, dtype=np.int64),
-                   np.ascontiguousarray(op.ins_frame, dtype=float), W, chunk, np.zeros((op.n_nodes, 3, nb)),
-                   np.empty((n_s, 3, nb)), np.zeros((W.shape[0], nb)), np.empty((3, nb)),
-                   np.empty((chunk, W.shape[1])), out)
+                   node_of_free, L, c, inv, np.zeros((1, 3)) if dirs is None else dirs, dirs is None, y,
+                   np.empty(nb), run_lo, run_hi, run_f0, np.ascontiguousarray(op.ins_nodes, dtype=np.int64),
+                   np.ascontiguousarray(op.ins_frame, dtype=float), _ec(op), W, chunk, np.zeros((op.n_nodes, 3, nb)),
+                   np.empty((n_s, 3, nb)), np.zeros((W.shape[0], nb)), np.empty((5, nb)), np.empty((chunk, W.shape[1])), out)
     return out
 
 
@@ -248,15 +243,15 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
 
     R_2 = P W (:func:`reaction_form`), block by block of rows: the displacements go node-major
     into a preallocated (n_nodes, 3, rows) array (rotated by one batched 3x3 product per node),
-    the members' du by one slice difference, their products into P (transposed, (6 n_el +
-    3 n_s, rows)), and P W by BLAS: a dozen numpy calls per block with ``out=`` instead of the
-    ~45 elementwise passes of building f2 and multiplying by A; results equal the latter to
-    rounding (tests).  With the optional compiled kernel (``passes``: the kernel's by default
-    when it is loaded, None for numpy) a block's elementwise work is three compiled calls with
-    the same bits (:func:`linecheck.core._loops.so_nodes`, ``so_frame``, ``so_products``; the
-    3 x 3 products in the fused order of OpenBLAS's dgemm, verified when the kernel loads), and
-    where numpy's own ``cblas_dgemm`` was found (``dgemm``: its address, the kernel's by default)
-    the whole block loop is one compiled call (:func:`_history`; the same BLAS calls, no GIL).
+    the members' second-order terms into P (transposed, (3 n_el + 3 n_s, rows)), and P W by
+    BLAS: a dozen numpy calls per block with ``out=`` instead of the ~45 elementwise passes of
+    building f2 and multiplying by A; results equal the latter to rounding (tests).  With the
+    optional compiled kernel (``passes``: the kernel's by default when it is loaded, None for
+    numpy) a block's elementwise work is three compiled calls with the same bits
+    (:func:`linecheck.core._loops.so_nodes`, ``so_frame``, ``so_products``; the 3 x 3 products
+    in the fused order of OpenBLAS's dgemm, verified when the kernel loads), and where numpy's
+    own ``cblas_dgemm`` was found (``dgemm``: its address, the kernel's by default) the whole
+    block loop is one compiled call (:func:`_history`; the same BLAS calls, no GIL).
 
     Rows are processed in blocks of a fixed size that depends on the operator only (the last
     block padded with zeros), so every BLAS product always has the same shape: a row's result
@@ -302,40 +297,98 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
     return _reactions(op, U.shape[0], fill)
 
 
-def second_order_of_loads(op: SecondOrder, L: np.ndarray, X: np.ndarray, *, passes=_AUTO, dgemm=_AUTO) -> np.ndarray:
-    """[N] R_2 of the quasi-static displacements u = X l of loads L [N], shape (m, n_l) ->
-    (m, n_r); X [m/N] (n_dof, n_l) maps the loads to the free displacements (x, y, z per free
-    node).  As :func:`second_order_reactions` of L X^T, without that history: each block's
-    displacements are computed node-major, X L_block^T, straight into the work array, by BLAS
-    products of a fixed shape (16 loads rows, whole micro-kernel tiles, one thread); the rest of
-    a block as there (``passes``, ``dgemm``; the compiled block loop only for C-ordered L and X,
-    whose BLAS arguments it reproduces)."""
+SOLVE_COLUMNS = 8192  # load rows per numpy band solve (:func:`_band_solve_rows`; the bits do not depend on it)
+
+
+def _band_solve_rows(c: np.ndarray, inv: np.ndarray, Y: np.ndarray) -> None:
+    """U^T U x = y in place for every column of Y (n_dof, m) (c: the upper band of dpbtrf, inv =
+    1 / its diagonal): the forward and back substitutions row by row of dofs, each a few
+    elementwise operations over all columns (a dot product of the band per row, rounded product
+    by product, then (y - s) inv; no contraction), the order of the compiled
+    :func:`linecheck.core._loops.so_solve`, so the same bits."""
+    kd = c.shape[0] - 1
+    n = c.shape[1]
+    s = np.empty(Y.shape[1])
+    t = np.empty(Y.shape[1])
+    for j in range(n):  # U^T y = b
+        k = min(j, kd)
+        if k > 0:
+            np.multiply(c[kd - k, j], Y[j - k], out=s)
+            for q in range(1, k):
+                np.multiply(c[kd - k + q, j], Y[j - k + q], out=t)
+                s += t
+            Y[j] -= s
+        Y[j] *= inv[j]
+    for j in range(n - 1, -1, -1):  # U x = y
+        k = min(n - 1 - j, kd)
+        if k > 0:
+            np.multiply(c[kd - 1, j + 1], Y[j + 1], out=s)
+            for q in range(2, k + 1):
+                np.multiply(c[kd - q, j + q], Y[j + q], out=t)
+                s += t
+            Y[j] -= s
+        Y[j] *= inv[j]
+
+
+def second_order_of_loads(op: SecondOrder, L: np.ndarray, c: np.ndarray, dirs: np.ndarray | None = None, *,
+                          passes=_AUTO, dgemm=_AUTO) -> np.ndarray:
+    """[N] R_2 of the quasi-static displacements u = K^-1 b of loads L [N], shape (m, n_free)
+    -> (m, n_r): b the load of free node i along global y (``dirs`` None) or along dirs[i]
+    ((n_free, 3), unit), K = U^T U with c [N/m] its upper band factor as ``dpbtrf`` returns it
+    (kd + 1, n_dof).  As :func:`second_order_reactions` of the solved displacements: each block
+    of rows is solved by the band (forward and back substitution over rows of lanes, ≈ 4 kd
+    multiply-adds per dof and row instead of the n_free of a dense K^-1; :func:`_band_solve_rows`,
+    compiled as ``_loops.so_solve``) straight into the node-major work array; the rest of a
+    block as there (``passes``, ``dgemm``)."""
     fns = _passes(passes)
     fp = _dgemm(dgemm, fns, op.W)
-    if fp is not None and L.dtype == float and X.dtype == float and L.flags.c_contiguous and X.flags.c_contiguous:
-        return _history(op, fns, fp, L.shape[0], L=L, X=X)
-    ch = max(16, SINGLE_THREAD_WORK // X.size // 16 * 16)
-    zero = np.zeros((ch, L.shape[1]))
+    c = np.ascontiguousarray(c, dtype=float)
+    inv = 1.0 / c[-1]
+    Dc = None if dirs is None else np.ascontiguousarray(dirs, dtype=float)
+    if fp is not None:
+        return _history(op, fns, fp, L.shape[0], loads=(np.ascontiguousarray(L, dtype=float), c, inv, Dc))
+    n_dof = c.shape[1]
+    if fns is not None:
+        Lc = np.ascontiguousarray(L, dtype=float)
+        y = np.empty((n_dof, 1))
+        sc = np.empty(1)
+        runs = _free_layout(op)[1:]
+
+        def fill(u: np.ndarray, i0: int, r: int) -> None:
+            nonlocal y, sc
+            nb = u.shape[2]
+            if y.shape[1] != nb:
+                y, sc = np.empty((n_dof, nb)), np.empty(nb)
+            fns.so_solve(c, inv, Lc, np.zeros((1, 3)) if Dc is None else Dc, Dc is None, i0, r, y, sc)
+            for lo, hi, f0 in zip(*runs):
+                u[lo:hi] = y[3 * f0:3 * (f0 + hi - lo)].reshape(hi - lo, 3, nb)
+
+        return _reactions(op, L.shape[0], fill, fns=fns)
+    state = {"i0": 0, "Y": np.empty((n_dof, 0))}
 
     def fill(u: np.ndarray, i0: int, r: int) -> None:
         nb = u.shape[2]
-        for j0 in range(0, nb, ch):
-            j1 = j0 + ch
-            if j0 >= r:
-                u[:, :, j0:] = 0.0
-                break
-            Lc = L[i0 + j0:i0 + j1]
-            if j1 > r:  # padded: the product keeps its shape
-                zero[: r - j0] = Lc
-                zero[r - j0:] = 0.0
-                Lc = zero
-            for lo, hi, f0 in op.runs:
-                np.matmul(X[3 * f0:3 * (f0 + hi - lo)], Lc.T, out=u[lo:hi].reshape(3 * (hi - lo), nb)[:, j0:j1])
+        Y = state["Y"]
+        if not state["i0"] <= i0 < state["i0"] + Y.shape[1] - r + 1:  # solve the next columns
+            m1 = min(L.shape[0], i0 + max(SOLVE_COLUMNS, nb))
+            Lb = L[i0:m1].T  # (n_free, cols)
+            Y = np.zeros((n_dof, m1 - i0))
+            if Dc is None:
+                Y[1::3] = Lb
+            else:
+                Y.reshape(-1, 3, m1 - i0)[...] = Lb[:, None, :] * Dc[:, :, None]
+            _band_solve_rows(c, inv, Y)
+            state.update(i0=i0, Y=Y)
+        j = i0 - state["i0"]
+        for lo, hi, f0 in op.runs:
+            u[lo:hi, :, :r] = Y[3 * f0:3 * (f0 + hi - lo), j:j + r].reshape(hi - lo, 3, r)
+        if r < nb:
+            u[:, :, r:] = 0.0
 
-    return _reactions(op, L.shape[0], fill, multiple=ch, fns=fns)
+    return _reactions(op, L.shape[0], fill)
 
 
-def _reactions(op: SecondOrder, m: int, fill, multiple: int = 1, fns=None) -> np.ndarray:
+def _reactions(op: SecondOrder, m: int, fill, fns=None) -> np.ndarray:
     """R_2 (m, n_r) of m rows of displacements that ``fill(u, i0, r)`` writes node-major into
     u[:, :, :r] (global x, y, z; (n_nodes, 3, nb)), zeroing u[:, :, r:] (docstrings above);
     ``fns`` the compiled passes or None (numpy, the same bits)."""
@@ -345,18 +398,22 @@ def _reactions(op: SecondOrder, m: int, fill, multiple: int = 1, fns=None) -> np
     # whole micro-kernel tiles: with 23-row blocks the edge rows' kernel rounded a column differently
     chunk = max(16, SINGLE_THREAD_WORK // W.size // 16 * 16)
     nb = max(1, BLOCK_ROWS // chunk) * chunk  # rows of one elementwise pass: arrays stay in cache
-    nb = -(-nb // multiple) * multiple
     u = np.zeros((op.n_nodes, 3, nb))  # pinned nodes stay zero
     P = np.zeros((W.shape[0], nb))  # padding columns stay zero
     li = np.empty((n_s, 3, nb))
+    ec = _ec(op)
     if fns is None:
         d = np.empty((n_el, 3, nb))
-        Pq = P[:6 * n_el].reshape(n_el, 6, nb)  # cable elements: the six products
-        Pi = P[6 * n_el:].reshape(n_s, 3, nb)  # insulators: a s, a w, s^2 + w^2
+        a = np.empty((n_el, nb))
+        q = np.empty((n_el, nb))
+        t = np.empty((n_el, nb))
+        E = [ec[:, k, None] for k in range(3)]  # (n_el, 1) each
+        Pq = P[:3 * n_el].reshape(n_el, 3, nb)  # cable elements: a du + q e
+        Pi = P[3 * n_el:].reshape(n_s, 3, nb)  # insulators: a s, a w, s^2 + w^2
         di = np.empty((n_s, 3, nb))
         sq = np.empty((n_s, 2, nb))
     else:
-        d = np.empty((3, nb))
+        d = np.empty((5, nb))
         ins_nodes = np.ascontiguousarray(op.ins_nodes, dtype=np.int64)
         frame = np.ascontiguousarray(op.ins_frame, dtype=float)
     out = np.empty((m, W.shape[1]))
@@ -366,12 +423,27 @@ def _reactions(op: SecondOrder, m: int, fill, multiple: int = 1, fns=None) -> np
         fill(u, i0, r)
         if fns is not None:  # the same operations, compiled (_loops.so_frame, so_products)
             fns.so_frame(u, ins_nodes, frame, li)
-            fns.so_products(u, li, P, d)
-        else:
-            np.subtract(u[1:], u[:-1], out=d)  # cable elements: u_b - u_a
-            np.multiply(d, d, out=Pq[:, :3])  # cable elements: products of du's components (_PAIRS)
-            np.multiply(d[:, :2], d[:, 1:], out=Pq[:, 3:5])
-            np.multiply(d[:, 0], d[:, 2], out=Pq[:, 5])
+            fns.so_products(u, ec, li, P, d)
+        else:  # cable elements (reaction_form): the order of _loops.so_products, op by op
+            np.subtract(u[1:], u[:-1], out=d)  # du = u_b - u_a
+            np.multiply(d[:, 0], E[0], out=a)  # a = e.du
+            np.multiply(d[:, 1], E[1], out=t)
+            a += t
+            np.multiply(d[:, 2], E[2], out=t)
+            a += t
+            np.multiply(d[:, 0], d[:, 0], out=q)  # q = |du|^2/2 - 3 a^2/2
+            np.multiply(d[:, 1], d[:, 1], out=t)
+            q += t
+            np.multiply(d[:, 2], d[:, 2], out=t)
+            q += t
+            q *= 0.5
+            np.multiply(a, a, out=t)
+            t *= 1.5
+            q -= t
+            for k in range(3):  # a du + q e
+                np.multiply(a, d[:, k], out=Pq[:, k])
+                np.multiply(q, E[k], out=t)
+                Pq[:, k] += t
             np.take(u, op.ins_nodes, axis=0, out=di)  # insulators: the fixed point does not move
             np.matmul(op.ins_frame, di, out=li)  # (a, s, w) in the insulator's frame
             np.multiply(li[:, :1], li[:, 1:], out=Pi[:, :2])  # a s, a w

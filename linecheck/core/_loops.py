@@ -18,7 +18,7 @@ from numba import types
 from numba.extending import intrinsic
 
 __all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "drag_loads", "field_radius", "field_velocity", "from_lanes", "history_reductions", "phasors", "quad_kms", "reactions_into",
-           "rest_product", "rotate", "rowdot", "so_frame", "so_history", "so_nodes", "so_products", "so_solve", "solve_columns", "span_terms",
+           "rest_product", "rotate", "rowdot", "so_frame", "so_history", "so_nodes", "so_place", "so_products", "so_solve", "solve_columns", "span_terms",
            "steps", "steps_1", "to_lanes"]
 
 
@@ -688,42 +688,55 @@ def so_products(u, ec, li, P, d):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, nogil=True)
-def so_solve(c, inv, L, dirs, straight, i0, r, y, s):  # pragma: no cover - compiled
-    """The quasi-static displacements of the load rows i0 <= i < i0 + r of L (m, n_free) into
-    y (n_dof, nb), lane j = row i0 + j (lanes >= r solve zeros): the right-hand sides (global y,
-    or along ``dirs`` (n_free, 3) when not ``straight``), then U^T U x = b by rows of lanes (c
-    the upper band of dpbtrf, inv = 1 / its diagonal; s scratch (nb,)); every operation rounded
-    by itself in second_order._band_solve_rows' order (no contraction), so the same bits.  The
-    rows with the core's full half-bandwidth (5) in one pass, the band's sum in a register
-    (2-D indexing: with row views LLVM's overlap checks kept it 3x slower, measured)."""
+def _rhs(Lt, dirs, straight, j, y):  # pragma: no cover - compiled
+    """Row j of the right-hand sides into y[j]: load i = j // 3 of Lt (n_free, nb) along global
+    y (``straight``) or along dirs[i], as second_order._band_solve_rows' caller places them."""
+    i = j // 3
+    q = j - 3 * i
+    nb = y.shape[1]
+    if straight:
+        if q == 1:
+            for l in range(nb):
+                y[j, l] = Lt[i, l]
+        else:
+            for l in range(nb):
+                y[j, l] = 0.0
+    else:
+        dq = dirs[i, q]
+        for l in range(nb):
+            y[j, l] = Lt[i, l] * dq
+
+
+@numba.njit(cache=True, nogil=True)
+def so_solve(c, inv, L, dirs, straight, i0, r, y, xr, s, Lt):  # pragma: no cover - compiled
+    """The quasi-static displacements of the load rows i0 <= i < i0 + r of L (m, n_free), lane
+    j = row i0 + j (lanes >= r solve zeros): the right-hand sides (global y, or along ``dirs``
+    (n_free, 3) when not ``straight``), then U^T U x = b by rows of lanes (c the upper band of
+    dpbtrf, inv = 1 / its diagonal); x returned in xr (n_dof, nb) in reversed row order,
+    xr[n - 1 - j] = x_j.  Every operation rounded by itself in second_order._band_solve_rows'
+    order (no contraction), so the same bits.  y (n_dof, nb), s (nb,), Lt (n_free, nb): scratch.
+
+    Speed (measured, docs/performance.md): the rows with the core's full half-bandwidth (5) in
+    one pass, the band's sum in a register and the load placed in the same pass (no zeroed
+    right-hand side), 2-D indexing (row views kept LLVM's overlap checks: 3x slower), loop bounds
+    rather than a flag around the loop (it did not vectorise: 2.8x), and the back substitution
+    written upward into xr (reading the rows just written below the one written; reading the rows
+    above it in place ran 2x slower)."""
     kd = c.shape[0] - 1
     n = c.shape[1]
     nb = y.shape[1]
     nf = L.shape[1]
-    for i in range(nf):  # the right-hand sides: L's rows into lanes, in tiles of 8 rows (L1)
-        for q in range(3):
-            if straight and q != 1:
-                for j in range(nb):
-                    y[3 * i + q, j] = 0.0
-            else:
-                for j in range(r, nb):
-                    y[3 * i + q, j] = 0.0
-    for j0 in range(0, r, 8):
-        j1 = min(j0 + 8, r)
+    Lb = L[i0:i0 + r]
+    for j in range(r):  # L's rows into lanes (row by row: 1.6x faster than in tiles, measured)
         for i in range(nf):
-            if straight:
-                for j in range(j0, j1):
-                    y[3 * i + 1, j] = L[i0 + j, i]
-            else:
-                for q in range(3):
-                    dq = dirs[i, q]
-                    for j in range(j0, j1):
-                        y[3 * i + q, j] = L[i0 + j, i] * dq
-    # the rows that read five unknowns in the register form: j >= j5 forward, j <= jb back
-    # (loop bounds, not a flag: a loop under ``if flag:`` did not vectorise, measured 2.8x)
+            Lt[i, j] = Lb[j, i]
+    for i in range(nf):
+        for j in range(r, nb):
+            Lt[i, j] = 0.0
+    # the rows in the register form: j >= j5 forward, n - 1 - j >= jb5 back
     j5 = 5 if kd == 5 and n > 5 else n
-    jb = n - 6 if j5 < n else -1
     for j in range(j5):  # U^T y = b
+        _rhs(Lt, dirs, straight, j, y)
         k = min(j, kd)
         w = inv[j]
         if k > 0:
@@ -746,27 +759,41 @@ def so_solve(c, inv, L, dirs, straight, i0, r, y, s):  # pragma: no cover - comp
         c3 = c[3, j]
         c4 = c[4, j]
         w = inv[j]
-        for l in range(nb):
-            y[j, l] = (y[j, l] - (c0 * y[j - 5, l] + c1 * y[j - 4, l] + c2 * y[j - 3, l] + c3 * y[j - 2, l]
+        i = j // 3
+        q = j - 3 * i
+        if not straight:
+            dq = dirs[i, q]
+            for l in range(nb):
+                y[j, l] = (Lt[i, l] * dq - (c0 * y[j - 5, l] + c1 * y[j - 4, l] + c2 * y[j - 3, l] + c3 * y[j - 2, l]
+                                            + c4 * y[j - 1, l])) * w
+        elif q == 1:
+            for l in range(nb):
+                y[j, l] = (Lt[i, l] - (c0 * y[j - 5, l] + c1 * y[j - 4, l] + c2 * y[j - 3, l] + c3 * y[j - 2, l]
+                                       + c4 * y[j - 1, l])) * w
+        else:
+            for l in range(nb):
+                y[j, l] = (0.0 - (c0 * y[j - 5, l] + c1 * y[j - 4, l] + c2 * y[j - 3, l] + c3 * y[j - 2, l]
                                   + c4 * y[j - 1, l])) * w
-    for j in range(n - 1, jb, -1):  # U x = y
-        k = min(n - 1 - j, kd)
+    jb5 = 5 if j5 < n else n
+    for jr in range(jb5):  # U x = y, x_j = xr[jr], j = n - 1 - jr
+        j = n - 1 - jr
+        k = min(jr, kd)
         w = inv[j]
         if k > 0:
             cji = c[kd - 1, j + 1]
             for l in range(nb):
-                s[l] = cji * y[j + 1, l]
+                s[l] = cji * xr[jr - 1, l]
             for t in range(2, k + 1):
                 cji = c[kd - t, j + t]
                 for l in range(nb):
-                    s[l] = s[l] + cji * y[j + t, l]
+                    s[l] = s[l] + cji * xr[jr - t, l]
             for l in range(nb):
-                y[j, l] = (y[j, l] - s[l]) * w
+                xr[jr, l] = (y[j, l] - s[l]) * w
         else:
             for l in range(nb):
-                y[j, l] = y[j, l] * w
-    for jj in range(jb + 1):
-        j = jb - jj
+                xr[jr, l] = y[j, l] * w
+    for jr in range(jb5, n):
+        j = n - 1 - jr
         c0 = c[4, j + 1]
         c1 = c[3, j + 2]
         c2 = c[2, j + 3]
@@ -774,8 +801,8 @@ def so_solve(c, inv, L, dirs, straight, i0, r, y, s):  # pragma: no cover - comp
         c4 = c[0, j + 5]
         w = inv[j]
         for l in range(nb):
-            y[j, l] = (y[j, l] - (c0 * y[j + 1, l] + c1 * y[j + 2, l] + c2 * y[j + 3, l] + c3 * y[j + 4, l]
-                                  + c4 * y[j + 5, l])) * w
+            xr[jr, l] = (y[j, l] - (c0 * xr[jr - 1, l] + c1 * xr[jr - 2, l] + c2 * xr[jr - 3, l] + c3 * xr[jr - 4, l]
+                                    + c4 * xr[jr - 5, l])) * w
 
 
 @intrinsic
@@ -801,11 +828,26 @@ _TRANS = np.int32(112)
 
 
 @numba.njit(cache=True, nogil=True)
-def so_history(fp, of_loads, U, T, rotate_, node_of_free, L, c, inv, dirs, straight, y, sc, run_lo, run_hi,
-               run_f0, ins_nodes, frame, ec, W, chunk, u, li, P, d, tmp, out):  # pragma: no cover - compiled
+def so_place(xr, run_lo, run_hi, run_f0, u):  # pragma: no cover - compiled
+    """u[node, k] (n_nodes, 3, nb) of the free nodes from so_solve's xr (reversed rows: dof
+    3 f + k of free node f is row n_dof - 1 - 3 f - k), run by run of free nodes."""
+    n = xr.shape[0]
+    nb = xr.shape[1]
+    for g in range(run_lo.size):
+        for a in range(run_hi[g] - run_lo[g]):
+            for k in range(3):
+                src = xr[n - 1 - 3 * (run_f0[g] + a) - k]
+                dst = u[run_lo[g] + a, k]
+                for j in range(nb):
+                    dst[j] = src[j]
+
+
+@numba.njit(cache=True, nogil=True)
+def so_history(fp, of_loads, U, T, rotate_, node_of_free, L, c, inv, dirs, straight, y, xr, sc, Lt, run_lo,
+               run_hi, run_f0, ins_nodes, frame, ec, W, chunk, u, li, P, d, tmp, out):  # pragma: no cover - compiled
     """second_order._reactions in one call (issue 16): per block of nb = u.shape[2] rows the
-    displacements (``of_loads``: so_solve of the block's loads into y, copied run by run of free
-    nodes; else so_nodes of U), so_frame, so_products and P W by the BLAS at ``fp`` in
+    displacements (``of_loads``: so_solve of the block's loads, placed run by run of free nodes by
+    so_place; else so_nodes of U), so_frame, so_products and P W by the BLAS at ``fp`` in
     ``chunk``-row products (a padded last one through ``tmp``) — every BLAS call with the
     arguments numpy's ``matmul`` passes for the same arrays, so the same bits."""
     m = out.shape[0]
@@ -818,14 +860,8 @@ def so_history(fp, of_loads, U, T, rotate_, node_of_free, L, c, inv, dirs, strai
         if not of_loads:
             so_nodes(U[i0:i1], r, T, node_of_free, rotate_, u)
         else:
-            so_solve(c, inv, L, dirs, straight, i0, r, y, sc)
-            for g in range(run_lo.size):
-                for a in range(run_hi[g] - run_lo[g]):
-                    for k in range(3):
-                        src = y[3 * (run_f0[g] + a) + k]
-                        dst = u[run_lo[g] + a, k]
-                        for j in range(nb):
-                            dst[j] = src[j]
+            so_solve(c, inv, L, dirs, straight, i0, r, y, xr, sc, Lt)
+            so_place(xr, run_lo, run_hi, run_f0, u)
         so_frame(u, ins_nodes, frame, li)
         so_products(u, ec, li, P, d)
         for j0 in range(0, r, chunk):

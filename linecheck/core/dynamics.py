@@ -227,9 +227,11 @@ def integrate(
                     loads[steps].reshape(-1, n_free), TB).reshape(steps.size, n_real, n_r)
                 sk = steps[steps >= second_order_start]
                 if second_order is not None and sk.size:  # the quasi-static displacements themselves
-                    # the quasi-static displacements K^-1 (loads along y or load_dirs) by the band factor
-                    R_B[sk] += second_order_of_loads(second_order[k], loads[sk].reshape(-1, n_free), c,
-                                                     load_dirs).reshape(sk.size, n_real, n_r)
+                    # K^-1 (loads along y or load_dirs) by the band factor; a run of consecutive
+                    # steps (one mean state) as a view of the loads, not a copy
+                    run = slice(int(sk[0]), int(sk[-1]) + 1) if sk[-1] - sk[0] + 1 == sk.size else sk
+                    R_B[run] += second_order_of_loads(second_order[k], loads[run].reshape(-1, n_free), c,
+                                                      load_dirs).reshape(sk.size, n_real, n_r)
     else:
         for n in range(n_steps):
             m, _ = model_of(n)

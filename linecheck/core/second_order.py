@@ -228,7 +228,7 @@ def _history(op: SecondOrder, fns, dgemm: int, m: int, U=None, T=None, loads=Non
     fns.so_history(dgemm, loads is not None, np.zeros((1, 3)) if U is None else U,
                    np.zeros((1, 3, 3)) if T is None else np.ascontiguousarray(T, dtype=float), T is not None,
                    node_of_free, L, c, inv, np.zeros((1, 3)) if dirs is None else dirs, dirs is None, y,
-                   np.empty(nb), run_lo, run_hi, run_f0, np.ascontiguousarray(op.ins_nodes, dtype=np.int64),
+                   np.empty_like(y), np.empty(nb), np.empty((L.shape[1], nb)), run_lo, run_hi, run_f0, np.ascontiguousarray(op.ins_nodes, dtype=np.int64),
                    np.ascontiguousarray(op.ins_frame, dtype=float), _ec(op), W, chunk, np.zeros((op.n_nodes, 3, nb)),
                    np.empty((n_s, 3, nb)), np.zeros((W.shape[0], nb)), np.empty((5, nb)), np.empty((chunk, W.shape[1])), out)
     return out
@@ -350,18 +350,17 @@ def second_order_of_loads(op: SecondOrder, L: np.ndarray, c: np.ndarray, dirs: n
     n_dof = c.shape[1]
     if fns is not None:
         Lc = np.ascontiguousarray(L, dtype=float)
-        y = np.empty((n_dof, 1))
-        sc = np.empty(1)
-        runs = _free_layout(op)[1:]
+        work = {}
+        run_lo, run_hi, run_f0 = _free_layout(op)[1:]
+        D3 = np.zeros((1, 3)) if Dc is None else Dc
 
         def fill(u: np.ndarray, i0: int, r: int) -> None:
-            nonlocal y, sc
             nb = u.shape[2]
-            if y.shape[1] != nb:
-                y, sc = np.empty((n_dof, nb)), np.empty(nb)
-            fns.so_solve(c, inv, Lc, np.zeros((1, 3)) if Dc is None else Dc, Dc is None, i0, r, y, sc)
-            for lo, hi, f0 in zip(*runs):
-                u[lo:hi] = y[3 * f0:3 * (f0 + hi - lo)].reshape(hi - lo, 3, nb)
+            if not work:
+                work.update(y=np.empty((n_dof, nb)), xr=np.empty((n_dof, nb)), s=np.empty(nb),
+                            Lt=np.empty((Lc.shape[1], nb)))
+            fns.so_solve(c, inv, Lc, D3, Dc is None, i0, r, work["y"], work["xr"], work["s"], work["Lt"])
+            fns.so_place(work["xr"], run_lo, run_hi, run_f0, u)
 
         return _reactions(op, L.shape[0], fill, fns=fns)
     state = {"i0": 0, "Y": np.empty((n_dof, 0))}

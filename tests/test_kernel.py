@@ -201,13 +201,13 @@ def test_section_second_order_same_bits(monkeypatch):
     """A 12-span section (load directions along the span normals) with second-order tension."""
     case = _short(CASES / "examples" / "section-12span.toml", duration=60.0, tension="second-order")
     got, fps = [], []
-    passes, dgemm = kernel.second_order_passes, kernel.second_order_dgemm
+    passes, gemm = kernel.second_order_passes, kernel.second_order_sgemm
     monkeypatch.setattr(kernel, "second_order_passes", lambda: got.append(passes()) or got[-1])
-    monkeypatch.setattr(kernel, "second_order_dgemm", lambda: fps.append(dgemm()) or fps[-1])
+    monkeypatch.setattr(kernel, "second_order_sgemm", lambda: fps.append(gemm()) or fps[-1])
     fast, slow = _both(monkeypatch, case, realizations=[0, 1])
     n_compiled = sum(p is not None for p in got)
     assert n_compiled > 0 and n_compiled < len(got)  # the compiled passes ran in the first run only
-    assert fps and (kernel._state.get("dgemm") is None or all(fp is not None for fp in fps))  # and the block loop
+    assert fps and (kernel._state.get("sgemm") is None or all(fp is not None for fp in fps))  # and the block loop
     assert np.array_equal(fast.resonant, slow.resonant)
     assert np.array_equal(fast.background, slow.background)
 
@@ -215,7 +215,7 @@ def test_section_second_order_same_bits(monkeypatch):
 @needs_kernel
 def test_second_order_passes_same_bits():
     """The compiled second-order passes (issue 16: rotation out of the node bases, insulator
-    frames, the products P) and the compiled block loop with numpy's own cblas_dgemm give the numpy
+    frames, the products P) and the compiled block loop with numpy's own cblas_sgemm give the numpy
     passes' bits on case09-six's operator: the Newmark history in node bases, global
     displacements, and the quasi-static displacements of loads, with a padded last block, rows of
     zeros and negative zeros, all reactions and a tower's three."""
@@ -235,30 +235,37 @@ def test_second_order_passes_same_bits():
     T = np.linalg.qr(rng.standard_normal((n_dof // 3, 3, 3)))[0]
     # numpy's own wheels (scipy-openblas, 64-bit integers): the whole block loop is compiled too
     blas = np.show_config(mode="dicts")["Build Dependencies"]["blas"]
-    dgemm = kernel.second_order_dgemm()
+    gemm = kernel.second_order_sgemm()
     if blas.get("name") == "scipy-openblas" and "USE64BITINT" in str(blas.get("openblas configuration")):
-        assert dgemm is not None
+        assert gemm is not None
     L = rng.standard_normal((700, n_dof // 3)) * 50.0
     L[[0, 300]] = 0.0
     c = lapack.dpbtrf(model.K_band, lower=0)[0]
     dirs = rng.standard_normal((n_dof // 3, 3))
     dirs /= np.linalg.norm(dirs, axis=1)[:, None]
-    for fp in (None, dgemm) if dgemm is not None else (None,):
+    for fp in (None, gemm) if gemm is not None else (None,):
         for t in (T, None):
-            ref = second_order_reactions(op, U, t, passes=None, dgemm=None)
-            got = second_order_reactions(op, U, t, passes=fns, dgemm=fp)
+            ref = second_order_reactions(op, U, t, passes=None, gemm=None)
+            got = second_order_reactions(op, U, t, passes=fns, gemm=fp)
             assert np.array_equal(got, ref) and np.array_equal(np.signbit(got), np.signbit(ref))
+            # the compiled Newmark loop's dof-major history (a column block of it, as dynamics passes)
+            H = np.zeros((n_dof, U.shape[0] + 40))
+            H[:, 20:-20] = U.T
+            got = second_order_reactions(op, H[:, 20:-20], t, transposed=True, passes=fns, gemm=fp)
+            assert np.array_equal(got, ref) and np.array_equal(np.signbit(got), np.signbit(ref))
+            assert np.array_equal(second_order_reactions(op, H[:, 20:-20], t, transposed=True, passes=None,
+                                                         gemm=None), ref)
         for d in (None, dirs):
-            ref = second_order_of_loads(op, L, c, d, passes=None, dgemm=None)
-            got = second_order_of_loads(op, L, c, d, passes=fns, dgemm=fp)
+            ref = second_order_of_loads(op, L, c, d, passes=None, gemm=None)
+            got = second_order_of_loads(op, L, c, d, passes=fns, gemm=fp)
             assert np.array_equal(got, ref) and np.array_equal(np.signbit(got), np.signbit(ref))
             assert np.abs(ref).max() > 0.0
         # a tower of interest's three columns (a scan): other chunk and block sizes
         op3 = dataclasses.replace(op, A=np.ascontiguousarray(op.A[:, 9:12]), W=np.ascontiguousarray(op.W[:, 9:12]))
-        ref = second_order_reactions(op3, U, T, passes=None, dgemm=None)
-        assert np.array_equal(second_order_reactions(op3, U, T, passes=fns, dgemm=fp), ref)
-        ref = second_order_of_loads(op3, L, c, dirs, passes=None, dgemm=None)
-        assert np.array_equal(second_order_of_loads(op3, L, c, dirs, passes=fns, dgemm=fp), ref)
+        ref = second_order_reactions(op3, U, T, passes=None, gemm=None)
+        assert np.array_equal(second_order_reactions(op3, U, T, passes=fns, gemm=fp), ref)
+        ref = second_order_of_loads(op3, L, c, dirs, passes=None, gemm=None)
+        assert np.array_equal(second_order_of_loads(op3, L, c, dirs, passes=fns, gemm=fp), ref)
 
 
 @needs_kernel

@@ -59,20 +59,24 @@ def test_sparse_reactions_are_the_full_product_bit_for_bit():
     np.testing.assert_allclose(got, U @ G.T, rtol=1e-12, atol=1e-12)
 
 
-@pytest.mark.parametrize("name, options", [
-    ("paper/case09-six.toml", {}),
-    ("examples/section-12span.toml", {"tension": "second-order", "drag": "quadratic"}),
+@pytest.mark.parametrize("name, options, rtol", [
+    ("paper/case09-six.toml", {}, 1e-9),
+    ("examples/section-12span.toml", {"tension": "second-order", "drag": "quadratic"}, 1e-8),
 ])
-def test_background_by_banded_solves_equals_the_static_transfer(monkeypatch, name, options):
+def test_background_by_banded_solves_equals_the_static_transfer(monkeypatch, name, options, rtol):
     """Step 3 of a long line solves K u_B = P l every step; on a system where both run it agrees
-    with the static transfer matrix to rounding (measured 3e-12 .. 2e-11 of the largest value)."""
+    with the static transfer matrix to rounding (measured 3e-12 .. 2e-11 of the largest value).
+    With the second-order tension the two paths' displacements (global solve, or the band solve
+    of second_order_of_loads) differ in their last bits, and R_2's float32 product (issue 16:
+    terms rounded to 6e-8) can round a term differently: measured 1.3e-9 of the largest
+    value, hence 1e-8 there."""
     case = case_of(name, realizations=2, duration=120.0, **options)
     a = service.run_case(case, spectral_check=False)
     monkeypatch.setattr(dynamics, "BACKGROUND_SOLVE_DOF", 0)
     b = service.run_case(case, spectral_check=False)
     for key in ("background", "resonant"):
         x, y = getattr(a, key), getattr(b, key)
-        assert np.abs(x - y).max() <= 1e-9 * np.abs(x).max()
+        assert np.abs(x - y).max() <= rtol * np.abs(x).max()
 
 
 def test_sparse_lowest_frequency_matches_the_dense_eigensolver(monkeypatch):

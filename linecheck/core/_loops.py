@@ -18,7 +18,7 @@ from numba import types
 from numba.extending import intrinsic
 
 __all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "drag_loads", "field_radius", "field_velocity", "from_lanes", "history_reductions", "phasors", "quad_kms", "reactions_into",
-           "rest_product", "rotate", "rowdot", "so_frame", "so_history", "so_nodes", "so_place", "so_products", "so_solve", "solve_columns", "span_terms",
+           "rest_product", "rotate", "rowdot", "so_frame", "so_history", "so_nodes", "so_nodes_t", "so_place", "so_products", "so_solve", "solve_columns", "span_terms",
            "steps", "steps_1", "to_lanes"]
 
 
@@ -244,7 +244,7 @@ def steps_1(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, band, a1,
             out, nz, GT, cols, R):  # pragma: no cover - compiled
     """:func:`steps` for one realization (U, V, A of shape (1, n_dof)): plain vectors."""
     n_b, _, n_free = loads.shape
-    keep = out.shape[0] > 0  # the states after every step, for the second-order tension
+    keep = out.shape[1] > 0  # the states after every step, for the second-order tension (dof-major)
     n = U.shape[1]
     u = U[0]
     v = V[0]
@@ -272,7 +272,7 @@ def steps_1(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, band, a1,
             v[d] = vn
             u[d] = b[d]
             if keep:
-                out[k, 0, d] = b[d]
+                out[d, k] = b[d]
         reactions_into(u, nz, GT, cols, R[k, 0])
 
 
@@ -282,12 +282,13 @@ def steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, band, a1,
     """Newmark steps of one block; U, V, A updated in place.
 
     U, V, A (n_real, n_dof) rotated state; loads (n_b, n_real, n_free) [N]; ycoef
-    (n_free, 3); out (n_b, n_real, n_dof) receives u after every step (not written when
-    out has no rows: only the second-order tension reads it); R (n_b, n_real, n_r)
+    (n_free, 3); out (n_dof, >= n_b n_real) receives u after every step, dof-major (column
+    k n_real + r: realization r after step k; not written when out has no columns: only the
+    second-order tension reads it, second_order_reactions(transposed=True)); R (n_b, n_real, n_r)
     the reactions G u, summed coordinate by coordinate from zero over the columns
     [cols[i, 0], cols[i, 1]) of GT's row i (the order of dynamics._sparse_reactions)."""
     n_b, m, n_free = loads.shape
-    keep = out.shape[0] > 0  # the states after every step, for the second-order tension
+    keep = out.shape[1] > 0  # the states after every step, for the second-order tension
     n = U.shape[1]
     u = to_lanes(U)  # lane l of group g is realization 4 g + l (padding lanes stay 0)
     v = to_lanes(V)
@@ -327,8 +328,11 @@ def steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, band, a1,
                     ag[d, l] = (vn - vg[d, l]) * r2 - ag[d, l]
                     vg[d, l] = vn
                     ug[d, l] = bg[d, l]
-        if keep:
-            from_lanes(u, out[k])
+        if keep:  # dof-major: column k m + r is realization r after step k (a row's m values at once)
+            c0 = k * m
+            for d in range(n):
+                for r in range(m):
+                    out[d, c0 + r] = u[r // 4, d, r % 4]
         for r in range(m):
             reactions_into(u[r // 4, :, r % 4], nz, GT, cols, R[k, r])
     from_lanes(u, U)
@@ -622,6 +626,35 @@ def so_nodes(U, r, T, node_of_free, rotate_, u):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, nogil=True, fastmath={"contract"})
+def so_nodes_t(U, i0, r, T, node_of_free, rotate_, u):  # pragma: no cover - compiled
+    """so_nodes of the rows i0 <= j < i0 + r stored as columns, U (3 n_f, m) (the compiled Newmark
+    loop's dof-major history): the same values, the same fused chain, read along the rows."""
+    nb = u.shape[2]
+    for f in range(node_of_free.size):
+        node = node_of_free[f]
+        x0 = U[3 * f]
+        x1 = U[3 * f + 1]
+        x2 = U[3 * f + 2]
+        for k in range(3):
+            row = u[node, k]
+            if rotate_:
+                t0 = T[f, k, 0]
+                t1 = T[f, k, 1]
+                t2 = T[f, k, 2]
+                for j in range(r):
+                    acc = 0.0 + t0 * x0[i0 + j]
+                    acc = acc + t1 * x1[i0 + j]
+                    acc = acc + t2 * x2[i0 + j]
+                    row[j] = acc + 0.0
+            else:
+                xk = U[3 * f + k]
+                for j in range(r):
+                    row[j] = xk[i0 + j]
+            for j in range(r, nb):
+                row[j] = 0.0
+
+
+@numba.njit(cache=True, nogil=True, fastmath={"contract"})
 def so_frame(u, ins_nodes, frame, li):  # pragma: no cover - compiled
     """li[s] (3, nb) = frame[s] (3 x 3) @ u[ins_nodes[s]] (3, nb), dgemm's chain (above)."""
     nb = u.shape[2]
@@ -643,7 +676,8 @@ def so_products(u, ec, li, P, d):  # pragma: no cover - compiled
     """P (3 n_el + 3 n_s, nb) of second_order._reactions: every cable element's second-order
     force per unit c, a d + q e (d = u[e + 1] - u[e], a = e.d, q = |d|^2/2 - 3 a^2/2; ec (n_el, 3)
     the unit chords), every insulator's a s, a w, s^2 + w^2 from li = (a, s, w); each product
-    and sum rounded by itself in the numpy form's order (no contraction).  d: scratch (5, nb)
+    and sum rounded by itself in the numpy form's order (no contraction), in float64, each
+    term then rounded once to P's type (float32).  d: scratch (5, nb)
     for d, a and q: one output row per loop vectorises (a loop writing three rows did not: too
     many possible overlaps for LLVM's run-time checks; measured 2.5x)."""
     n_el = u.shape[0] - 1
@@ -806,18 +840,19 @@ def so_solve(c, inv, L, dirs, straight, i0, r, y, xr, s, Lt):  # pragma: no cove
 
 
 @intrinsic
-def _dgemm64(typingctx, fp, ta, tb, m, n, k, a, lda, b, ldb, c, ldc):  # pragma: no cover - compiled
-    """cblas_dgemm(RowMajor, ta, tb, m, n, k, 1.0, a, lda, b, ldb, 0.0, c, ldc) of an ILP64 CBLAS
-    (64-bit sizes) through its address ``fp``: the call numpy's ``matmul`` makes (kernel.py)."""
+def _sgemm64(typingctx, fp, ta, tb, m, n, k, a, lda, b, ldb, c, ldc):  # pragma: no cover - compiled
+    """cblas_sgemm(RowMajor, ta, tb, m, n, k, 1.0f, a, lda, b, ldb, 0.0f, c, ldc) of an ILP64 CBLAS
+    (64-bit sizes) through its address ``fp``: the call numpy's ``matmul`` makes for float32
+    arrays (kernel.py)."""
     sig = types.void(types.intp, types.int32, types.int32, types.int64, types.int64, types.int64,
                      types.voidptr, types.int64, types.voidptr, types.int64, types.voidptr, types.int64)
 
     def codegen(context, builder, signature, args):
-        i32, i64, dbl, vp = ir.IntType(32), ir.IntType(64), ir.DoubleType(), ir.IntType(8).as_pointer()
-        fnty = ir.FunctionType(ir.VoidType(), [i32, i32, i32, i64, i64, i64, dbl, vp, i64, vp, i64, dbl, vp, i64])
+        i32, i64, flt, vp = ir.IntType(32), ir.IntType(64), ir.FloatType(), ir.IntType(8).as_pointer()
+        fnty = ir.FunctionType(ir.VoidType(), [i32, i32, i32, i64, i64, i64, flt, vp, i64, vp, i64, flt, vp, i64])
         fn = builder.inttoptr(args[0], fnty.as_pointer())
-        builder.call(fn, [ir.Constant(i32, 101), args[1], args[2], args[3], args[4], args[5], ir.Constant(dbl, 1.0),
-                          args[6], args[7], args[8], args[9], ir.Constant(dbl, 0.0), args[10], args[11]])
+        builder.call(fn, [ir.Constant(i32, 101), args[1], args[2], args[3], args[4], args[5], ir.Constant(flt, 1.0),
+                          args[6], args[7], args[8], args[9], ir.Constant(flt, 0.0), args[10], args[11]])
         return context.get_dummy_value()
 
     return sig, codegen
@@ -843,13 +878,14 @@ def so_place(xr, run_lo, run_hi, run_f0, u):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, nogil=True)
-def so_history(fp, of_loads, U, T, rotate_, node_of_free, L, c, inv, dirs, straight, y, xr, sc, Lt, run_lo,
-               run_hi, run_f0, ins_nodes, frame, ec, W, chunk, u, li, P, d, tmp, out):  # pragma: no cover - compiled
+def so_history(fp, of_loads, transposed, U, T, rotate_, node_of_free, L, c, inv, dirs, straight, y, xr, sc, Lt,
+               run_lo, run_hi, run_f0, ins_nodes, frame, ec, W, chunk, u, li, P, d, tmp, out):  # pragma: no cover - compiled
     """second_order._reactions in one call (issue 16): per block of nb = u.shape[2] rows the
     displacements (``of_loads``: so_solve of the block's loads, placed run by run of free nodes by
-    so_place; else so_nodes of U), so_frame, so_products and P W by the BLAS at ``fp`` in
-    ``chunk``-row products (a padded last one through ``tmp``) — every BLAS call with the
-    arguments numpy's ``matmul`` passes for the same arrays, so the same bits."""
+    so_place; else so_nodes of U, or so_nodes_t of U's columns when ``transposed``), so_frame, so_products (P float32) and P W by the sgemm at
+    ``fp`` in ``chunk``-row products into tmp (float32, (chunk, n_r)), copied into out (float64)
+    — every BLAS call with the arguments numpy's ``matmul`` passes for the same arrays, so the
+    same bits."""
     m = out.shape[0]
     nb = u.shape[2]
     nr = W.shape[1]
@@ -857,20 +893,18 @@ def so_history(fp, of_loads, U, T, rotate_, node_of_free, L, c, inv, dirs, strai
     for i0 in range(0, m, nb):
         i1 = min(i0 + nb, m)
         r = i1 - i0
-        if not of_loads:
+        if transposed:
+            so_nodes_t(U, i0, r, T, node_of_free, rotate_, u)
+        elif not of_loads:
             so_nodes(U[i0:i1], r, T, node_of_free, rotate_, u)
         else:
             so_solve(c, inv, L, dirs, straight, i0, r, y, xr, sc, Lt)
             so_place(xr, run_lo, run_hi, run_f0, u)
         so_frame(u, ins_nodes, frame, li)
         so_products(u, ec, li, P, d)
-        for j0 in range(0, r, chunk):
-            if j0 + chunk <= r:
-                _dgemm64(fp, _TRANS, _NO_TRANS, chunk, nr, npw, P[:, j0:].ctypes.data, nb, W.ctypes.data, nr,
-                         out[i0 + j0:].ctypes.data, nr)
-            else:
-                _dgemm64(fp, _TRANS, _NO_TRANS, chunk, nr, npw, P[:, j0:].ctypes.data, nb, W.ctypes.data, nr,
-                         tmp.ctypes.data, nr)
-                for q in range(r - j0):
-                    for cc in range(nr):
-                        out[i0 + j0 + q, cc] = tmp[q, cc]
+        for j0 in range(0, r, chunk):  # P W in float32 (sgemm), each chunk through tmp into out
+            _sgemm64(fp, _TRANS, _NO_TRANS, chunk, nr, npw, P[:, j0:].ctypes.data, nb, W.ctypes.data, nr,
+                     tmp.ctypes.data, nr)
+            for q in range(min(chunk, r - j0)):
+                for cc in range(nr):
+                    out[i0 + j0 + q, cc] = tmp[q, cc]

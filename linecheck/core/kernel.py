@@ -18,9 +18,9 @@ other, and so does the loop), and the second-order tension's elementwise passes 
 terms P of :func:`linecheck.core.second_order.reaction_form` and step 3's banded solve of the
 loads by rows of lanes (``_loops.so_solve``, the order of ``second_order._band_solve_rows``), their
 3 × 3 products as the fused multiply-add chain of OpenBLAS's dgemm kernel; where numpy's own
-``cblas_dgemm`` is found, :func:`second_order_dgemm`, the whole block loop with its BLAS products
-P W, called with the arguments numpy's ``matmul`` passes: the same bits, without the GIL that
-``matmul`` keeps during a 2-D product); without it (or with ``LINECHECK_KERNEL=numpy``) the numpy
+``cblas_sgemm`` is found, :func:`second_order_sgemm`, the whole block loop with its BLAS products
+P W (float32), called with the arguments numpy's ``matmul`` passes: the same bits, without the
+GIL that ``matmul`` keeps during a 2-D product); without it (or with ``LINECHECK_KERNEL=numpy``) the numpy
 code runs.
 Each compiled function is compared with its numpy form when the kernel loads; one that differs
 here is not used.
@@ -428,13 +428,13 @@ def history_reductions(M: np.ndarray, background: np.ndarray, resonant: np.ndarr
     return tuple(np.array(o) for o in out)  # seven arrays of their own, as numpy's
 
 
-def _second_order_test(fns, dgemm: int | None = None) -> bool:
+def _second_order_test(fns, gemm: int | None = None) -> bool:
     """The compiled second-order passes give the numpy form's bits through
     :func:`~linecheck.core.second_order.second_order_reactions` (in node bases and global) and
     ``second_order_of_loads``, on an operator of random numbers with two runs of free nodes,
     insulators, rows of zeros and a padded last block; else the numpy passes are used (their 3 x 3
     products are OpenBLAS's, whose kernels may round differently on another machine).  With
-    ``dgemm`` (numpy's cblas_dgemm) the whole block loop of ``_loops.so_history`` is compared."""
+    ``gemm`` (numpy's cblas_sgemm) the whole block loop of ``_loops.so_history`` is compared."""
     from types import SimpleNamespace
 
     from scipy.linalg import lapack
@@ -464,20 +464,22 @@ def _second_order_test(fns, dgemm: int | None = None) -> bool:
     dirs = rng.standard_normal((free.size, 3))
     dirs /= np.linalg.norm(dirs, axis=1)[:, None]
     ok = True
+    Ut = np.ascontiguousarray(U.T)  # the compiled Newmark loop's dof-major history
     for t in (T, None):
-        ref = second_order_reactions(op, U, t, passes=None, dgemm=None)
-        got = second_order_reactions(op, U, t, passes=fns, dgemm=dgemm)
-        ok &= bool(np.array_equal(ref, got) and np.array_equal(np.signbit(ref), np.signbit(got)))
+        ref = second_order_reactions(op, U, t, passes=None, gemm=None)
+        for got in (second_order_reactions(op, U, t, passes=fns, gemm=gemm),
+                    second_order_reactions(op, Ut, t, transposed=True, passes=fns, gemm=gemm)):
+            ok &= bool(np.array_equal(ref, got) and np.array_equal(np.signbit(ref), np.signbit(got)))
     for d in (None, dirs):
-        ref = second_order_of_loads(op, L, c, d, passes=None, dgemm=None)
-        got = second_order_of_loads(op, L, c, d, passes=fns, dgemm=dgemm)
+        ref = second_order_of_loads(op, L, c, d, passes=None, gemm=None)
+        got = second_order_of_loads(op, L, c, d, passes=fns, gemm=gemm)
         ok &= bool(np.array_equal(ref, got) and np.array_equal(np.signbit(ref), np.signbit(got)))
     return ok
 
 
-def _numpy_cblas_dgemm() -> int | None:
-    """The address of the ``cblas_dgemm`` that numpy's ``matmul`` calls, when numpy is built on
-    scipy-openblas with 64-bit integers (numpy's own wheels: the symbol ``scipy_cblas_dgemm64_``
+def _numpy_cblas_sgemm() -> int | None:
+    """The address of the ``cblas_sgemm`` that numpy's ``matmul`` calls for float32 arrays, when
+    numpy is built on scipy-openblas with 64-bit integers (numpy's own wheels: the symbol ``scipy_cblas_sgemm64_``
     of the OpenBLAS library numpy loaded), else None.  The library is the one already in the
     process (Linux: /proc/self/maps; else the folder numpy's wheels bundle it in), so the kernel
     selected for this CPU is numpy's too; the load test then checks the bits."""
@@ -501,20 +503,20 @@ def _numpy_cblas_dgemm() -> int | None:
         paths += glob.glob(os.path.join(here, pattern))
     for path in dict.fromkeys(paths):
         try:
-            fn = ctypes.CDLL(path).scipy_cblas_dgemm64_
+            fn = ctypes.CDLL(path).scipy_cblas_sgemm64_
         except (OSError, AttributeError):
             continue
         return int(ctypes.cast(fn, ctypes.c_void_p).value)
     return None
 
 
-def second_order_dgemm() -> int | None:
-    """The address of numpy's ``cblas_dgemm`` for :func:`linecheck.core._loops.so_history` (the
+def second_order_sgemm() -> int | None:
+    """The address of numpy's ``cblas_sgemm`` for :func:`linecheck.core._loops.so_history` (the
     second-order tension's whole block loop compiled, BLAS calls included, without the GIL) when the
     kernel is loaded and that loop gave the numpy form's bits at load, else None."""
     if not (use(0.0) and _state.get("so_history")):
         return None
-    return _state["dgemm"]
+    return _state["sgemm"]
 
 
 def second_order_passes():
@@ -577,8 +579,8 @@ def available() -> bool:
             _state["field"] = ok and _field_test(fns)
             _state["quad"] = ok and _quad_test(fns.quad_kms)
             _state["second_order"] = ok and _second_order_test(fns)
-            _state["dgemm"] = _numpy_cblas_dgemm() if _state["second_order"] else None
-            _state["so_history"] = _state["dgemm"] is not None and _second_order_test(fns, _state["dgemm"])
+            _state["sgemm"] = _numpy_cblas_sgemm() if _state["second_order"] else None
+            _state["so_history"] = _state["sgemm"] is not None and _second_order_test(fns, _state["sgemm"])
         return bool(_state["ok"])
 
 
@@ -596,8 +598,9 @@ def newmark_block(U: np.ndarray, V: np.ndarray, A: np.ndarray, loads: np.ndarray
         cu, cv, dm: the diagonal operators of :class:`~linecheck.core.dynamics._Stepper`, (n_dof,).
         r2: [1/s] 2/Δt.  chat: Cholesky factor of K̂ (upper band, (BANDWIDTH + 1, n_dof)).
         rest: off-diagonal structural damping C~_off (:class:`~linecheck.core.model.CSRArrays`, read by its diagonals) or None; a1: [1/s] 2/Δt.
-        out: receives u after every step, (n_b, n_real, n_dof); with no rows (0, n_real, n_dof)
-            nothing is written (only the second-order tension reads the states).
+        out: receives u after every step, dof-major (n_dof, >= n_b n_real): column k n_real + r
+            is realization r after step k; with no columns (n_dof, 0) nothing is written (only the
+            second-order tension reads the states: ``second_order_reactions(transposed=True)``).
         nz, GT, cols: the stepper's sparse reaction rows (:func:`~linecheck.core.dynamics._sparse_rows`).
         R: [N] receives the reactions G T u~ after every step, (n_b, n_real, n_r) (the bits of
             :func:`~linecheck.core.dynamics._sparse_reactions`).

@@ -57,7 +57,8 @@ class SecondOrder:
         A: [-] member second-order forces -> reactions: the support terms S f2 minus the
             p_2 -> G K^-1 p_2 transfer (Z = K^-1 G^T, module docstring), shape (3 n_m, n_r).
         W: [N/m^2] the same map from the members' second-order terms P: R_2 = P W, shape
-            (3 n_el + 3 n_s, n_r) (:func:`reaction_form`).
+            (3 n_el + 3 n_s, n_r) (:func:`reaction_form`; float64, the product takes it in
+            float32, :data:`PW_DTYPE`).
         ins_nodes: global node of every suspension attachment, (n_s,).
         ins_frame: [-] rows (e, t1, t2) of every insulator's orthonormal frame, (n_s, 3, 3).
     """
@@ -183,16 +184,24 @@ def _passes(passes):
     return passes
 
 
-def _dgemm(dgemm, fns, W: np.ndarray):
-    """numpy's cblas_dgemm for the compiled block loop, or None; only with a C-ordered float W
-    (the loop passes the leading dimension numpy's ``matmul`` takes for that layout)."""
-    if fns is None or W.dtype != float or not W.flags.c_contiguous:
+PW_DTYPE = np.float32  # the P W product (issue 16): float32 terms and sums (docs/method.md, its error)
+
+
+def _w32(op: SecondOrder) -> np.ndarray:
+    """W in the product's precision, C-ordered (n_rows, n_r)."""
+    return np.ascontiguousarray(op.W, dtype=PW_DTYPE)
+
+
+def _gemm(gemm, fns):
+    """numpy's cblas_sgemm for the compiled block loop, or None (no compiled passes, not found, or
+    the product not in float32)."""
+    if fns is None or PW_DTYPE != np.float32:
         return None
-    if dgemm is _AUTO:
+    if gemm is _AUTO:
         from . import kernel
 
-        return kernel.second_order_dgemm()
-    return dgemm
+        return kernel.second_order_sgemm()
+    return gemm
 
 
 def _free_layout(op: SecondOrder) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -208,12 +217,12 @@ def _ec(op: SecondOrder) -> np.ndarray:
     return np.ascontiguousarray(op.e[:3 * (op.n_nodes - 1)].reshape(-1, 3))
 
 
-def _history(op: SecondOrder, fns, dgemm: int, m: int, U=None, T=None, loads=None) -> np.ndarray:
+def _history(op: SecondOrder, fns, gemm: int, m: int, U=None, T=None, loads=None, transposed=False) -> np.ndarray:
     """R_2 (m, n_r) by the compiled block loop (:func:`linecheck.core._loops.so_history`): the
-    same blocks, chunks and BLAS calls as :func:`_reactions` (with numpy's own cblas_dgemm, called
+    same blocks, chunks and BLAS calls as :func:`_reactions` (with numpy's own cblas_sgemm, called
     with the arguments its ``matmul`` passes), without the GIL and the per-block Python calls;
     ``loads`` = (L, c, inv, dirs) of :func:`second_order_of_loads`."""
-    W = op.W  # C-ordered float (_dgemm)
+    W = _w32(op)
     n_el = op.n_nodes - 1
     n_s = op.c.size - n_el
     chunk = max(16, SINGLE_THREAD_WORK // W.size // 16 * 16)
@@ -225,33 +234,40 @@ def _history(op: SecondOrder, fns, dgemm: int, m: int, U=None, T=None, loads=Non
         L, c, inv, dirs = loads
         y = np.empty((c.shape[1], nb))
     out = np.empty((m, W.shape[1]))
-    fns.so_history(dgemm, loads is not None, np.zeros((1, 3)) if U is None else U,
+    fns.so_history(gemm, loads is not None, transposed, np.zeros((1, 3)) if U is None else U,
                    np.zeros((1, 3, 3)) if T is None else np.ascontiguousarray(T, dtype=float), T is not None,
                    node_of_free, L, c, inv, np.zeros((1, 3)) if dirs is None else dirs, dirs is None, y,
-                   np.empty_like(y), np.empty(nb), np.empty((L.shape[1], nb)), run_lo, run_hi, run_f0, np.ascontiguousarray(op.ins_nodes, dtype=np.int64),
+                   np.empty_like(y), np.empty(nb), np.empty((L.shape[1], nb)), run_lo, run_hi, run_f0,
+                   np.ascontiguousarray(op.ins_nodes, dtype=np.int64),
                    np.ascontiguousarray(op.ins_frame, dtype=float), _ec(op), W, chunk, np.zeros((op.n_nodes, 3, nb)),
-                   np.empty((n_s, 3, nb)), np.zeros((W.shape[0], nb)), np.empty((5, nb)), np.empty((chunk, W.shape[1])), out)
+                   np.empty((n_s, 3, nb)), np.zeros((W.shape[0], nb), dtype=PW_DTYPE), np.empty((5, nb)),
+                   np.empty((chunk, W.shape[1]), dtype=PW_DTYPE), out)
     return out
 
 
-def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None = None, *,
-                           passes=_AUTO, dgemm=_AUTO) -> np.ndarray:
+def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None = None, *, transposed: bool = False,
+                           passes=_AUTO, gemm=_AUTO) -> np.ndarray:
     """[N] R_2 at every tower for free displacements U [m], shape (m, n_dof) -> (m, n_r).
 
     With ``T`` (per-node bases as columns, (n_free_nodes, 3, 3)) U holds the components u~ in
-    the node bases, u = T u~ node by node (the Newmark history of :mod:`.dynamics`).
+    the node bases, u = T u~ node by node (the Newmark history of :mod:`.dynamics`).  With
+    ``transposed`` U is given as its transpose (n_dof, m) (the compiled Newmark loop's dof-major
+    history): the same result, read along its rows.
 
     R_2 = P W (:func:`reaction_form`), block by block of rows: the displacements go node-major
     into a preallocated (n_nodes, 3, rows) array (rotated by one batched 3x3 product per node),
     the members' second-order terms into P (transposed, (3 n_el + 3 n_s, rows)), and P W by
     BLAS: a dozen numpy calls per block with ``out=`` instead of the ~45 elementwise passes of
-    building f2 and multiplying by A; results equal the latter to rounding (tests).  With the
-    optional compiled kernel (``passes``: the kernel's by default when it is loaded, None for
-    numpy) a block's elementwise work is three compiled calls with the same bits
-    (:func:`linecheck.core._loops.so_nodes`, ``so_frame``, ``so_products``; the 3 x 3 products
-    in the fused order of OpenBLAS's dgemm, verified when the kernel loads), and where numpy's
-    own ``cblas_dgemm`` was found (``dgemm``: its address, the kernel's by default) the whole
-    block loop is one compiled call (:func:`_history`; the same BLAS calls, no GIL).
+    building f2 and multiplying by A.  The terms are formed in float64 and P W is taken in
+    float32 (:data:`PW_DTYPE`: each term rounded once to float32, the sums sgemm's; 1.7x faster
+    than the float64 product, off by ~1e-6 of max |R_2|, i.e. ~1e-7 of the reactions:
+    docs/method.md; tests).  With the optional compiled kernel (``passes``: the kernel's by
+    default when it is loaded, None for numpy) a block's elementwise work is three compiled
+    calls with the same bits (:func:`linecheck.core._loops.so_nodes`, ``so_frame``,
+    ``so_products``; the 3 x 3 products in the fused order of OpenBLAS's dgemm, verified when
+    the kernel loads), and where numpy's own ``cblas_sgemm`` was found (``gemm``: its address,
+    the kernel's by default) the whole block loop is one compiled call (:func:`_history`; the
+    same BLAS calls, no GIL).
 
     Rows are processed in blocks of a fixed size that depends on the operator only (the last
     block padded with zeros), so every BLAS product always has the same shape: a row's result
@@ -259,21 +275,27 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
     bit-identical whatever the batch chunking.  The products are small enough for OpenBLAS to
     run on one thread (no thread start-up on a shared machine).
     """
-    n_f = U.shape[1] // 3
-    pad = None
     fns = _passes(passes)
-    fp = _dgemm(dgemm, fns, op.W)
+    fp = _gemm(gemm, fns)
+    m = U.shape[1] if transposed else U.shape[0]
     if fp is not None:
-        return _history(op, fns, fp, U.shape[0], U=np.ascontiguousarray(U, dtype=float), T=T)
+        return _history(op, fns, fp, m, U=np.ascontiguousarray(U, dtype=float), T=T, transposed=transposed)
     if fns is not None:
         Uc = np.ascontiguousarray(U, dtype=float)
         node_of_free = _free_layout(op)[0]
         Tc = np.zeros((1, 3, 3)) if T is None else np.ascontiguousarray(T, dtype=float)
 
         def fill(u: np.ndarray, i0: int, r: int) -> None:
-            fns.so_nodes(Uc[i0:i0 + r], r, Tc, node_of_free, T is not None, u)
+            if transposed:
+                fns.so_nodes_t(Uc, i0, r, Tc, node_of_free, T is not None, u)
+            else:
+                fns.so_nodes(Uc[i0:i0 + r], r, Tc, node_of_free, T is not None, u)
 
-        return _reactions(op, U.shape[0], fill, fns=fns)
+        return _reactions(op, m, fill, fns=fns)
+    if transposed:
+        U = U.T
+    n_f = U.shape[1] // 3
+    pad = None
 
     def fill(u: np.ndarray, i0: int, r: int) -> None:
         nonlocal pad
@@ -331,7 +353,7 @@ def _band_solve_rows(c: np.ndarray, inv: np.ndarray, Y: np.ndarray) -> None:
 
 
 def second_order_of_loads(op: SecondOrder, L: np.ndarray, c: np.ndarray, dirs: np.ndarray | None = None, *,
-                          passes=_AUTO, dgemm=_AUTO) -> np.ndarray:
+                          passes=_AUTO, gemm=_AUTO) -> np.ndarray:
     """[N] R_2 of the quasi-static displacements u = K^-1 b of loads L [N], shape (m, n_free)
     -> (m, n_r): b the load of free node i along global y (``dirs`` None) or along dirs[i]
     ((n_free, 3), unit), K = U^T U with c [N/m] its upper band factor as ``dpbtrf`` returns it
@@ -339,9 +361,9 @@ def second_order_of_loads(op: SecondOrder, L: np.ndarray, c: np.ndarray, dirs: n
     of rows is solved by the band (forward and back substitution over rows of lanes, ≈ 4 kd
     multiply-adds per dof and row instead of the n_free of a dense K^-1; :func:`_band_solve_rows`,
     compiled as ``_loops.so_solve``) straight into the node-major work array; the rest of a
-    block as there (``passes``, ``dgemm``)."""
+    block as there (``passes``, ``gemm``)."""
     fns = _passes(passes)
-    fp = _dgemm(dgemm, fns, op.W)
+    fp = _gemm(gemm, fns)
     c = np.ascontiguousarray(c, dtype=float)
     inv = 1.0 / c[-1]
     Dc = None if dirs is None else np.ascontiguousarray(dirs, dtype=float)
@@ -391,26 +413,29 @@ def _reactions(op: SecondOrder, m: int, fill, fns=None) -> np.ndarray:
     """R_2 (m, n_r) of m rows of displacements that ``fill(u, i0, r)`` writes node-major into
     u[:, :, :r] (global x, y, z; (n_nodes, 3, nb)), zeroing u[:, :, r:] (docstrings above);
     ``fns`` the compiled passes or None (numpy, the same bits)."""
-    W = op.W
+    W = _w32(op)
     n_el = op.n_nodes - 1
     n_s = op.c.size - n_el
     # whole micro-kernel tiles: with 23-row blocks the edge rows' kernel rounded a column differently
     chunk = max(16, SINGLE_THREAD_WORK // W.size // 16 * 16)
     nb = max(1, BLOCK_ROWS // chunk) * chunk  # rows of one elementwise pass: arrays stay in cache
     u = np.zeros((op.n_nodes, 3, nb))  # pinned nodes stay zero
-    P = np.zeros((W.shape[0], nb))  # padding columns stay zero
+    P = np.zeros((W.shape[0], nb), dtype=PW_DTYPE)  # padding columns stay zero
     li = np.empty((n_s, 3, nb))
     ec = _ec(op)
+    tmp = np.empty((chunk, W.shape[1]), dtype=PW_DTYPE)
     if fns is None:
         d = np.empty((n_el, 3, nb))
         a = np.empty((n_el, nb))
         q = np.empty((n_el, nb))
         t = np.empty((n_el, nb))
+        v = np.empty((n_el, nb))
         E = [ec[:, k, None] for k in range(3)]  # (n_el, 1) each
         Pq = P[:3 * n_el].reshape(n_el, 3, nb)  # cable elements: a du + q e
         Pi = P[3 * n_el:].reshape(n_s, 3, nb)  # insulators: a s, a w, s^2 + w^2
         di = np.empty((n_s, 3, nb))
         sq = np.empty((n_s, 2, nb))
+        pi = np.empty((n_s, 3, nb))
     else:
         d = np.empty((5, nb))
         ins_nodes = np.ascontiguousarray(op.ins_nodes, dtype=np.int64)
@@ -423,7 +448,7 @@ def _reactions(op: SecondOrder, m: int, fill, fns=None) -> np.ndarray:
         if fns is not None:  # the same operations, compiled (_loops.so_frame, so_products)
             fns.so_frame(u, ins_nodes, frame, li)
             fns.so_products(u, ec, li, P, d)
-        else:  # cable elements (reaction_form): the order of _loops.so_products, op by op
+        else:  # cable elements (reaction_form): the order of _loops.so_products, op by op, in float64
             np.subtract(u[1:], u[:-1], out=d)  # du = u_b - u_a
             np.multiply(d[:, 0], E[0], out=a)  # a = e.du
             np.multiply(d[:, 1], E[1], out=t)
@@ -439,19 +464,18 @@ def _reactions(op: SecondOrder, m: int, fill, fns=None) -> np.ndarray:
             np.multiply(a, a, out=t)
             t *= 1.5
             q -= t
-            for k in range(3):  # a du + q e
-                np.multiply(a, d[:, k], out=Pq[:, k])
+            for k in range(3):  # a du + q e, rounded once to P's type
+                np.multiply(a, d[:, k], out=v)
                 np.multiply(q, E[k], out=t)
-                Pq[:, k] += t
+                v += t
+                Pq[:, k] = v
             np.take(u, op.ins_nodes, axis=0, out=di)  # insulators: the fixed point does not move
             np.matmul(op.ins_frame, di, out=li)  # (a, s, w) in the insulator's frame
-            np.multiply(li[:, :1], li[:, 1:], out=Pi[:, :2])  # a s, a w
+            np.multiply(li[:, :1], li[:, 1:], out=pi[:, :2])  # a s, a w
             np.multiply(li[:, 1:], li[:, 1:], out=sq)
-            np.add(sq[:, 0], sq[:, 1], out=Pi[:, 2])  # s^2 + w^2
-        for j0 in range(0, r, chunk):
-            j1 = j0 + chunk
-            if j1 <= r:
-                np.matmul(P[:, j0:j1].T, W, out=out[i0 + j0:i0 + j1])
-            else:
-                out[i0 + j0:i1] = (P[:, j0:j1].T @ W)[: r - j0]
+            np.add(sq[:, 0], sq[:, 1], out=pi[:, 2])  # s^2 + w^2
+            Pi[...] = pi
+        for j0 in range(0, r, chunk):  # P W in float32 (sgemm), through tmp as the compiled loop
+            np.matmul(P[:, j0:j0 + chunk].T, W, out=tmp)
+            out[i0 + j0:min(i0 + j0 + chunk, i1)] = tmp[:min(chunk, r - j0)]
     return out

@@ -254,8 +254,8 @@ def integrate(
     if second_order is not None and second_order_start == 0:
         R_F[0] += so(0, U)
     block = max(1, min(512, 2_000_000 // max(n_real * n_dof, 1)))  # steps per block
-    if second_order is not None:  # the history the second-order tension reads stays in cache
-        # (L2: 512 instead of 3600 KB for case09-six; median run 30-90 ms faster, measured)
+    if second_order is not None and compiled:  # the history the second-order tension reads stays
+        # in cache (L2: 512 instead of 3600 KB for case09-six; median run 30-90 ms faster, measured)
         block = max(1, min(block, SECOND_ORDER_HISTORY // max(n_real * n_dof, 1)))
     buf = np.empty((block, n_real, n_dof))
     # the compiled loop keeps the second-order tension's history dof-major (n_dof, steps x

@@ -153,7 +153,7 @@ mean I² in step 1, its zero-mean rest in the fluctuating load) and `tension = "
 (reactions with the tension increment quadratic in the linear motion): against a full
 non-linear analysis of the same wind the linear pair is unconservative on every synoptic peak
 (R_y −3 … −6 %, R_x −7 … −18 %, docs/validation.md), the pair of options closes most of that
-gap, and it adds about a fifth to a ten-realization run (+20–25 % measured,
+gap, and it adds about a tenth to a ten-realization run (+9 … +15 % measured,
 docs/performance.md). Derivations: docs/method.md, "Closing the linearisation gap".
 
 """

@@ -222,6 +222,8 @@ def test_second_order_fast_form_equals_member_forces(rotated, monkeypatch):
     assert np.array_equal(second_order_reactions(op, U[37:38], T), prod32[37:38])
     assert np.array_equal(second_order_reactions(op, U[5:300:3], T), prod32[5:300:3])
     monkeypatch.setattr(second_order, "PW_DTYPE", np.float64)  # the form itself, in float64
+    op = dataclasses.replace(op)  # its product matrix derived again, in float64
+    assert op.Wp.dtype == np.float64
     fast = second_order_reactions(op, U, T)
     assert np.abs(fast - ref).max() <= 5e-12 * scale, np.abs(fast - ref).max() / scale
     if np.finfo(np.longdouble).eps < 1e-18:  # extended precision available (x86)

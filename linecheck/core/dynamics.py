@@ -257,10 +257,11 @@ def integrate(
     if second_order is not None and compiled:  # the history the second-order tension reads stays
         # in cache (L2: 512 instead of 3600 KB for case09-six; median run 30-90 ms faster, measured)
         block = max(1, min(block, SECOND_ORDER_HISTORY // max(n_real * n_dof, 1)))
-    buf = np.empty((block, n_real, n_dof))
-    # the compiled loop keeps the second-order tension's history dof-major (n_dof, steps x
-    # realizations): the second-order pass then reads it along its rows (so_nodes_t)
-    hist = np.empty((n_dof, block * n_real if second_order is not None else 0))
+    # the numpy loop's history of a block (its reactions and the second-order tension read it);
+    # the compiled loop keeps only what the second-order tension reads, dof-major (n_dof, steps x
+    # realizations), which the second-order pass reads along its rows (so_nodes_t)
+    buf = None if compiled else np.empty((block, n_real, n_dof))
+    hist = np.empty((n_dof, block * n_real if compiled and second_order is not None else 0))
     # segments: runs of steps under one linear model (one mean state), cut into blocks
     keys = np.arange(n_steps) if model_at is not None else np.asarray(state_of_step)
     starts = np.concatenate([[1], 2 + np.flatnonzero(keys[2:] != keys[1:-1])]) if n_steps > 1 else np.zeros(0, int)

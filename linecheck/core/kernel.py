@@ -435,22 +435,20 @@ def _second_order_test(fns, gemm: int | None = None) -> bool:
     insulators, rows of zeros and a padded last block; else the numpy passes are used (their 3 x 3
     products are OpenBLAS's, whose kernels may round differently on another machine).  With
     ``gemm`` (numpy's cblas_sgemm) the whole block loop of ``_loops.so_history`` is compared."""
-    from types import SimpleNamespace
-
     from scipy.linalg import lapack
 
-    from .second_order import second_order_of_loads, second_order_reactions
+    from .second_order import SecondOrder, second_order_of_loads, second_order_reactions
 
     rng = np.random.default_rng(28)
     n_nodes, n_s, n_r = 21, 3, 7
     free = np.r_[1:10, 11:20]  # nodes 0, 10 and 20 pinned
     n_el = n_nodes - 1
     e = rng.standard_normal((n_el + n_s, 3))
-    op = SimpleNamespace(
-        n_nodes=n_nodes, c=np.ones(n_el + n_s), runs=((1, 10, 0), (11, 20, 9)),
-        e=(e / np.linalg.norm(e, axis=1)[:, None]).ravel(),
-        ins_nodes=np.array([5, 12, 17]), ins_frame=np.linalg.qr(rng.standard_normal((n_s, 3, 3)))[0],
-        W=rng.standard_normal((3 * n_el + 3 * n_s, n_r)) * 1e3)
+    op = SecondOrder(
+        e=(e / np.linalg.norm(e, axis=1)[:, None]).ravel(), c=np.ones(n_el + n_s), n_nodes=n_nodes,
+        pinned=np.array([0, 10, 20]), runs=((1, 10, 0), (11, 20, 9)), ins_free=np.array([4, 10, 15]),
+        A=np.zeros((3 * (n_el + n_s), n_r)), W=rng.standard_normal((3 * n_el + 3 * n_s, n_r)) * 1e3,
+        ins_nodes=np.array([5, 12, 17]), ins_frame=np.linalg.qr(rng.standard_normal((n_s, 3, 3)))[0])
     T = np.linalg.qr(rng.standard_normal((free.size, 3, 3)))[0]
     U = rng.standard_normal((300, 3 * free.size)) * 0.2
     U[[0, 7, 150]] = 0.0

@@ -30,7 +30,7 @@ for the quasi-static B, so that R = F - B stays consistent.  Nothing here prints
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.linalg import lapack
@@ -40,6 +40,9 @@ from .model import LinearModel
 from .static import StaticState
 
 _FLIP = np.array([1.0, 1.0, -1.0])  # R_z is positive downward
+PW_DTYPE = np.float32  # the P W product (issue 16): float32 terms and sums (docs/method.md, its error)
+SINGLE_THREAD_WORK = 4 * 65536  # rows x W.size up to OpenBLAS' multithreading threshold (m n k <= 4 x 65536)
+BLOCK_ROWS = 128  # rows of one block of elementwise passes (their arrays stay in cache)
 
 
 @dataclass(frozen=True)
@@ -61,6 +64,12 @@ class SecondOrder:
             float32, :data:`PW_DTYPE`).
         ins_nodes: global node of every suspension attachment, (n_s,).
         ins_frame: [-] rows (e, t1, t2) of every insulator's orthonormal frame, (n_s, 3, 3).
+
+    Derived once per operator (also by ``dataclasses.replace``), for the block passes that run
+    once per Newmark block: ``Wp`` W in the product's type (:data:`PW_DTYPE`, C-ordered), ``ec``
+    the cable elements' unit chords (n_el, 3), ``node_of_free`` the global node of every free
+    node and ``run_lo``, ``run_hi``, ``run_f0`` the runs' first node, end node and first free
+    index (int64), ``chunk`` the rows of one BLAS product and ``nb`` of one block (a multiple).
     """
 
     e: np.ndarray
@@ -73,6 +82,29 @@ class SecondOrder:
     W: np.ndarray
     ins_nodes: np.ndarray
     ins_frame: np.ndarray
+    Wp: np.ndarray = field(init=False, repr=False)
+    ec: np.ndarray = field(init=False, repr=False)
+    node_of_free: np.ndarray = field(init=False, repr=False)
+    run_lo: np.ndarray = field(init=False, repr=False)
+    run_hi: np.ndarray = field(init=False, repr=False)
+    run_f0: np.ndarray = field(init=False, repr=False)
+    chunk: int = field(init=False, repr=False)
+    nb: int = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        put = object.__setattr__  # frozen: set the derived fields once, here
+        put(self, "ins_nodes", np.ascontiguousarray(self.ins_nodes, dtype=np.int64))
+        put(self, "ins_frame", np.ascontiguousarray(self.ins_frame, dtype=float))
+        put(self, "Wp", np.ascontiguousarray(self.W, dtype=PW_DTYPE))
+        put(self, "ec", np.ascontiguousarray(np.asarray(self.e, dtype=float)[:3 * (self.n_nodes - 1)].reshape(-1, 3)))
+        runs = sorted(self.runs, key=lambda x: x[2])
+        put(self, "node_of_free", np.concatenate([np.arange(lo, hi, dtype=np.int64) for lo, hi, _ in runs]))
+        for i, name in enumerate(("run_lo", "run_hi", "run_f0")):
+            put(self, name, np.array([x[i] for x in runs], dtype=np.int64))
+        # whole micro-kernel tiles: with 23-row blocks the edge rows' kernel rounded a column differently
+        chunk = max(16, SINGLE_THREAD_WORK // self.W.size // 16 * 16)
+        put(self, "chunk", chunk)
+        put(self, "nb", max(1, BLOCK_ROWS // chunk) * chunk)  # rows of one elementwise pass: in cache
 
 
 def second_order_operator(model: LinearModel, state: StaticState) -> SecondOrder:
@@ -169,8 +201,6 @@ def reaction_form(e: np.ndarray, c: np.ndarray, A: np.ndarray, n_el: int) -> tup
     return W, frame
 
 
-SINGLE_THREAD_WORK = 4 * 65536  # rows x W.size up to OpenBLAS' multithreading threshold (m n k <= 4 x 65536)
-BLOCK_ROWS = 128  # rows of one block of elementwise passes (their arrays stay in cache)
 
 
 _AUTO = object()  # passes: the compiled kernel's when loaded and verified (kernel.second_order_passes)
@@ -184,18 +214,10 @@ def _passes(passes):
     return passes
 
 
-PW_DTYPE = np.float32  # the P W product (issue 16): float32 terms and sums (docs/method.md, its error)
-
-
-def _w32(op: SecondOrder) -> np.ndarray:
-    """W in the product's precision, C-ordered (n_rows, n_r)."""
-    return np.ascontiguousarray(op.W, dtype=PW_DTYPE)
-
-
-def _gemm(gemm, fns):
+def _gemm(gemm, fns, op: SecondOrder):
     """numpy's cblas_sgemm for the compiled block loop, or None (no compiled passes, not found, or
-    the product not in float32)."""
-    if fns is None or PW_DTYPE != np.float32:
+    the operator's product not in float32)."""
+    if fns is None or op.Wp.dtype != np.float32:
         return None
     if gemm is _AUTO:
         from . import kernel
@@ -204,30 +226,13 @@ def _gemm(gemm, fns):
     return gemm
 
 
-def _free_layout(op: SecondOrder) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The global node of every free node (n_free_nodes,) and the runs' first node, end node and
-    first free index (n_runs,) each, as int64 arrays for the compiled passes."""
-    runs = sorted(op.runs, key=lambda x: x[2])
-    node_of_free = np.concatenate([np.arange(lo, hi) for lo, hi, _ in runs])
-    return (node_of_free,) + tuple(np.array([x[i] for x in runs], dtype=np.int64) for i in range(3))
-
-
-def _ec(op: SecondOrder) -> np.ndarray:
-    """The cable elements' unit chords (n_el, 3), C-ordered."""
-    return np.ascontiguousarray(op.e[:3 * (op.n_nodes - 1)].reshape(-1, 3))
-
-
 def _history(op: SecondOrder, fns, gemm: int, m: int, U=None, T=None, loads=None, transposed=False) -> np.ndarray:
     """R_2 (m, n_r) by the compiled block loop (:func:`linecheck.core._loops.so_history`): the
     same blocks, chunks and BLAS calls as :func:`_reactions` (with numpy's own cblas_sgemm, called
     with the arguments its ``matmul`` passes), without the GIL and the per-block Python calls;
     ``loads`` = (L, c, inv, dirs) of :func:`second_order_of_loads`."""
-    W = _w32(op)
-    n_el = op.n_nodes - 1
-    n_s = op.c.size - n_el
-    chunk = max(16, SINGLE_THREAD_WORK // W.size // 16 * 16)
-    nb = max(1, BLOCK_ROWS // chunk) * chunk
-    node_of_free, run_lo, run_hi, run_f0 = _free_layout(op)
+    W, nb = op.Wp, op.nb
+    n_s = op.c.size - (op.n_nodes - 1)
     if loads is None:
         L, c, inv, dirs, y = np.zeros((1, 1)), np.zeros((1, 1)), np.zeros(1), np.zeros((1, 3)), np.zeros((1, nb))
     else:
@@ -236,12 +241,11 @@ def _history(op: SecondOrder, fns, gemm: int, m: int, U=None, T=None, loads=None
     out = np.empty((m, W.shape[1]))
     fns.so_history(gemm, loads is not None, transposed, np.zeros((1, 3)) if U is None else U,
                    np.zeros((1, 3, 3)) if T is None else np.ascontiguousarray(T, dtype=float), T is not None,
-                   node_of_free, L, c, inv, np.zeros((1, 3)) if dirs is None else dirs, dirs is None, y,
-                   np.empty_like(y), np.empty(nb), np.empty((L.shape[1], nb)), run_lo, run_hi, run_f0,
-                   np.ascontiguousarray(op.ins_nodes, dtype=np.int64),
-                   np.ascontiguousarray(op.ins_frame, dtype=float), _ec(op), W, chunk, np.zeros((op.n_nodes, 3, nb)),
-                   np.empty((n_s, 3, nb)), np.zeros((W.shape[0], nb), dtype=PW_DTYPE), np.empty((5, nb)),
-                   np.empty((chunk, W.shape[1]), dtype=PW_DTYPE), out)
+                   op.node_of_free, L, c, inv, np.zeros((1, 3)) if dirs is None else dirs, dirs is None, y,
+                   np.empty_like(y), np.empty(nb), np.empty((L.shape[1], nb)), op.run_lo, op.run_hi, op.run_f0,
+                   op.ins_nodes, op.ins_frame, op.ec, W, op.chunk, np.zeros((op.n_nodes, 3, nb)),
+                   np.empty((n_s, 3, nb)), np.zeros((W.shape[0], nb), dtype=W.dtype), np.empty((5, nb)),
+                   np.empty((op.chunk, W.shape[1]), dtype=W.dtype), out)
     return out
 
 
@@ -276,20 +280,19 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
     run on one thread (no thread start-up on a shared machine).
     """
     fns = _passes(passes)
-    fp = _gemm(gemm, fns)
+    fp = _gemm(gemm, fns, op)
     m = U.shape[1] if transposed else U.shape[0]
     if fp is not None:
         return _history(op, fns, fp, m, U=np.ascontiguousarray(U, dtype=float), T=T, transposed=transposed)
     if fns is not None:
         Uc = np.ascontiguousarray(U, dtype=float)
-        node_of_free = _free_layout(op)[0]
         Tc = np.zeros((1, 3, 3)) if T is None else np.ascontiguousarray(T, dtype=float)
 
         def fill(u: np.ndarray, i0: int, r: int) -> None:
             if transposed:
-                fns.so_nodes_t(Uc, i0, r, Tc, node_of_free, T is not None, u)
+                fns.so_nodes_t(Uc, i0, r, Tc, op.node_of_free, T is not None, u)
             else:
-                fns.so_nodes(Uc[i0:i0 + r], r, Tc, node_of_free, T is not None, u)
+                fns.so_nodes(Uc[i0:i0 + r], r, Tc, op.node_of_free, T is not None, u)
 
         return _reactions(op, m, fill, fns=fns)
     if transposed:
@@ -317,9 +320,6 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
             u[:, :, r:] = 0.0
 
     return _reactions(op, U.shape[0], fill)
-
-
-SOLVE_COLUMNS = 8192  # load rows per numpy band solve (:func:`_band_solve_rows`; the bits do not depend on it)
 
 
 def _band_solve_rows(c: np.ndarray, inv: np.ndarray, Y: np.ndarray) -> None:
@@ -363,7 +363,7 @@ def second_order_of_loads(op: SecondOrder, L: np.ndarray, c: np.ndarray, dirs: n
     compiled as ``_loops.so_solve``) straight into the node-major work array; the rest of a
     block as there (``passes``, ``gemm``)."""
     fns = _passes(passes)
-    fp = _gemm(gemm, fns)
+    fp = _gemm(gemm, fns, op)
     c = np.ascontiguousarray(c, dtype=float)
     inv = 1.0 / c[-1]
     Dc = None if dirs is None else np.ascontiguousarray(dirs, dtype=float)
@@ -372,38 +372,25 @@ def second_order_of_loads(op: SecondOrder, L: np.ndarray, c: np.ndarray, dirs: n
     n_dof = c.shape[1]
     if fns is not None:
         Lc = np.ascontiguousarray(L, dtype=float)
-        work = {}
-        run_lo, run_hi, run_f0 = _free_layout(op)[1:]
         D3 = np.zeros((1, 3)) if Dc is None else Dc
+        y, xr, sc, Lt = np.empty((n_dof, op.nb)), np.empty((n_dof, op.nb)), np.empty(op.nb), np.empty((L.shape[1], op.nb))
 
         def fill(u: np.ndarray, i0: int, r: int) -> None:
-            nb = u.shape[2]
-            if not work:
-                work.update(y=np.empty((n_dof, nb)), xr=np.empty((n_dof, nb)), s=np.empty(nb),
-                            Lt=np.empty((Lc.shape[1], nb)))
-            fns.so_solve(c, inv, Lc, D3, Dc is None, i0, r, work["y"], work["xr"], work["s"], work["Lt"])
-            fns.so_place(work["xr"], run_lo, run_hi, run_f0, u)
+            fns.so_solve(c, inv, Lc, D3, Dc is None, i0, r, y, xr, sc, Lt)
+            fns.so_place(xr, op.run_lo, op.run_hi, op.run_f0, u)
 
         return _reactions(op, L.shape[0], fill, fns=fns)
-    state = {"i0": 0, "Y": np.empty((n_dof, 0))}
+    Y = np.zeros((n_dof, L.shape[0]))  # the right-hand sides of all rows, solved at once
+    if Dc is None:
+        Y[1::3] = L.T
+    else:
+        Y.reshape(-1, 3, L.shape[0])[...] = L.T[:, None, :] * Dc[:, :, None]
+    _band_solve_rows(c, inv, Y)
 
     def fill(u: np.ndarray, i0: int, r: int) -> None:
-        nb = u.shape[2]
-        Y = state["Y"]
-        if not state["i0"] <= i0 < state["i0"] + Y.shape[1] - r + 1:  # solve the next columns
-            m1 = min(L.shape[0], i0 + max(SOLVE_COLUMNS, nb))
-            Lb = L[i0:m1].T  # (n_free, cols)
-            Y = np.zeros((n_dof, m1 - i0))
-            if Dc is None:
-                Y[1::3] = Lb
-            else:
-                Y.reshape(-1, 3, m1 - i0)[...] = Lb[:, None, :] * Dc[:, :, None]
-            _band_solve_rows(c, inv, Y)
-            state.update(i0=i0, Y=Y)
-        j = i0 - state["i0"]
         for lo, hi, f0 in op.runs:
-            u[lo:hi, :, :r] = Y[3 * f0:3 * (f0 + hi - lo), j:j + r].reshape(hi - lo, 3, r)
-        if r < nb:
+            u[lo:hi, :, :r] = Y[3 * f0:3 * (f0 + hi - lo), i0:i0 + r].reshape(hi - lo, 3, r)
+        if r < u.shape[2]:
             u[:, :, r:] = 0.0
 
     return _reactions(op, L.shape[0], fill)
@@ -413,17 +400,13 @@ def _reactions(op: SecondOrder, m: int, fill, fns=None) -> np.ndarray:
     """R_2 (m, n_r) of m rows of displacements that ``fill(u, i0, r)`` writes node-major into
     u[:, :, :r] (global x, y, z; (n_nodes, 3, nb)), zeroing u[:, :, r:] (docstrings above);
     ``fns`` the compiled passes or None (numpy, the same bits)."""
-    W = _w32(op)
+    W, chunk, nb, ec = op.Wp, op.chunk, op.nb, op.ec
     n_el = op.n_nodes - 1
     n_s = op.c.size - n_el
-    # whole micro-kernel tiles: with 23-row blocks the edge rows' kernel rounded a column differently
-    chunk = max(16, SINGLE_THREAD_WORK // W.size // 16 * 16)
-    nb = max(1, BLOCK_ROWS // chunk) * chunk  # rows of one elementwise pass: arrays stay in cache
     u = np.zeros((op.n_nodes, 3, nb))  # pinned nodes stay zero
-    P = np.zeros((W.shape[0], nb), dtype=PW_DTYPE)  # padding columns stay zero
+    P = np.zeros((W.shape[0], nb), dtype=W.dtype)  # padding columns stay zero
     li = np.empty((n_s, 3, nb))
-    ec = _ec(op)
-    tmp = np.empty((chunk, W.shape[1]), dtype=PW_DTYPE)
+    tmp = np.empty((chunk, W.shape[1]), dtype=W.dtype)
     if fns is None:
         d = np.empty((n_el, 3, nb))
         a = np.empty((n_el, nb))
@@ -438,15 +421,13 @@ def _reactions(op: SecondOrder, m: int, fill, fns=None) -> np.ndarray:
         pi = np.empty((n_s, 3, nb))
     else:
         d = np.empty((5, nb))
-        ins_nodes = np.ascontiguousarray(op.ins_nodes, dtype=np.int64)
-        frame = np.ascontiguousarray(op.ins_frame, dtype=float)
     out = np.empty((m, W.shape[1]))
     for i0 in range(0, m, nb):
         i1 = min(i0 + nb, m)
         r = i1 - i0
         fill(u, i0, r)
         if fns is not None:  # the same operations, compiled (_loops.so_frame, so_products)
-            fns.so_frame(u, ins_nodes, frame, li)
+            fns.so_frame(u, op.ins_nodes, op.ins_frame, li)
             fns.so_products(u, ec, li, P, d)
         else:  # cable elements (reaction_form): the order of _loops.so_products, op by op, in float64
             np.subtract(u[1:], u[:-1], out=d)  # du = u_b - u_a

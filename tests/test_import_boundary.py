@@ -5,6 +5,8 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import pytest
+
 CORE_MODULES = [
     "linecheck.core.case",
     "linecheck.core.errors",
@@ -76,3 +78,35 @@ def test_every_core_module_is_listed():
     }
     missing = found - set(CORE_MODULES) - set(KERNEL_MODULES)
     assert not missing, f"add to CORE_MODULES: {sorted(missing)}"
+
+
+#: modules the start-up of ``linecheck --help`` must not load: each costs 0.1-0.5 s (scipy.stats
+#: alone ≈ 0.4 s) and none is needed to print the help; the commands import them where they work
+HEAVY_AT_STARTUP = ("scipy.stats", "scipy.optimize", "linecheck.core.dynamics", "linecheck.service", "numba",
+                    "textual", "pandas", "openpyxl")
+
+
+@pytest.mark.parametrize("args", [["--help"], ["run", "--help"], ["batch", "--help"]], ids=" ".join)
+def test_help_loads_no_heavy_module(args):
+    """``linecheck --help`` (and a command's help) answers without loading the numerical core or
+    the front-end libraries: asserted on the modules loaded, not on seconds (a test's verdict never
+    depends on the machine's load)."""
+    code = (
+        "import contextlib, io, sys\n"
+        "from linecheck.cli.app import main\n"
+        f"sys.argv = ['linecheck', *{args!r}]\n"
+        "out = io.StringIO()\n"
+        "try:\n"
+        "    with contextlib.redirect_stdout(out):\n"
+        "        main()\n"
+        "except SystemExit as e:\n"
+        "    code = e.code\n"
+        "else:\n"
+        "    code = 0\n"
+        f"bad = [m for m in {HEAVY_AT_STARTUP!r} if m in sys.modules]\n"
+        "print(code, 'Usage' in out.getvalue(), ','.join(bad))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    code_, usage, bad = (out.stdout.strip().split(" ") + [""])[:3]
+    assert (code_, usage) == ("0", "True"), out.stdout + out.stderr  # the help was printed
+    assert bad == "", f"linecheck {' '.join(args)} loaded {bad}"

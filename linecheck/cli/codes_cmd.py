@@ -7,10 +7,8 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from .. import service
 from ..io.atomic import check_target
 from ..io.document import CodeCheck
-from ..io.jsonout import codes_document, codes_to_dict, write_json
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .progress import progress_bar
 
@@ -46,6 +44,9 @@ def codes(
     loads_only: Annotated[bool, typer.Option("--loads-only", help="Only the code loads: do not run the case.")] = False,
 ) -> None:
     """Design-code conductor wind loads (ASCE 74, IEC 60826, EN 50341-1, AS/NZS 7000) beside linecheck's peaks."""
+    from .. import service  # here, not at import: the service loads the numerical core (start-up time)
+    from ..io.jsonout import codes_document, codes_to_dict, write_json
+
     case = read_case(case_file)
     if json_out is not None:
         check_target(json_out, what="JSON")

@@ -6,11 +6,8 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from .. import service
 from ..core.errors import CaseError
 from ..io.atomic import check_target
-from ..io.jsonout import static_to_dict, write_json
-from ..io.section import section_summary, tower_rows
 from .app import CaseArg, CasesArg, JsonOpt, app, console, err_console, handle_errors, read_case
 from .limits import warn as limits_warn
 from .progress import progress_bar
@@ -20,6 +17,8 @@ from .progress import progress_bar
 @handle_errors
 def check(cases: CasesArg) -> None:
     """Validate case files without running them; every bad file is reported, one line each (exit 2 if any)."""
+    from .. import service  # here, not at import: the service loads the numerical core (start-up time)
+
     failed = 0
     for path in cases:
         try:
@@ -39,6 +38,8 @@ def check(cases: CasesArg) -> None:
 
 def section_line(case) -> str:
     """``"13 towers T1-T13, 12 spans, 255-420 m, 2 angle towers; tower of interest 7 (T7)"``."""
+    from ..io.section import section_summary, tower_rows
+
     rows = tower_rows(case.line)
     toi = case.line.tower_of_interest
     return (f"{len(rows)} towers {rows[0].name}-{rows[-1].name}, {section_summary(case.line)}; "
@@ -49,6 +50,10 @@ def section_line(case) -> str:
 @handle_errors
 def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     """Step 1: non-linear static analysis under the (running-)mean wind."""
+    from .. import service
+    from ..io.jsonout import static_to_dict, write_json
+    from ..io.section import tower_rows
+
     case = read_case(case_file)
     if json_out is not None:
         check_target(json_out, what="JSON")

@@ -9,13 +9,11 @@ from rich.markup import escape
 from rich.table import Table
 
 from ..core.extremes import CONT_R_THRESHOLD as CONT_R_FLAG  # Cont_R flag, paper Sect. 5 (one definition)
-from .. import service
 from ..core.case import Case
 from ..core.results import REACTIONS
 from ..io.atomic import check_target
 from ..io.display import STAT_ROWS, SUMMARY_STATS, number_text, stat_text
 from ..io.document import RunDocument, StatDef
-from ..io.jsonout import _num, run_document, write_json
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .export_cmd import (
     EngineerOpt,
@@ -195,7 +193,9 @@ def run(
              "same bits whatever the number).")] = None,
 ) -> None:
     """Steps 1-3: mean, background and resonant reactions, gust factors and contributions."""
+    from .. import service  # here, not at import: the service loads the numerical core (start-up time)
     from ..batch.executors import default_jobs
+    from ..io.jsonout import run_document, write_json
 
     fields = title_block(project, line, engineer, revision, title, excel=excel)
     apply_max_memory(max_memory)
@@ -258,6 +258,9 @@ def modes(
     shapes: Annotated[bool, typer.Option("--shapes", help="Include mode shapes in the JSON.")] = False,
 ) -> None:
     """Natural frequencies (and mode shapes) of the still-air and mean states."""
+    from .. import service
+    from ..io.jsonout import _num, write_json
+
     case = read_case(case_file)
     if json_out is not None:
         check_target(json_out, what="JSON")

@@ -6,9 +6,7 @@ from typing import Any
 
 from rich.table import Table
 
-from .. import service
 from ..io.atomic import check_target
-from ..io.jsonout import spectral_document, spectral_to_dict, write_json
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .limits import warn as limits_warn
 
@@ -43,6 +41,9 @@ def davenport_line(doc: dict) -> str:
 @handle_errors
 def spectral(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     """Frequency-domain estimates (exact random vibration and closed form) for a synoptic case."""
+    from .. import service  # here, not at import: the service loads the numerical core (start-up time)
+    from ..io.jsonout import spectral_document, spectral_to_dict, write_json
+
     case = read_case(case_file)
     if json_out is not None:
         check_target(json_out, what="JSON")

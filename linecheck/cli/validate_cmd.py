@@ -9,7 +9,6 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from .. import validation
 from ..io.atomic import check_target, write_text_atomic
 from .app import JsonOpt, app, console, handle_errors
 from .progress import progress_bar
@@ -23,6 +22,8 @@ def validate(
     quick: Annotated[bool, typer.Option("--quick", help="Skip the six-span time-vs-frequency runs and Table 5.")] = False,
 ) -> None:
     """Run the verification set: closed forms, Matheson & Holmes, time vs frequency domain, Table 5."""
+    from .. import validation  # here, not at import: it loads the numerical core (start-up time)
+
     for out in (json_out, markdown):
         if out is not None:
             check_target(out)

@@ -5,18 +5,18 @@ from __future__ import annotations
 import io
 import math
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import numpy as np
 import typer
 from rich.table import Table
 
 from ..core.case import Case
-from ..core.wind.mean import downburst_field, event_window
-from ..core.wind.point import PointSeries, point_series
 from ..io.atomic import check_target, write_atomic, write_text_atomic
-from ..io.jsonout import write_json
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
+
+if TYPE_CHECKING:  # annotations only: the wind modules are imported where they are used (start-up time)
+    from ..core.wind.point import PointSeries
 
 CsvOpt = Annotated[Path | None, typer.Option("--csv", help="Write time, mean and total velocity at p as CSV to this file.")]
 FieldOpt = Annotated[
@@ -67,6 +67,8 @@ def _f(x: float) -> float | None:
 
 def series_summary(case: Case, s: PointSeries) -> dict[str, Any]:
     """Summary statistics of the series as a JSON document (SI units)."""
+    from ..core.wind.mean import downburst_field, event_window
+
     k_mean, k_tot = int(np.argmax(s.mean_speed)), int(np.argmax(s.total))
     mod = s.intensity * (s.mean_speed if case.wind.type == "downburst" else s.v_ref)
     doc: dict[str, Any] = {
@@ -129,6 +131,8 @@ def wind(
     if json_out is not None:
         check_target(json_out, what="JSON")
     from .. import service
+    from ..core.wind.point import point_series
+    from ..io.jsonout import write_json
     from .limits import warn as limits_warn
 
     service.check_budget(case, "wind", warn=limits_warn)  # resource guard (issue 14)
@@ -160,8 +164,6 @@ def wind(
         write_json(json_out, doc)
         console.print(f"wrote {json_out}")
     if field_out is not None:
-        from .. import service
-
         fld = service.wind_field(case, realization=realization - 1)
         arrays = fld.to_npz_dict()
 

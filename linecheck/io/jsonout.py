@@ -8,12 +8,14 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..service import StaticResult
 from .atomic import write_text_atomic
+
+if TYPE_CHECKING:  # annotations only: importing the service loads the numerical core
+    from ..service import StaticResult
 
 
 def _num(x: Any) -> Any:

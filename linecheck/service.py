@@ -783,12 +783,14 @@ def _run(case: Case, *, realizations, interpolate_states: bool, spectral_check: 
     statistics compute its reactions alone."""
     from .core.wind.turbulence import fluctuating_velocity
 
-    real = np.arange(case.analysis.realizations) if realizations is None else np.asarray(realizations, dtype=int)
+    # the resource guard first, before any allocation (even the realizations' indices: 8 GB for -n 1e9)
+    n_real = int(case.analysis.realizations if realizations is None else len(realizations))
     asked = max(1, int(threads))
-    threads = run_threads(case, int(real.size), threads, spectral_check=spectral_check)
+    threads = run_threads(case, n_real, threads, spectral_check=spectral_check)
     warned: list[str] = []
     check_budget(case, "run", warn=lambda m: (warned.append(m), warn(m) if warn else None),
-                 realizations=int(real.size), spectral_check=spectral_check, threads=threads)
+                 realizations=n_real, spectral_check=spectral_check, threads=threads)
+    real = np.arange(n_real) if realizations is None else np.asarray(realizations, dtype=int)
     # load the compiled kernel (same bits) before step 1 when the steps will pay for it, so that
     # step 1's span tension (a downburst's 250 states) and the statistics use it too (issue 20)
     kernel.use(float(record_time(case).size) * real.size * 3 * (case.line.spans * case.line.elements_per_span + 1))
@@ -1018,7 +1020,7 @@ def run_until(
     if not target > 0:
         raise ValueError(f"target {target!r} must be > 0")
     n = max(2, min(case.analysis.realizations, max_realizations))
-    parts = [run_case(case, realizations=np.arange(n), interpolate_states=interpolate_states,
+    parts = [run_case(case, realizations=range(n), interpolate_states=interpolate_states,
                       spectral_check=spectral_check, progress=progress, cancel=cancel, warn=warn, threads=threads)]
     while True:
         res = join_runs(parts)

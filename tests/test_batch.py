@@ -203,6 +203,34 @@ def test_broken_case_is_reported_and_others_complete(short_cases, tmp_path):
                                                                  f"{short_cases[1].stem}.json"])
 
 
+def test_case_above_the_memory_limit_fails_alone_before_the_batch_starts(short_cases, tmp_path, monkeypatch):
+    """Every task checks its own chunk, but the merged result holds every realization: a case
+    whose whole run is above the memory limit is refused before any task is submitted (its
+    one-line estimate, a CaseError: exit 2 on its own), and the other cases run."""
+    huge_dir = tmp_path / "huge"
+    huge_dir.mkdir()
+    huge = write_short_case(CASES / "paper" / "case02-single.toml", huge_dir, realizations=1_000_000_000)
+    ran: list[str] = []
+    real = service.run_case
+
+    def spy(case, **kw):
+        ran.append(case.name)
+        return real(case, **kw)
+
+    monkeypatch.setattr(service, "run_case", spy)  # sequential: tasks run in this process
+    events: list[BatchEvent] = []
+    rep = run_batch([short_cases[0], huge], progress=events.append)
+    by_path = {o.path: o for o in rep.outcomes}
+    bad = by_path[huge]
+    assert bad.status == "failed" and bad.error_kind == "CaseError", bad
+    assert "run needs about" in bad.error and "--max-memory" in bad.error
+    assert by_path[short_cases[0]].status == "done"
+    assert set(ran) == {load_case(short_cases[0]).name}  # the huge case never ran a chunk
+    assert [e.name for e in events if e.kind == "case_failed"] == [bad.name]
+    assert events[-1].overall_total == 3 and events[-1].overall_done == pytest.approx(3)  # the huge one left out
+    assert rep.exit_code == 1
+
+
 def test_non_convergence_fails_only_its_case(short_cases, monkeypatch):
     real = service.run_case
     victim = load_case(short_cases[1]).name

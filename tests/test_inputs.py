@@ -187,6 +187,31 @@ def test_huge_realization_override_exits_2_with_the_estimate_before_computing(mo
     assert "run needs about 577 TB of memory" in out and "--max-memory" in out
 
 
+def _address_space_limit(nbytes: int):
+    """A ``preexec_fn`` that caps the child's address space (RLIMIT_AS) at ``nbytes``."""
+    def limit() -> None:
+        import resource
+
+        resource.setrlimit(resource.RLIMIT_AS, (nbytes, nbytes))
+    return limit
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="RLIMIT_AS as a hard cap: Linux")
+def test_huge_realization_override_is_refused_before_any_allocation():
+    """The guard runs before anything is sized by the realization count: the same refusal in a
+    process whose address space is capped at 4 GB, where allocating the 1e9 realizations' indices
+    (8 GB) first would end in a MemoryError (exit 1) instead of the one-line estimate (exit 2)."""
+    code = "import sys; from linecheck.cli.app import main; sys.argv[0] = 'linecheck'; main()"
+    env = {**os.environ, "COLUMNS": "250"}
+    r = subprocess.run([sys.executable, "-c", code, "run", str(PAPER / "case01-single.toml"), "-n", "1000000000"],
+                       capture_output=True, text=True, env=env, timeout=120,
+                       preexec_fn=_address_space_limit(4_000_000_000))
+    err = " ".join(r.stderr.split())
+    assert r.returncode == 2, r.stdout + r.stderr
+    assert "run needs about 577 TB of memory" in err and "--max-memory" in err
+    assert "Traceback" not in r.stderr and len(r.stderr.strip().splitlines()) == 1
+
+
 def test_overrides_are_validated_like_the_file():
     r = cli("run", str(PAPER / "case01-single.toml"), "-n", "2000000000")
     assert r.exit_code == 2

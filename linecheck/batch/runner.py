@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..core import budget
 from ..core.case import Case, case_hash, load_case
 from ..core.errors import Cancelled, CaseError, LinecheckError
 from ..io.document import BatchSource, FailedRun, RunDocument
@@ -358,6 +359,21 @@ def run_batch(
             o.status, o.doc = "skipped", doc
             st.done = o.realizations
             overall_done += o.realizations
+
+    # ---- the resource guard of every case to run, before any starts (issue 14): each task checks
+    # its own chunk, but the merged result keeps every realization's histories, so a case above
+    # the memory limit fails here alone (its one-line estimate, a CaseError) and the others run
+    for st in states:
+        o = st.outcome
+        if st.case is None or o.status != "pending":
+            continue
+        n = max(2, min(o.realizations, int(until[1]))) if until is not None else o.realizations  # run_until's start
+        try:
+            budget.guard(st.case, "run", realizations=n)
+        except CaseError as err:
+            o.status, o.error, o.error_kind = "failed", str(err), type(err).__name__
+            st.done = o.realizations  # its own progress complete; none of it in the overall count
+            overall_total -= o.realizations
 
     emit("start", None, executor.describe())
     for st in states:

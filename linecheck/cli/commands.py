@@ -101,3 +101,4 @@ from . import export_cmd  # noqa: E402,F401
 from . import batch_cmd  # noqa: E402,F401
 from . import validate_cmd  # noqa: E402,F401
 from . import codes_cmd  # noqa: E402,F401
+from . import info_cmd  # noqa: E402,F401

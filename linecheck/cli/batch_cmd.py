@@ -353,6 +353,8 @@ def batch(
 ) -> None:
     """Run many cases (all realizations) in parallel, saving each result as it completes."""
     from ..batch import make_executor, run_batch
+    from ..io.provenance import kernel_warning
+    from .limits import warn as limits_warn
 
     apply_max_memory(max_memory)  # each task checks its memory estimate (workers inherit the limit)
 
@@ -366,6 +368,9 @@ def batch(
         paths, plan = model_jobs(paths, models)
     _check_excel(excel, force, template)
     out_dir = json_dir if json_dir is not None else ((excel.parent if excel is not None else Path.cwd()) / "results")
+    kernel_off = kernel_warning()  # compiled pieces off (Numba installed): one line, before the batch
+    if kernel_off:
+        limits_warn(kernel_off)
     cancel = threading.Event()
     with (make_executor(jobs, scheduler, connect_timeout) as executor,
           BatchDisplay(interval=progress_interval) as display):

@@ -45,7 +45,7 @@ def codes(
 ) -> None:
     """Design-code conductor wind loads (ASCE 74, IEC 60826, EN 50341-1, AS/NZS 7000) beside linecheck's peaks."""
     from .. import service  # here, not at import: the service loads the numerical core (start-up time)
-    from ..io.jsonout import codes_document, codes_to_dict, write_json
+    from ..io.jsonout import codes_document, codes_to_dict, with_provenance, write_json
 
     case = read_case(case_file)
     if json_out is not None:
@@ -64,5 +64,5 @@ def codes(
     console.print("[dim]linecheck peak: " + res.peak + ". Unverified codes are shown, not judged (docs/codes.md).[/]",
                   highlight=False)
     if json_out is not None:
-        write_json(json_out, doc)
+        write_json(json_out, with_provenance(doc))
         console.print(f"wrote {json_out}")

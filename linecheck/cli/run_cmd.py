@@ -196,6 +196,7 @@ def run(
     from .. import service  # here, not at import: the service loads the numerical core (start-up time)
     from ..batch.executors import default_jobs
     from ..io.jsonout import run_document, write_json
+    from ..io.provenance import kernel_warning
 
     fields = title_block(project, line, engineer, revision, title, excel=excel)
     apply_max_memory(max_memory)
@@ -209,6 +210,9 @@ def run(
 
         check_excel_target(excel, force=force, template=template)
     names = service.parse_models(case, models) if models is not None else ()
+    kernel_off = kernel_warning()  # compiled pieces off (Numba installed): one line, before the work
+    if kernel_off:
+        limits_warn(kernel_off)
     with progress_bar() as cb:
         if names:
             spread = service.run_models(case, names, progress=cb, spectral_check=not no_check, warn=limits_warn,
@@ -259,7 +263,7 @@ def modes(
 ) -> None:
     """Natural frequencies (and mode shapes) of the still-air and mean states."""
     from .. import service
-    from ..io.jsonout import _num, write_json
+    from ..io.jsonout import _num, with_provenance, write_json
 
     case = read_case(case_file)
     if json_out is not None:
@@ -297,5 +301,5 @@ def modes(
         if shapes:
             doc["still_air"]["shapes"] = _num(res.still_air.shapes)
             doc["mean"]["shapes"] = _num(res.mean.shapes)
-        write_json(json_out, doc)
+        write_json(json_out, with_provenance(doc))
         console.print(f"wrote {json_out}")

@@ -42,7 +42,7 @@ def davenport_line(doc: dict) -> str:
 def spectral(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     """Frequency-domain estimates (exact random vibration and closed form) for a synoptic case."""
     from .. import service  # here, not at import: the service loads the numerical core (start-up time)
-    from ..io.jsonout import spectral_document, spectral_to_dict, write_json
+    from ..io.jsonout import spectral_document, spectral_to_dict, with_provenance, write_json
 
     case = read_case(case_file)
     if json_out is not None:
@@ -57,7 +57,7 @@ def spectral(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     if text:
         console.print(text, highlight=False)
     if json_out is not None:
-        write_json(json_out, doc)
+        write_json(json_out, with_provenance(doc))
         console.print(f"wrote {json_out}")
 
 

@@ -132,7 +132,7 @@ def wind(
         check_target(json_out, what="JSON")
     from .. import service
     from ..core.wind.point import point_series
-    from ..io.jsonout import write_json
+    from ..io.jsonout import with_provenance, write_json
     from .limits import warn as limits_warn
 
     service.check_budget(case, "wind", warn=limits_warn)  # resource guard (issue 14)
@@ -161,7 +161,7 @@ def wind(
         write_text_atomic(csv_out, series_csv(s), what="CSV")
         console.print(f"wrote {csv_out}")
     if json_out is not None:
-        write_json(json_out, doc)
+        write_json(json_out, with_provenance(doc))
         console.print(f"wrote {json_out}")
     if field_out is not None:
         fld = service.wind_field(case, realization=realization - 1)

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from ..core.errors import CaseError
+from .provenance import Provenance
 
 #: Version of the run-result JSON layout.  1 (no "schema_version" key): before issue 18,
 #: statistics as {"mean", "std"} only.
@@ -521,7 +522,8 @@ HEADER_FIELDS: tuple[tuple[str, str], ...] = (
 )
 #: Optional typed blocks after ``"towers"``, in JSON order (absent from the JSON when None).
 BLOCK_FIELDS = ("still_air", "static", "parameters", "burn_in", "damping", "structural_damping", "spectral",
-                "codes", "time_histories", "batch", "model", "models", "models_envelope", "models_failed")
+                "codes", "time_histories", "batch", "model", "models", "models_envelope", "models_failed",
+                "provenance")
 _BATCH_KEYS = ("case_file", "case_hash", "changes")
 
 
@@ -534,7 +536,9 @@ class RunDocument:
     document), ``burn_in``, ``damping``/``structural_damping``, ``spectral``, ``codes`` (per
     code), ``time_histories``, ``batch`` (written as the top-level keys ``"case_file"``,
     ``"case_hash"``, ``"changes"``), ``model``/``models``/``models_envelope``/``models_failed``
-    (downburst model spread), ``until``.  ``blocks``: keys this version does not know, verbatim.
+    (downburst model spread), ``until``, ``provenance`` (versions, BLAS and compiled kernel of the
+    run, :mod:`linecheck.io.provenance`; absent from results saved before it was recorded).
+    ``blocks``: keys this version does not know, verbatim.
     """
 
     schema_version: int
@@ -571,6 +575,7 @@ class RunDocument:
     models: dict[str, dict[str, ReactionResult]] | None = None
     models_envelope: dict[str, dict[str, EnvelopeEntry]] | None = None
     models_failed: dict[str, str] | None = None
+    provenance: Provenance | None = None
     blocks: dict[str, Any] = field(default_factory=dict)
 
     def reaction(self, r: str) -> ReactionResult:
@@ -633,6 +638,7 @@ class RunDocument:
                 models_envelope=opt("models_envelope", lambda e: {
                     r: {s: EnvelopeEntry.from_json(x) for s, x in st.items()} for r, st in e.items()}),
                 models_failed=d.get("models_failed"),
+                provenance=opt("provenance", Provenance.from_json),  # older results: none
             )
         except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
             raise CaseError(f"{what}incomplete or damaged ({type(exc).__name__}: {exc}): regenerate it with "
@@ -728,6 +734,34 @@ def json_schema() -> dict[str, Any]:
         parts = t.split("|")
         return {"type": parts[0] if len(parts) == 1 else parts}
 
+    string_or_null = {"type": ["string", "null"]}
+    blas = {"type": "object", "description": "a BLAS library loaded by the run's process: library (openblas, mkl, "
+            "blis), version, core (the core kernel OpenBLAS selected for the CPU, e.g. Haswell, SkylakeX), "
+            "threads, path of the shared library; null where the library does not say",
+            "properties": {"library": {"type": "string"}, "version": string_or_null, "core": string_or_null,
+                           "threads": {"type": ["integer", "null"]}, "path": string_or_null},
+            "required": ["library", "version", "core", "threads", "path"], "additionalProperties": False}
+    piece = {"type": "object", "properties": {"name": {"type": "string"}, "on": {"type": "boolean"},
+                                              "reason": {"type": "string"}},
+             "required": ["name", "on", "reason"], "additionalProperties": False}
+    provenance = {
+        "type": "object",
+        "description": "where the result was computed (as `linecheck info --json`): versions (numba: \"not "
+                       "installed\" when absent), the BLAS numpy calls, the BLAS scipy.linalg calls (null when "
+                       "numpy's) and the compiled kernel: Numba installed, LINECHECK_KERNEL mode, and per piece "
+                       "whether it ran compiled (reason: why not, \"\" when on); absent from older results",
+        "properties": {**{k: {"type": "string"} for k in ("linecheck", "python", "numpy", "scipy", "numba")},
+                       "blas": {"$ref": "#/$defs/blas"},
+                       "scipy_blas": {**blas, "type": ["object", "null"]},
+                       "kernel": {"type": "object",
+                                  "properties": {"installed": {"type": "boolean"},
+                                                 "mode": {"enum": ["auto", "numpy", "numba"]},
+                                                 "pieces": {"type": "array", "items": piece}},
+                                  "required": ["installed", "mode", "pieces"], "additionalProperties": False}},
+        "required": ["linecheck", "python", "numpy", "scipy", "numba", "blas", "kernel"],
+        "additionalProperties": True,
+    }
+
     header = {k: json_type(t) for k, t in HEADER_FIELDS}
     header["schema_version"] = {"const": SCHEMA_VERSION}
     header["wind"] = {"enum": ["synoptic", "downburst"]}
@@ -769,6 +803,7 @@ def json_schema() -> dict[str, Any]:
             "structural_damping": {"type": "number"},
             "spectral": {"type": "object"},
             "time_histories": {"type": "object"},
+            "provenance": {"$ref": "#/$defs/provenance"},
         },
         "required": [k for k, _ in HEADER_FIELDS] + ["reactions", "towers"],
         "additionalProperties": True,
@@ -781,6 +816,8 @@ def json_schema() -> dict[str, Any]:
                    "prefixItems": [num_or_null, num_or_null], "minItems": 2, "maxItems": 2},
             "reaction": reaction,
             "reactions": reactions,
+            "blas": blas,
+            "provenance": provenance,
             **{f"stat_{s.name}": stat_schema(s) for s in STAT_TABLE},
         },
     }

@@ -43,8 +43,17 @@ def _header(case: Any) -> dict[str, Any]:
     }
 
 
+def with_provenance(doc: dict[str, Any]) -> dict[str, Any]:
+    """``doc`` with the top-level ``"provenance"`` block every result document records
+    (:func:`linecheck.io.provenance.provenance`: versions, BLAS, compiled kernel pieces)."""
+    from .provenance import provenance
+
+    return {**doc, "provenance": provenance().to_json()}
+
+
 def static_to_dict(res: StaticResult) -> dict[str, Any]:
-    """Step-1 JSON: ``{"case", "units", "tower_of_interest", "towers": [...], "spans": [...]}``.
+    """Step-1 JSON: ``{"case", "units", "tower_of_interest", "towers": [...], "spans": [...],
+    "provenance"}``.
 
     Synoptic: one value per key.  Downburst: every value is a list over the
     step-1 instants and ``"time"`` lists them.
@@ -107,7 +116,7 @@ def static_to_dict(res: StaticResult) -> dict[str, Any]:
     }
     if series:
         doc["time"] = _num(m.time)
-    return doc
+    return with_provenance(doc)
 
 
 def write_json(path: str | Path, doc: Any, *, force: bool = True) -> Path:
@@ -155,13 +164,15 @@ def run_document(res: Any, *, full_histories: bool = False, max_points: int = 20
     ``{"mean", "std", "se", "p05", "p50", "p95"}``, peaks with ``"gumbel"``, GF_Dy/GF_QS/Cont_R
     with ``"ci"``, each reaction with ``"dynamic_analysis"``), ``until``, and the typed blocks
     ``still_air``, ``static``, ``parameters``, ``burn_in``, ``damping``, ``spectral`` (synoptic,
-    with its sanity check), ``codes`` and ``time_histories``.  Forces in N, Cont_* as
+    with its sanity check), ``codes``, ``time_histories`` and ``provenance`` (versions, BLAS and
+    compiled kernel pieces of this process: :mod:`linecheck.io.provenance`).  Forces in N, Cont_* as
     fractions, GF null where the mean vanishes.  Time histories are those of realization 1 at
     the tower of interest, thinned to about ``max_points`` samples keeping every block's
     extremes unless ``full_histories``.
     """
     from ..core.results import REACTIONS
     from .document import BurnIn, SanityItem, StaticSeries, StillAir, TimeHistories, document_of
+    from .provenance import provenance
 
     case = res.case
     j = res.tower_index
@@ -201,6 +212,7 @@ def run_document(res: Any, *, full_histories: bool = False, max_points: int = 20
     blocks["time_histories"] = TimeHistories(
         int(res.realizations[0]) + 1, bool(idx.size < res.time.size), _num(res.time[idx]),
         {r: {"M": _num(M[idx, c]), "B": _num(B[idx, c]), "R": _num(R[idx, c])} for c, r in enumerate(REACTIONS)})
+    blocks["provenance"] = provenance()
     return document_of(res, **blocks)
 
 

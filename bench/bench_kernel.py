@@ -1,11 +1,12 @@
-"""Issue 20: the optional compiled step loop (``linecheck[fast]``, Numba) against the numpy loop.
+"""The optional compiled kernel (``linecheck[fast]``, Numba) against the numpy code.
 
     .venv/bin/python bench/bench_kernel.py            # --repeat 3
 
 Each row runs the same case twice in this process, the numpy loop (``LINECHECK_KERNEL=numpy``,
 the baseline) and the compiled kernel (``LINECHECK_KERNEL=numba``), fresh turbulence every run,
 best of ``--repeat``; the frequency-domain check is included where a run makes it.  The two
-give the same bits (tests/test_kernel.py); the last column checks it again here.
+agree within a tolerance (tests/test_kernel.py: RTOL_RUN, 1e-9 of the largest value); the last
+column prints their largest relative difference here.
 """
 
 from __future__ import annotations
@@ -49,7 +50,7 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
-    if not kernel.available():
+    if not kernel.installed():
         sys.exit("Numba is not installed: pip install -e '.[fast]'")
     rows = [
         ("Sy 40 m/s, 6 spans, 1 realization", case_with("case09-six"), [0]),
@@ -61,13 +62,15 @@ def main() -> None:
     out = []
     for name, case, reals in rows:
         best, res = timed(case, reals, args.repeat)
-        same = all(np.array_equal(getattr(res["numpy"], k), getattr(res["numba"], k))
-                   for k in ("background", "resonant"))
-        out.append((name, best["numpy"], best["numba"], same))
+        diff = max(float(np.abs(getattr(res["numba"], k) - getattr(res["numpy"], k)).max()
+                         / np.abs(getattr(res["numpy"], k)).max()) for k in ("background", "resonant"))
+        out.append((name, best["numpy"], best["numba"], diff))
     print(f"machine: {os.cpu_count()} cores; {time.strftime('%Y-%m-%d %H:%M')}; best of {args.repeat}")
-    print(f"{'run':40s} {'numpy loop':>11s} {'kernel':>8s} {'ratio':>6s}  same bits")
-    for name, a, b, same in out:
-        print(f"{name:40s} {a:10.2f}s {b:7.2f}s {a / b:5.2f}x  {same}")
+    off = [f"{p.name} ({p.reason})" for p in kernel.status() if not p.on]
+    print("kernel pieces off: " + (", ".join(off) if off else "none"))
+    print(f"{'run':40s} {'numpy loop':>11s} {'kernel':>8s} {'ratio':>6s}  rel. difference")
+    for name, a, b, diff in out:
+        print(f"{name:40s} {a:10.2f}s {b:7.2f}s {a / b:5.2f}x  {diff:.1e}")
 
 
 if __name__ == "__main__":

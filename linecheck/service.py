@@ -602,7 +602,7 @@ def fluctuating_loads(case: Case, system: LineSystem, model, t: np.ndarray, v: n
         pq, s2 = per_q[:, sel], sig2[:, sel]  # (n_steps, n_nodes), as per_v
         pq_p, s2_p = per_q[:, pinned], sig2[:, pinned]
     # the same elementwise products as on every node, written straight into the loads (one
-    # compiled pass when the kernel is loaded: the same bits, issue 20)
+    # compiled pass with the kernel's piece ``loads``)
     kernel.drag_loads(pv, pq if quad else None, s2 if quad else None, v, sel, loads)
     for i in range(n_real if pinned.size else 0):
         vp = v[i][:, pinned]
@@ -791,9 +791,6 @@ def _run(case: Case, *, realizations, interpolate_states: bool, spectral_check: 
     check_budget(case, "run", warn=lambda m: (warned.append(m), warn(m) if warn else None),
                  realizations=n_real, spectral_check=spectral_check, threads=threads)
     real = np.arange(n_real) if realizations is None else np.asarray(realizations, dtype=int)
-    # load the compiled kernel (same bits) before step 1 when the steps will pay for it, so that
-    # step 1's span tension (a downburst's 250 states) and the statistics use it too (issue 20)
-    kernel.use(float(record_time(case).size) * real.size * 3 * (case.line.spans * case.line.elements_per_span + 1))
     st = _static_analysis(case, progress=progress, cancel=cancel)
     system, mean = st.system, st.mean
     t = record_time(case)
@@ -858,10 +855,8 @@ def _run(case: Case, *, realizations, interpolate_states: bool, spectral_check: 
     load_dirs = None if system.straight_in_plan else system.node_normals[models[0].dofs.free_nodes]
     model_at = _interpolated_models(case, st, bracket, weights) if interpolate_states else None
 
-    # the compiled kernel (same bits) when installed and worth loading: decided once for the
-    # whole run, so that the chunks' wind synthesis uses it too
-    compiled = kernel.use(float(t.size) * real.size * models[0].mass.size)
-    concurrent = asked > 1 and compiled
+    # realization threads only with the compiled step loop, which runs without the GIL
+    concurrent = asked > 1 and kernel.use("newmark")
     if not concurrent:
         threads = 1  # the numpy step loop holds the GIL between its small calls: threads lose time
     # the frequency-domain check needs only step 1 and the burn-in's models: with threads to

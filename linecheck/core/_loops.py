@@ -1,13 +1,14 @@
-"""The compiled loops of the optional kernel (issue 20): Numba functions at module level.
+"""The compiled loops of the optional kernel: Numba functions at module level.
 
-Imported only by :func:`linecheck.core.kernel._compile`, i.e. only when the kernel is asked
-for (the rest of the core imports numpy and scipy only; tests/test_import_boundary.py).  The
-functions are module-level so that Numba's on-disk cache (``cache=True``) can key them: a
-function that calls other jitted functions through closure cells gets a new cache key in every
-process (the cells are pickled by identity) and was recompiled every time (≈ 1–2 s per function
-and process, and a new cache entry each time).  What the loops compute, and why their bits
-equal the numpy loop's, is documented in :mod:`linecheck.core.kernel`.
-"""
+Imported only by :mod:`linecheck.core.kernel` when a piece of the kernel is first asked for (the
+rest of the core imports numpy and scipy only; tests/test_import_boundary.py).  The functions are
+module-level so that Numba's on-disk cache (``cache=True``) can key them: a function that calls
+other jitted functions through closure cells gets a new cache key in every process (the cells are
+pickled by identity) and was recompiled every time.  What the loops compute, and how they are
+checked against the numpy forms (a tolerance, not bits), is documented in
+:mod:`linecheck.core.kernel`.  Where two loops here serve the same realization in different
+groupings (one vector or four lanes), they run the same operations in the same order, so a
+realization's bits do not depend on the grouping (determinism across chunking and ``--jobs``)."""
 
 from __future__ import annotations
 
@@ -15,16 +16,18 @@ import numba
 import numpy as np
 from llvmlite import ir
 from numba import types
-from numba.extending import intrinsic
+from numba.core import cgutils
+from numba.extending import get_cython_function_address, intrinsic
 
 __all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "drag_loads", "field_radius", "field_velocity", "from_lanes", "history_reductions", "phasors", "quad_kms", "reactions_into",
            "rest_product", "rotate", "rowdot", "so_frame", "so_history", "so_nodes", "so_nodes_t", "so_place", "so_products", "so_solve", "solve_columns", "span_terms",
            "steps", "steps_1", "to_lanes"]
 
 
-# the banded triangular solves, with contraction as OpenBLAS's Haswell dtbsv forms them.
+# the banded triangular solves (LAPACK dpbtrs' algorithm: a dot product per row, then an axpy
+# per column), with contraction (fused multiply-adds where LLVM finds them).
 # x is (n_groups, n_dof, 4): the realizations in groups of four lanes (padded with zeros),
-# every lane solved by itself in dtbsv's order; four independent chains per group hide the
+# every lane solved by itself in the same order; four independent chains per group hide the
 # latency of the dependent divide and multiply-adds (LLVM keeps the lanes scalar; measured:
 # four lanes cost ≈ 1.4 x one, docs/performance.md)
 @numba.njit(cache=True, nogil=True, fastmath={"contract"})
@@ -412,7 +415,7 @@ def coherent_spectrum(xr_, xi_, rho_rows, s_rows, row_of_gap, amp, scale, spec):
     """The wind synthesis' spectrum of ordered nodes in one pass (issue 20): from the unit phasors
     xi = exp(i phi) (:func:`phasors`: xr_ + i xi_), the Markov (equal gaps: KMS) recursion
     y_0 = xi_0, y_j = rho y_(j-1) + s xi_j along the nodes with the coefficient row of gap j - 1,
-    and spec[j, k + 1] = scale (amp_k y_jk), with numpy's bits (turbulence.synthesize): a real
+    and spec[j, k + 1] = scale (amp_k y_jk), as numpy's form (turbulence.synthesize): a real
     times a complex as numpy forms it (the real cast to complex: (a x_r - 0 x_i, a x_i + 0 x_r)).
     xr_, xi_ (n_nodes, n_freq); rho_rows, s_rows (n_rows, n_freq); row_of_gap (n_nodes - 1,);
     amp (n_freq,); spec (n_nodes, >= n_freq + 1) complex, zero outside columns 1 .. n_freq."""
@@ -442,7 +445,7 @@ def coherent_spectrum(xr_, xi_, rho_rows, s_rows, row_of_gap, amp, scale, spec):
 
 @numba.njit(cache=True, nogil=True)
 def drag_loads(pv, pq, s2, v, s0, quad, loads):  # pragma: no cover - compiled
-    """The fluctuating drag on the free nodes (service.fluctuating_loads) with numpy's bits:
+    """The fluctuating drag on the free nodes (service.fluctuating_loads), as the numpy form:
     loads[t, i, f] = pv[t, f] v[i, t, s0 + f] (paper Eq. 5), plus ((v^2 - s2) pq) with the
     quadratic drag (issue 16), each product and sum rounded by itself.  pv, pq, s2 (n_steps,
     n_free); v (n_real, n_steps, n_nodes), the free nodes s0 .. s0 + n_free - 1; loads
@@ -461,8 +464,8 @@ def drag_loads(pv, pq, s2, v, s0, quad, loads):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def span_terms(ay, az, by, bz, H, EA, l, with_e, f, g, e):  # pragma: no cover - compiled
-    """The integrands of one Newton step of the span tension (static.span_terms) with numpy's
-    bits, each product, quotient and sum rounded by itself in numpy's order:
+    """The integrands of one Newton step of the span tension (static.span_terms), each product,
+    quotient and sum as the numpy form writes it:
     p = a + b/H, u = sqrt((1 + p_y^2) + p_z^2), den = 1 + (H u)/EA, f = u/den,
     g = ((-u^2)/EA)/den^2 + ((1/den^2) (-(p_y b_y + p_z b_z)/H^2))/u and, with with_e,
     e = ((1/den^2) (-(p_y a_y + p_z a_z)/l))/u.  ay, az, H, l (n, n_spans); by, bz (1 or n,
@@ -492,7 +495,7 @@ def span_terms(ay, az, by, bz, H, EA, l, with_e, f, g, e):  # pragma: no cover -
 
 @numba.njit(cache=True, nogil=True)
 def history_reductions(M, B, R, sa, out):  # pragma: no cover - compiled
-    """results.history_reductions in one pass with numpy's bits: per (sample, tower, component)
+    """results.history_reductions in one pass: per (sample, tower, component)
     the sums of B^2, R^2, (B + R)^2 over time, one sample after the other from the first (numpy's
     order along a non-contiguous axis), divided by n_t, square-rooted; and the largest |M + B|,
     |(M + B) + R|, |(M + B) + sa|, |((M + B) + R) + sa|.  The histories are finite (the time
@@ -526,7 +529,7 @@ def history_reductions(M, B, R, sa, out):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, nogil=True)
 def field_radius(x, cx, cy, r_max, decay, r, z):  # pragma: no cover - compiled
-    """First pass of DownburstField.velocity (Holmes & Oliver 2000) with numpy's bits: per instant
+    """First pass of DownburstField.velocity (Holmes & Oliver 2000): per instant
     t and line point x, r = hypot(x - cx, 0 - cy) and the Gaussian's exponent
     z = -(((r - r_max)/decay)^2) (numpy then takes exp(z) on the whole array, as it does now).
     x (n_x,); cx, cy (n_t,); r, z (n_t, n_x)."""
@@ -543,7 +546,7 @@ def field_radius(x, cx, cy, r_max, decay, r, z):  # pragma: no cover - compiled
 @numba.njit(cache=True, nogil=True)
 def field_velocity(x, cx, cy, r, e, r_max, fz, pi, v_max, tx, ty, vx, vy):  # pragma: no cover - compiled
     """Second pass: f_r = r/r_max inside r_max else e (= exp(z)), speed = v_max ((f_r f_z) Pi(t)),
-    v = speed d/r + translation (0 + translation at r = 0), with numpy's bits."""
+    v = speed d/r + translation (0 + translation at r = 0)."""
     for t in range(cx.size):
         dy = 0.0 - cy[t]
         p = pi[t]
@@ -562,7 +565,7 @@ def field_velocity(x, cx, cy, r, e, r_max, fz, pi, v_max, tx, ty, vx, vy):  # pr
 
 @numba.njit(cache=True, nogil=True)
 def quad_kms(w, rho, gap, out):  # pragma: no cover - compiled
-    """spectral._quad_kms_nodes with numpy's bits: w (K, N, F) complex, rho (F,) (``gap`` False)
+    """spectral._quad_kms_nodes in one pass: w (K, N, F) complex, rho (F,) (``gap`` False)
     or per gap (N - 1, F); out (K, F) = sum_i |w_i|^2 (summed over the nodes one after the other,
     as numpy reduces a non-contiguous axis) + 2 sum_j Re(conj(w_j) h_j), h_j = (h_{j-1} + w_{j-1})
     rho_j, the complex-times-real product written as numpy forms it, (a c - b 0, a 0 + b c)."""
@@ -596,10 +599,8 @@ def quad_kms(w, rho, gap, out):  # pragma: no cover - compiled
             out[k, f] = out[k, f] + 2.0 * cr[f]
 
 
-# the second-order tension's passes (issue 16, second_order._reactions): the 3 x 3 products as
-# OpenBLAS's dgemm kernel forms them (a fused multiply-add chain over k = 0, 1, 2 from a zeroed
-# accumulator, then added to the zeroed C: acc + 0), compiled with ``contract``; starting from
-# 0.0 leaves LLVM one way to fuse each step
+# the second-order tension's passes (second_order._reactions): the 3 x 3 products as a
+# multiply-add chain over k = 0, 1, 2, compiled with ``contract``
 @numba.njit(cache=True, nogil=True, fastmath={"contract"})
 def so_nodes(U, r, T, node_of_free, rotate_, u):  # pragma: no cover - compiled
     """u[node, k, j] (n_nodes, 3, nb) of the free nodes from the rows j < r of U (m, 3 n_f):
@@ -673,8 +674,7 @@ def so_products(u, ec, li, P, d):  # pragma: no cover - compiled
     """P (3 n_el + 3 n_s, nb) of second_order._reactions: every cable element's second-order
     force per unit c, a d + q e (d = u[e + 1] - u[e], a = e.d, q = |d|^2/2 - 3 a^2/2; ec (n_el, 3)
     the unit chords), every insulator's a s, a w, s^2 + w^2 from li = (a, s, w); each product
-    and sum rounded by itself in the numpy form's order (no contraction), in float64, each
-    term then rounded once to P's type (float32).  d: scratch (5, nb)
+    and sum rounded by itself, in float64.  d: scratch (5, nb)
     for d, a and q: one output row per loop vectorises (a loop writing three rows did not: too
     many possible overlaps for LLVM's run-time checks; measured 2.5x)."""
     n_el = u.shape[0] - 1
@@ -721,7 +721,7 @@ def so_products(u, ec, li, P, d):  # pragma: no cover - compiled
 @numba.njit(cache=True, nogil=True)
 def _rhs(Lt, dirs, straight, j, y):  # pragma: no cover - compiled
     """Row j of the right-hand sides into y[j]: load i = j // 3 of Lt (n_free, nb) along global
-    y (``straight``) or along dirs[i], as second_order._band_solve_rows' caller places them."""
+    y (``straight``) or along dirs[i], as second_order.second_order_of_loads places them."""
     i = j // 3
     q = j - 3 * i
     nb = y.shape[1]
@@ -744,8 +744,8 @@ def so_solve(c, inv, L, dirs, straight, i0, r, y, xr, s, Lt):  # pragma: no cove
     j = row i0 + j (lanes >= r solve zeros): the right-hand sides (global y, or along ``dirs``
     (n_free, 3) when not ``straight``), then U^T U x = b by rows of lanes (c the upper band of
     dpbtrf, inv = 1 / its diagonal); x returned in xr (n_dof, nb) in reversed row order,
-    xr[n - 1 - j] = x_j.  Every operation rounded by itself in second_order._band_solve_rows'
-    order (no contraction), so the same bits.  y (n_dof, nb), s (nb,), Lt (n_free, nb): scratch.
+    xr[n - 1 - j] = x_j (the algorithm of LAPACK dpbtrs, which the numpy form calls; no
+    contraction).  y (n_dof, nb), s (nb,), Lt (n_free, nb): scratch.
 
     Speed (measured, docs/performance.md): the rows with the core's full half-bandwidth (5) in
     one pass, the band's sum in a register and the load placed in the same pass (no zeroed
@@ -836,27 +836,49 @@ def so_solve(c, inv, L, dirs, straight, i0, r, y, xr, s, Lt):  # pragma: no cove
                                     + c4 * xr[jr - 5, l])) * w
 
 
+def scipy_dgemm() -> int | None:
+    """The address of scipy's Fortran ``dgemm`` (``scipy.linalg.cython_blas``, 32-bit integer
+    sizes: the interface scipy documents for it), or None when that module or an LP64 ``dgemm``
+    is not found.  :func:`so_history` calls it from compiled code, without the GIL."""
+    try:
+        from scipy.linalg import cython_blas
+    except ImportError:  # pragma: no cover - scipy always ships it
+        return None
+    capsule = cython_blas.__pyx_capi__.get("dgemm")
+    if capsule is None or "int *" not in str(capsule) or "int64" in str(capsule):  # pragma: no cover
+        return None
+    return int(get_cython_function_address("scipy.linalg.cython_blas", "dgemm"))
+
+
 @intrinsic
-def _sgemm64(typingctx, fp, ta, tb, m, n, k, a, lda, b, ldb, c, ldc):  # pragma: no cover - compiled
-    """cblas_sgemm(RowMajor, ta, tb, m, n, k, 1.0f, a, lda, b, ldb, 0.0f, c, ldc) of an ILP64 CBLAS
-    (64-bit sizes) through its address ``fp``: the call numpy's ``matmul`` makes for float32
-    arrays (kernel.py)."""
-    sig = types.void(types.intp, types.int32, types.int32, types.int64, types.int64, types.int64,
-                     types.voidptr, types.int64, types.voidptr, types.int64, types.voidptr, types.int64)
+def _dgemm_nt(typingctx, fp, m, n, k, a, lda, b, ldb, c, ldc):  # pragma: no cover - compiled
+    """Fortran dgemm('N', 'T', m, n, k, 1.0, a, lda, b, ldb, 0.0, c, ldc) through its address
+    ``fp`` (:func:`scipy_dgemm`; every argument by reference, sizes as 32-bit integers): column-
+    major C (m, n) = A (m, k) B (n, k)^T."""
+    sig = types.void(types.intp, types.int64, types.int64, types.int64, types.voidptr, types.int64,
+                     types.voidptr, types.int64, types.voidptr, types.int64)
 
     def codegen(context, builder, signature, args):
-        i32, i64, flt, vp = ir.IntType(32), ir.IntType(64), ir.FloatType(), ir.IntType(8).as_pointer()
-        fnty = ir.FunctionType(ir.VoidType(), [i32, i32, i32, i64, i64, i64, flt, vp, i64, vp, i64, flt, vp, i64])
+        i8, i32, f64 = ir.IntType(8), ir.IntType(32), ir.DoubleType()
+        p8, p32, pf = i8.as_pointer(), i32.as_pointer(), f64.as_pointer()
+        fnty = ir.FunctionType(ir.VoidType(), [p8, p8, p32, p32, p32, pf, pf, p32, pf, p32, pf, pf, p32])
         fn = builder.inttoptr(args[0], fnty.as_pointer())
-        builder.call(fn, [ir.Constant(i32, 101), args[1], args[2], args[3], args[4], args[5], ir.Constant(flt, 1.0),
-                          args[6], args[7], args[8], args[9], ir.Constant(flt, 0.0), args[10], args[11]])
+
+        def ref(ty, value):  # a stack slot holding value (allocated once, in the entry block)
+            slot = cgutils.alloca_once(builder, ty)
+            builder.store(value, slot)
+            return slot
+
+        def size(v):
+            return ref(i32, builder.trunc(v, i32))
+
+        builder.call(fn, [ref(i8, ir.Constant(i8, ord("N"))), ref(i8, ir.Constant(i8, ord("T"))),
+                          size(args[1]), size(args[2]), size(args[3]), ref(f64, ir.Constant(f64, 1.0)),
+                          builder.bitcast(args[4], pf), size(args[5]), builder.bitcast(args[6], pf), size(args[7]),
+                          ref(f64, ir.Constant(f64, 0.0)), builder.bitcast(args[8], pf), size(args[9])])
         return context.get_dummy_value()
 
     return sig, codegen
-
-
-_NO_TRANS = np.int32(111)
-_TRANS = np.int32(112)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -877,12 +899,12 @@ def so_place(xr, run_lo, run_hi, run_f0, u):  # pragma: no cover - compiled
 @numba.njit(cache=True, nogil=True)
 def so_history(fp, of_loads, transposed, U, T, rotate_, node_of_free, L, c, inv, dirs, straight, y, xr, sc, Lt,
                run_lo, run_hi, run_f0, ins_nodes, frame, ec, W, chunk, u, li, P, d, tmp, out):  # pragma: no cover - compiled
-    """second_order._reactions in one call (issue 16): per block of nb = u.shape[2] rows the
-    displacements (``of_loads``: so_solve of the block's loads, placed run by run of free nodes by
-    so_place; else so_nodes of U, or so_nodes_t of U's columns when ``transposed``), so_frame, so_products (P float32) and P W by the sgemm at
-    ``fp`` in ``chunk``-row products into tmp (float32, (chunk, n_r)), copied into out (float64)
-    — every BLAS call with the arguments numpy's ``matmul`` passes for the same arrays, so the
-    same bits."""
+    """second_order._reactions in one call: per block of nb = u.shape[2] rows the displacements
+    (``of_loads``: so_solve of the block's loads, placed run by run of free nodes by so_place; else
+    so_nodes of U, or so_nodes_t of U's columns when ``transposed``), so_frame, so_products and
+    P W by the dgemm at ``fp`` (scipy's, :func:`scipy_dgemm`) in ``chunk``-row products into tmp
+    ((chunk, n_r)), copied into out: every product has the same shape, so a row's result does not
+    depend on the other rows of its block."""
     m = out.shape[0]
     nb = u.shape[2]
     nr = W.shape[1]
@@ -899,9 +921,8 @@ def so_history(fp, of_loads, transposed, U, T, rotate_, node_of_free, L, c, inv,
             so_place(xr, run_lo, run_hi, run_f0, u)
         so_frame(u, ins_nodes, frame, li)
         so_products(u, ec, li, P, d)
-        for j0 in range(0, r, chunk):  # P W in float32 (sgemm), each chunk through tmp into out
-            _sgemm64(fp, _TRANS, _NO_TRANS, chunk, nr, npw, P[:, j0:].ctypes.data, nb, W.ctypes.data, nr,
-                     tmp.ctypes.data, nr)
+        for j0 in range(0, r, chunk):  # P W by dgemm in chunk-row products (always that shape) into tmp
+            _dgemm_nt(fp, nr, chunk, npw, W.ctypes.data, nr, P[:, j0:].ctypes.data, nb, tmp.ctypes.data, nr)
             for q in range(min(chunk, r - j0)):
                 for cc in range(nr):
                     out[i0 + j0 + q, cc] = tmp[q, cc]

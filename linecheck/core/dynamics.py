@@ -191,7 +191,7 @@ def integrate(
             """Second-order reactions of global displacements U (..., n_dof) under the state of step n."""
             return second_order_reactions(second_order[int(state_of_step[n])], U.reshape(-1, n_dof)).reshape(
                 U.shape[:-1] + (n_r,))
-    compiled = kernel.use(float(n_steps) * n_real * n_dof)  # optional compiled loops, same bits (issue 20)
+    compiled = kernel.use("newmark")  # the optional compiled step loop and banded solves (kernel.py)
     if model_at is None and n_dof > BACKGROUND_SOLVE_DOF:
         # a long line (issue 20): the dense static transfer (n_free x n_r) would cost O(n^2) per
         # step; solve K u_B = P l by the banded Cholesky instead (dpbtrs: column by column, so a
@@ -204,7 +204,7 @@ def integrate(
             per = max(1, rows // max(n_real, 1))
             for i0 in range(0, all_steps.size, per):
                 steps = all_steps[i0:i0 + per]
-                if compiled and second_order is None:  # the same arithmetic, compiled and fused
+                if compiled and second_order is None:  # the same arithmetic, compiled and fused (kernel.background)
                     R_B[steps] = kernel.background(c, loads[steps].reshape(-1, n_free), load_dirs,
                                                    sparse_g).reshape(steps.size, n_real, n_r)
                     continue
@@ -218,7 +218,7 @@ def integrate(
         for k in np.unique(state_of_step):
             c = _factor(models[k].K_band, np.zeros(n_dof), f"stiffness of mean state {k + 1}")
             # static transfer from the y-loads to the reactions, (G K^-1 P)^T = (K^-1 G^T)[y]
-            # K^-1 G^T with dpbtrs' bits, compiled when the kernel is loaded (in place, on a copy of
+            # K^-1 G^T by the band factor, compiled with the piece newmark (in place, on a copy of
             # G^T; dpbtrs copies its right-hand sides itself)
             GT = models[k].G.T
             TB = np.ascontiguousarray(from_ydof(kernel.solve_columns(c, np.array(GT, order="F")) if compiled
@@ -226,7 +226,7 @@ def integrate(
             all_steps = np.flatnonzero(state_of_step == k)
             for i0 in range(0, all_steps.size, chunk):
                 steps = all_steps[i0:i0 + chunk]
-                R_B[steps] = (kernel.rowdot if compiled else _rowdot)(
+                R_B[steps] = kernel.rowdot(
                     loads[steps].reshape(-1, n_free), TB).reshape(steps.size, n_real, n_r)
                 sk = steps[steps >= second_order_start]
                 if second_order is not None and sk.size:  # the quasi-static displacements themselves
@@ -273,7 +273,7 @@ def integrate(
     # reference scheme (model_at) builds one operator per step instead
     stacked = (_StackedBases(models, damping, np.asarray(state_of_step)[starts], nm, load_dirs)
                if model_at is None else None)
-    rot = kernel.rotate if compiled else st_rotate  # the change of node bases (the same bits)
+    rot = kernel.rotate  # the change of node bases (compiled when its piece is on)
     for s0, s1 in zip(starts, ends):
         if stacked is None:
             new = _Stepper.build(*model_of(int(s0)), nm, load_dirs)
@@ -305,7 +305,7 @@ def integrate(
             in_place = np.shares_memory(_dpbtrs(chat, probe.T, lower=0, overwrite_b=1)[0], probe)
         for b0 in range(int(s0), int(s1), block):
             b1 = min(b0 + block, int(s1))
-            if compiled:  # the same arithmetic as the loop below, compiled (same bits; kernel.py)
+            if compiled:  # the same arithmetic as the loop below, compiled (kernel.py)
                 kernel.newmark_block(U, V, A, loads[b0:b1], st.ycoef, st.cu, st.cv, st.dm, st.r2, chat, rest,
                                      a1, hist, st.nz, st.GT,
                                      st.cols, R_F[b0:b1])

@@ -160,7 +160,7 @@ def compute_statistics(
         mean_max = np.broadcast_to(np.abs(mean).max(axis=0), background.shape[:1] + mean.shape[1:]).copy()
     from . import kernel
 
-    # one compiled pass over the histories when the kernel is loaded (the same bits, checked at load)
+    # one compiled pass over the histories with the kernel's piece ``reductions`` (checked at load)
     rms_b, rms_r, rms_f, pk_qs, pk_dy, pk_qs_t, pk_dy_t = kernel.history_reductions(M, background, resonant, still_air)
     defined = mean_max > ZERO_MEAN_RTOL * scale
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -198,8 +198,7 @@ def history_reductions(M: np.ndarray, background: np.ndarray, resonant: np.ndarr
     r.m.s. of B, R and B + R, and the peaks |M + B|, |M + B + R| (also with the still-air reaction
     added).  M (1 or n, n_t, n_towers, 3); background, resonant (n, n_t, n_towers, 3); still_air
     (n_towers, 3) [N].  Returns seven arrays (n, n_towers, 3).  (:func:`linecheck.core.kernel.
-    history_reductions` gives the same bits in one compiled pass: numpy sums along the time axis
-    one sample after the other, as the compiled loop does.)"""
+    history_reductions` computes them in one compiled pass, within the kernel's tolerance.)"""
     qs = M + background
     dyn = qs + resonant
     rms_b = np.sqrt(np.mean(background**2, axis=1))

@@ -40,7 +40,6 @@ from .model import LinearModel
 from .static import StaticState
 
 _FLIP = np.array([1.0, 1.0, -1.0])  # R_z is positive downward
-PW_DTYPE = np.float32  # the P W product (issue 16): float32 terms and sums (docs/method.md, its error)
 SINGLE_THREAD_WORK = 4 * 65536  # rows x W.size up to OpenBLAS' multithreading threshold (m n k <= 4 x 65536)
 BLOCK_ROWS = 128  # rows of one block of elementwise passes (their arrays stay in cache)
 
@@ -60,13 +59,12 @@ class SecondOrder:
         A: [-] member second-order forces -> reactions: the support terms S f2 minus the
             p_2 -> G K^-1 p_2 transfer (Z = K^-1 G^T, module docstring), shape (3 n_m, n_r).
         W: [N/m^2] the same map from the members' second-order terms P: R_2 = P W, shape
-            (3 n_el + 3 n_s, n_r) (:func:`reaction_form`; float64, the product takes it in
-            float32, :data:`PW_DTYPE`).
+            (3 n_el + 3 n_s, n_r) (:func:`reaction_form`).
         ins_nodes: global node of every suspension attachment, (n_s,).
         ins_frame: [-] rows (e, t1, t2) of every insulator's orthonormal frame, (n_s, 3, 3).
 
     Derived once per operator (also by ``dataclasses.replace``), for the block passes that run
-    once per Newmark block: ``Wp`` W in the product's type (:data:`PW_DTYPE`, C-ordered), ``ec``
+    once per Newmark block: ``Wp`` W C-ordered, ``ec``
     the cable elements' unit chords (n_el, 3), ``node_of_free`` the global node of every free
     node and ``run_lo``, ``run_hi``, ``run_f0`` the runs' first node, end node and first free
     index (int64), ``chunk`` the rows of one BLAS product and ``nb`` of one block (a multiple).
@@ -95,7 +93,7 @@ class SecondOrder:
         put = object.__setattr__  # frozen: set the derived fields once, here
         put(self, "ins_nodes", np.ascontiguousarray(self.ins_nodes, dtype=np.int64))
         put(self, "ins_frame", np.ascontiguousarray(self.ins_frame, dtype=float))
-        put(self, "Wp", np.ascontiguousarray(self.W, dtype=PW_DTYPE))
+        put(self, "Wp", np.ascontiguousarray(self.W, dtype=float))
         put(self, "ec", np.ascontiguousarray(np.asarray(self.e, dtype=float)[:3 * (self.n_nodes - 1)].reshape(-1, 3)))
         runs = sorted(self.runs, key=lambda x: x[2])
         put(self, "node_of_free", np.concatenate([np.arange(lo, hi, dtype=np.int64) for lo, hi, _ in runs]))
@@ -214,23 +212,23 @@ def _passes(passes):
     return passes
 
 
-def _gemm(gemm, fns, op: SecondOrder):
-    """numpy's cblas_sgemm for the compiled block loop, or None (no compiled passes, not found, or
-    the operator's product not in float32)."""
-    if fns is None or op.Wp.dtype != np.float32:
+def _dgemm(dgemm, fns):
+    """scipy's dgemm (its address) for the compiled block loop, or None (no compiled passes, or
+    the piece ``second_order_loop`` off)."""
+    if fns is None:
         return None
-    if gemm is _AUTO:
+    if dgemm is _AUTO:
         from . import kernel
 
-        return kernel.second_order_sgemm()
-    return gemm
+        return kernel.second_order_dgemm()
+    return dgemm
 
 
-def _history(op: SecondOrder, fns, gemm: int, m: int, U=None, T=None, loads=None, transposed=False) -> np.ndarray:
+def _history(op: SecondOrder, fns, dgemm: int, m: int, U=None, T=None, loads=None, transposed=False) -> np.ndarray:
     """R_2 (m, n_r) by the compiled block loop (:func:`linecheck.core._loops.so_history`): the
-    same blocks, chunks and BLAS calls as :func:`_reactions` (with numpy's own cblas_sgemm, called
-    with the arguments its ``matmul`` passes), without the GIL and the per-block Python calls;
-    ``loads`` = (L, c, inv, dirs) of :func:`second_order_of_loads`."""
+    same blocks and chunks as :func:`_reactions`, P W by scipy's dgemm called from compiled code,
+    without the GIL and the per-block Python calls; ``loads`` = (L, c, inv, dirs) of
+    :func:`second_order_of_loads`."""
     W, nb = op.Wp, op.nb
     n_s = op.c.size - (op.n_nodes - 1)
     if loads is None:
@@ -239,7 +237,7 @@ def _history(op: SecondOrder, fns, gemm: int, m: int, U=None, T=None, loads=None
         L, c, inv, dirs = loads
         y = np.empty((c.shape[1], nb))
     out = np.empty((m, W.shape[1]))
-    fns.so_history(gemm, loads is not None, transposed, np.zeros((1, 3)) if U is None else U,
+    fns.so_history(dgemm, loads is not None, transposed, np.zeros((1, 3)) if U is None else U,
                    np.zeros((1, 3, 3)) if T is None else np.ascontiguousarray(T, dtype=float), T is not None,
                    op.node_of_free, L, c, inv, np.zeros((1, 3)) if dirs is None else dirs, dirs is None, y,
                    np.empty_like(y), np.empty(nb), np.empty((L.shape[1], nb)), op.run_lo, op.run_hi, op.run_f0,
@@ -250,7 +248,7 @@ def _history(op: SecondOrder, fns, gemm: int, m: int, U=None, T=None, loads=None
 
 
 def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None = None, *, transposed: bool = False,
-                           passes=_AUTO, gemm=_AUTO) -> np.ndarray:
+                           passes=_AUTO, dgemm=_AUTO) -> np.ndarray:
     """[N] R_2 at every tower for free displacements U [m], shape (m, n_dof) -> (m, n_r).
 
     With ``T`` (per-node bases as columns, (n_free_nodes, 3, 3)) U holds the components u~ in
@@ -262,25 +260,21 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
     into a preallocated (n_nodes, 3, rows) array (rotated by one batched 3x3 product per node),
     the members' second-order terms into P (transposed, (3 n_el + 3 n_s, rows)), and P W by
     BLAS: a dozen numpy calls per block with ``out=`` instead of the ~45 elementwise passes of
-    building f2 and multiplying by A.  The terms are formed in float64 and P W is taken in
-    float32 (:data:`PW_DTYPE`: each term rounded once to float32, the sums sgemm's; 1.7x faster
-    than the float64 product, off by ~1e-6 of max |R_2|, i.e. ~1e-7 of the reactions:
-    docs/method.md; tests).  With the optional compiled kernel (``passes``: the kernel's by
-    default when it is loaded, None for numpy) a block's elementwise work is three compiled
-    calls with the same bits (:func:`linecheck.core._loops.so_nodes`, ``so_frame``,
-    ``so_products``; the 3 x 3 products in the fused order of OpenBLAS's dgemm, verified when
-    the kernel loads), and where numpy's own ``cblas_sgemm`` was found (``gemm``: its address,
-    the kernel's by default) the whole block loop is one compiled call (:func:`_history`; the
-    same BLAS calls, no GIL).
+    building f2 and multiplying by A.  With the optional compiled kernel (``passes``: the kernel's
+    by default when its piece ``second_order`` is on, None for numpy) a block's elementwise work is
+    three compiled calls (:func:`linecheck.core._loops.so_nodes`, ``so_frame``, ``so_products``),
+    and with the piece ``second_order_loop`` (``dgemm``: scipy's dgemm address, the kernel's by
+    default) the whole block loop is one compiled call (:func:`_history`, no GIL).  The forms
+    agree within the kernel's tolerance (:data:`linecheck.core.kernel.RTOL`), not bit for bit.
 
     Rows are processed in blocks of a fixed size that depends on the operator only (the last
     block padded with zeros), so every BLAS product always has the same shape: a row's result
     does not depend on how many other rows (realizations) share the call, and results stay
-    bit-identical whatever the batch chunking.  The products are small enough for OpenBLAS to
+    bit-identical (on one machine and code path) whatever the batch chunking.  The products are small enough for OpenBLAS to
     run on one thread (no thread start-up on a shared machine).
     """
     fns = _passes(passes)
-    fp = _gemm(gemm, fns, op)
+    fp = _dgemm(dgemm, fns)
     m = U.shape[1] if transposed else U.shape[0]
     if fp is not None:
         return _history(op, fns, fp, m, U=np.ascontiguousarray(U, dtype=float), T=T, transposed=transposed)
@@ -322,48 +316,18 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
     return _reactions(op, U.shape[0], fill)
 
 
-def _band_solve_rows(c: np.ndarray, inv: np.ndarray, Y: np.ndarray) -> None:
-    """U^T U x = y in place for every column of Y (n_dof, m) (c: the upper band of dpbtrf, inv =
-    1 / its diagonal): the forward and back substitutions row by row of dofs, each a few
-    elementwise operations over all columns (a dot product of the band per row, rounded product
-    by product, then (y - s) inv; no contraction), the order of the compiled
-    :func:`linecheck.core._loops.so_solve`, so the same bits."""
-    kd = c.shape[0] - 1
-    n = c.shape[1]
-    s = np.empty(Y.shape[1])
-    t = np.empty(Y.shape[1])
-    for j in range(n):  # U^T y = b
-        k = min(j, kd)
-        if k > 0:
-            np.multiply(c[kd - k, j], Y[j - k], out=s)
-            for q in range(1, k):
-                np.multiply(c[kd - k + q, j], Y[j - k + q], out=t)
-                s += t
-            Y[j] -= s
-        Y[j] *= inv[j]
-    for j in range(n - 1, -1, -1):  # U x = y
-        k = min(n - 1 - j, kd)
-        if k > 0:
-            np.multiply(c[kd - 1, j + 1], Y[j + 1], out=s)
-            for q in range(2, k + 1):
-                np.multiply(c[kd - q, j + q], Y[j + q], out=t)
-                s += t
-            Y[j] -= s
-        Y[j] *= inv[j]
-
-
 def second_order_of_loads(op: SecondOrder, L: np.ndarray, c: np.ndarray, dirs: np.ndarray | None = None, *,
-                          passes=_AUTO, gemm=_AUTO) -> np.ndarray:
+                          passes=_AUTO, dgemm=_AUTO) -> np.ndarray:
     """[N] R_2 of the quasi-static displacements u = K^-1 b of loads L [N], shape (m, n_free)
     -> (m, n_r): b the load of free node i along global y (``dirs`` None) or along dirs[i]
     ((n_free, 3), unit), K = U^T U with c [N/m] its upper band factor as ``dpbtrf`` returns it
     (kd + 1, n_dof).  As :func:`second_order_reactions` of the solved displacements: each block
     of rows is solved by the band (forward and back substitution over rows of lanes, ≈ 4 kd
-    multiply-adds per dof and row instead of the n_free of a dense K^-1; :func:`_band_solve_rows`,
-    compiled as ``_loops.so_solve``) straight into the node-major work array; the rest of a
-    block as there (``passes``, ``gemm``)."""
+    multiply-adds per dof and row instead of the n_free of a dense K^-1: LAPACK ``dpbtrs`` on all
+    rows at once, or compiled as ``_loops.so_solve`` straight into the node-major work array); the
+    rest of a block as there (``passes``, ``dgemm``)."""
     fns = _passes(passes)
-    fp = _gemm(gemm, fns, op)
+    fp = _dgemm(dgemm, fns)
     c = np.ascontiguousarray(c, dtype=float)
     inv = 1.0 / c[-1]
     Dc = None if dirs is None else np.ascontiguousarray(dirs, dtype=float)
@@ -385,7 +349,9 @@ def second_order_of_loads(op: SecondOrder, L: np.ndarray, c: np.ndarray, dirs: n
         Y[1::3] = L.T
     else:
         Y.reshape(-1, 3, L.shape[0])[...] = L.T[:, None, :] * Dc[:, :, None]
-    _band_solve_rows(c, inv, Y)
+    Y, info = lapack.dpbtrs(c, Y, lower=0, overwrite_b=1)  # column by column: a row's result is its own
+    if info != 0:  # pragma: no cover - c comes from a successful dpbtrf
+        raise NumericalError(f"banded solve failed (dpbtrs info {info})")
 
     def fill(u: np.ndarray, i0: int, r: int) -> None:
         for lo, hi, f0 in op.runs:
@@ -399,7 +365,7 @@ def second_order_of_loads(op: SecondOrder, L: np.ndarray, c: np.ndarray, dirs: n
 def _reactions(op: SecondOrder, m: int, fill, fns=None) -> np.ndarray:
     """R_2 (m, n_r) of m rows of displacements that ``fill(u, i0, r)`` writes node-major into
     u[:, :, :r] (global x, y, z; (n_nodes, 3, nb)), zeroing u[:, :, r:] (docstrings above);
-    ``fns`` the compiled passes or None (numpy, the same bits)."""
+    ``fns`` the compiled passes or None (numpy)."""
     W, chunk, nb, ec = op.Wp, op.chunk, op.nb, op.ec
     n_el = op.n_nodes - 1
     n_s = op.c.size - n_el
@@ -429,7 +395,7 @@ def _reactions(op: SecondOrder, m: int, fill, fns=None) -> np.ndarray:
         if fns is not None:  # the same operations, compiled (_loops.so_frame, so_products)
             fns.so_frame(u, op.ins_nodes, op.ins_frame, li)
             fns.so_products(u, ec, li, P, d)
-        else:  # cable elements (reaction_form): the order of _loops.so_products, op by op, in float64
+        else:  # cable elements (reaction_form), as _loops.so_products
             np.subtract(u[1:], u[:-1], out=d)  # du = u_b - u_a
             np.multiply(d[:, 0], E[0], out=a)  # a = e.du
             np.multiply(d[:, 1], E[1], out=t)
@@ -445,7 +411,7 @@ def _reactions(op: SecondOrder, m: int, fill, fns=None) -> np.ndarray:
             np.multiply(a, a, out=t)
             t *= 1.5
             q -= t
-            for k in range(3):  # a du + q e, rounded once to P's type
+            for k in range(3):  # a du + q e
                 np.multiply(a, d[:, k], out=v)
                 np.multiply(q, E[k], out=t)
                 v += t
@@ -456,7 +422,7 @@ def _reactions(op: SecondOrder, m: int, fill, fns=None) -> np.ndarray:
             np.multiply(li[:, 1:], li[:, 1:], out=sq)
             np.add(sq[:, 0], sq[:, 1], out=pi[:, 2])  # s^2 + w^2
             Pi[...] = pi
-        for j0 in range(0, r, chunk):  # P W in float32 (sgemm), through tmp as the compiled loop
+        for j0 in range(0, r, chunk):  # P W in products of always chunk rows (a row's bits its own)
             np.matmul(P[:, j0:j0 + chunk].T, W, out=tmp)
             out[i0 + j0:min(i0 + j0 + chunk, i1)] = tmp[:min(chunk, r - j0)]
     return out

@@ -490,7 +490,7 @@ def _banded_solve(blocks, omega: np.ndarray, rhs: np.ndarray) -> np.ndarray:
 def _quad_kms_nodes(w: np.ndarray, rho: np.ndarray, compiled: bool = True) -> np.ndarray:
     """:func:`_quad_kms` with the node axis second to last and frequency last:
     w (..., N, n_f) complex, rho (n_f,) or per gap (N-1, n_f) -> (..., n_f) real (one compiled
-    pass with the same bits when the kernel is loaded, ``kernel.quad_kms``; issue 20)."""
+    pass with the kernel's piece ``quad``, ``kernel.quad_kms``)."""
     if compiled and w.ndim == 3 and w.shape[1] > 0:
         from . import kernel
 

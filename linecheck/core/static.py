@@ -171,7 +171,7 @@ class _Spans:
         ay, az = (dy / l)[..., None], (dz / l)[..., None]
         by, bz = Lu[:, None] * self.qy_gp, -Lu[:, None] * self.qz_gp  # both (n_spans, n_gp)
         H = np.array(H0, dtype=float)
-        terms = kernel.span_terms if kernel.use(0.0) else span_terms
+        terms = kernel.span_terms  # compiled when its piece is on, else span_terms
         for _ in range(60):
             f, g = terms(ay, az, by, bz, H, EA)
             F = l * (f @ w) - Lu
@@ -195,8 +195,8 @@ def span_terms(ay: np.ndarray, az: np.ndarray, by: np.ndarray, bz: np.ndarray, H
     """The integrands of one Newton step of :meth:`_Spans.tension`: f = u/(1 + H u/EA) (the
     length integrand, F = l ∫f - L_u) and g = ∂f/∂H (∂F/∂H = l ∫g); with the chords l also
     e = ∂f/∂l (∂F/∂l = ∫f + l ∫e); docs/method.md, "Elastic span relation".
-    (:func:`linecheck.core.kernel.span_terms` computes the same bits in one compiled pass when
-    the kernel is loaded.)
+    (:func:`linecheck.core.kernel.span_terms` computes them in one compiled pass with the
+    kernel's piece ``span``, within its tolerance.)
 
     Args: ay, az [-] chord slopes (..., n_spans, 1); by, bz [N] L_u Q_y, −L_u Q_z at the Gauss
         points (..., n_spans, n_gp); H [N] (..., n_spans); EA [N]; l [m] (..., n_spans).

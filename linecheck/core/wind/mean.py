@@ -554,7 +554,7 @@ class DownburstField:
         x shape (n_x,), t shape (n_t,) -> two arrays of shape (n_t, n_x).  Radial outflow
         plus the translation velocity (vector sum, Holmes & Oliver 2000).
         """
-        if self.ring is None and self.table is None:  # the analytic field compiled, same bits (issue 20)
+        if self.ring is None and self.table is None:  # the analytic field compiled (kernel piece ``field``)
             from .. import kernel
 
             fast = kernel.field_velocity(self, np.asarray(x, dtype=float).ravel(), np.asarray(t, dtype=float).ravel())
@@ -563,7 +563,7 @@ class DownburstField:
         return self.velocity_numpy(x, t)
 
     def velocity_numpy(self, x: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`velocity` in numpy (what the compiled form reproduces bit for bit)."""
+        """:meth:`velocity` in numpy (the compiled form agrees within the kernel's tolerance)."""
         x = np.asarray(x, dtype=float)[None, :]
         t = np.asarray(t, dtype=float)[:, None]
         cx, cy = self.centre_at(t)

@@ -378,7 +378,7 @@ def synthesize(x: np.ndarray, grid: SpectralGrid, phases: np.ndarray | UnitPhase
             raise ValueError("the KMS path needs equally spaced, increasing x")
         rho = davenport_coherence(grid.freq, spacing, decay, v_mean)  # coherence of neighbours: C_jk = rho^|j-k|
         # the phasors, the recursion and the scaling below in one compiled pass when the kernel
-        # is loaded (the same bits, checked at load; issue 20)
+        # piece ``spectrum`` is on (checked at load)
         spec = kernel.coherent_spectrum(given, rho[None, :], np.zeros(max(n_nodes - 1, 0), dtype=np.int64),
                                         grid.amplitude, m)
         if spec is None:

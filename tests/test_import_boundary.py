@@ -33,6 +33,7 @@ CORE_MODULES = [
     "linecheck.io.display",
     "linecheck.io.document",
     "linecheck.io.section",
+    "linecheck.io.provenance",
 ]
 #: core modules that import Numba themselves: loaded only by linecheck.core.kernel when the
 #: optional compiled kernel is asked for (issue 20)

@@ -111,3 +111,24 @@ def test_help_loads_no_heavy_module(args):
     code_, usage, bad = (out.stdout.strip().split(" ") + [""])[:3]
     assert (code_, usage) == ("0", "True"), out.stdout + out.stderr  # the help was printed
     assert bad == "", f"linecheck {' '.join(args)} loaded {bad}"
+
+
+def test_check_loads_no_solver():
+    """`linecheck check` of a synoptic and a downburst case loads the case model, the budget and the
+    mean wind only: not the solvers (static, dynamics, model), scipy.stats/optimize/interpolate,
+    the service or Numba (start-up time; checked by modules, never by seconds)."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    code = (
+        "import sys\n"
+        "from linecheck.cli.app import main\n"
+        f"sys.argv = ['linecheck', 'check', {str(root / 'cases/paper/case09-six.toml')!r},"
+        f" {str(root / 'cases/paper/case01-six.toml')!r}]\n"
+        "try:\n    main()\nexcept SystemExit as e:\n    assert e.code in (0, None), e.code\n"
+        "heavy = ['linecheck.service', 'linecheck.core.static', 'linecheck.core.dynamics', 'linecheck.core.model',\n"
+        "         'scipy.stats', 'scipy.optimize', 'scipy.interpolate', 'scipy.integrate', 'numba']\n"
+        "print('loaded:' + ','.join(m for m in heavy if m in sys.modules))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip().splitlines()[-1] == "loaded:", out.stdout

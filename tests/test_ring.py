@@ -269,3 +269,13 @@ def test_wall_jet_is_the_holmes_oliver_wood_profile():
         ref = M.radial_profile(rho * dj, 1.2 * dj, 0.5 * dj) * M.vertical_profile(z, M.wood_delta(0.025 * dj))
         np.testing.assert_allclose(R.wall_jet(rho, z / dj), R.C_W * ref, rtol=1e-4, atol=1e-12)
     assert R._ETA_PEAK == pytest.approx(M.ETA_PEAK, rel=1e-4)
+
+
+def test_eta_peak_constant_is_the_maximum_of_the_wood_profile():
+    """ETA_PEAK is a literal (no optimisation at import, the same value on every machine); it is
+    the maximum of Wood et al.'s f_z as the bounded minimiser finds it (xatol 1e-13): the
+    derivative of f_z vanishes there (central difference, h = 1e-6: |f'| h / f ≤ 1e-10)."""
+    assert M._wood_peak() == pytest.approx(M.ETA_PEAK, abs=1e-12)
+    h = 1e-6
+    slope = (M._wood(M.ETA_PEAK + h) - M._wood(M.ETA_PEAK - h)) / (2 * h)
+    assert abs(float(slope)) * h / float(M._wood(M.ETA_PEAK)) < 1e-10

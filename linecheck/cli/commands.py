@@ -17,13 +17,13 @@ from .progress import progress_bar
 @handle_errors
 def check(cases: CasesArg) -> None:
     """Validate case files without running them; every bad file is reported, one line each (exit 2 if any)."""
-    from .. import service  # here, not at import: the service loads the numerical core (start-up time)
+    from ..analysis.guard import check_case  # the light checks only: the solvers stay unloaded
 
     failed = 0
     for path in cases:
         try:
             case = read_case(path)
-            service.check_case(case, warn=limits_warn)  # field file, V_ref at p, resource estimate
+            check_case(case, warn=limits_warn)  # field file, V_ref at p, resource estimate
         except CaseError as err:
             err_console.print(f"[bold red]error:[/] {escape(str(err))}", highlight=False, soft_wrap=True, emoji=False)
             failed += 1

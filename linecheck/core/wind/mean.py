@@ -42,15 +42,20 @@ from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-from scipy.interpolate import RegularGridInterpolator
-from scipy.optimize import brentq, minimize_scalar
 from scipy.special import erf
 
 from ..case import Case, Downburst, read_regular_file
 from ..errors import CaseError
 from ..system import LineSystem
 from . import ring as ring_model
+
+if TYPE_CHECKING:
+    from scipy.interpolate import RegularGridInterpolator
+# scipy.interpolate and scipy.optimize are imported where they are used: importing them costs
+# ≈ 0.4 s, which `linecheck check` of a downburst case would otherwise pay
 
 # ------------------------------------------------------------------------- constants
 R_MAX_OVER_DJ = 1.2  # r_max = 1.2 D_j: radius of peak outflow of Kim & Hangan (2007), = paper's Db_y R
@@ -73,12 +78,17 @@ def _wood(eta: np.ndarray | float) -> np.ndarray:
 
 
 def _wood_peak() -> float:
+    """The maximum of f_z, found numerically (tests/test_ring.py checks :data:`ETA_PEAK` against it)."""
+    from scipy.optimize import minimize_scalar
+
     res = minimize_scalar(lambda e: -float(_wood(e)), bounds=(1e-6, 2.0), method="bounded",
                           options={"xatol": 1e-13})
     return float(res.x)
 
 
-ETA_PEAK = _wood_peak()  # ~0.1836: z_max = ETA_PEAK * delta
+#: z/delta of the maximum of Wood et al.'s f_z, as :func:`_wood_peak` finds it (xatol 1e-13); a
+#: constant, so that every machine uses the same value and importing costs no optimisation
+ETA_PEAK = 0.18358363375664333  # z_max = ETA_PEAK * delta
 
 
 # ------------------------------------------------------------------------- MeanWind
@@ -595,6 +605,8 @@ class _SliceInterpolator:
 
     def __init__(self, r: np.ndarray, t: np.ndarray, values: np.ndarray) -> None:
         self.r, self.t = r, t
+        from scipy.interpolate import RegularGridInterpolator
+
         self.rgi = RegularGridInterpolator((r, t), values, method="linear", bounds_error=False, fill_value=None)
 
     def __call__(self, rr: np.ndarray, tt: np.ndarray, path: Path) -> np.ndarray:
@@ -627,6 +639,8 @@ def _table_slice_cached(table: FieldTable, z: float, vertical: bool) -> _SliceIn
         if z < table.z[0] - 1e-12 or z > table.z[-1] + 1e-12:
             raise _field_error(table.path, f"the conductor height is z/D_j = {z:.4g} but the table covers z_over_dj "
                                f"{table.z[0]:g} to {table.z[-1]:g}: extend the table")
+        from scipy.interpolate import RegularGridInterpolator
+
         rgi = RegularGridInterpolator((table.r, table.z, table.t), values, method="linear")
         rr, tt = np.meshgrid(table.r, table.t, indexing="ij")
         zz = np.full_like(rr, min(max(z, table.z[0]), table.z[-1]))
@@ -640,6 +654,8 @@ def _table_slice(table: FieldTable, z: float, vertical: bool = False) -> _SliceI
 
 @lru_cache(maxsize=16)
 def _table_volume(table: FieldTable) -> RegularGridInterpolator:
+    from scipy.interpolate import RegularGridInterpolator
+
     return RegularGridInterpolator((table.r, table.z, table.t), table.radial, method="linear")
 
 
@@ -723,6 +739,8 @@ def _ring_scale(case: Case) -> ring_model.RingJet:
     k = int(np.argmax(s))
     peak = float(s[k])
     lo, hi = tau[max(k - 1, 0)], tau[min(k + 1, tau.size - 1)]
+    from scipy.optimize import minimize_scalar
+
     res = minimize_scalar(lambda tt: -abs(float(ring_model.radial_speed(rho_p, z_ref / dj, tt))),
                           bounds=(lo, hi), method="bounded", options={"xatol": 1e-10})
     peak = max(peak, float(-res.fun))
@@ -750,6 +768,8 @@ def _max_speed_at_p(field: DownburstField, v_max: float, times: np.ndarray) -> t
     best_t, best = float(times[k]), float(s[k])
     lo, hi = times[max(k - 1, 0)], times[min(k + 1, times.size - 1)]
     if hi > lo:
+        from scipy.optimize import minimize_scalar
+
         res = minimize_scalar(lambda tt: -float(speed(np.array([tt]))[0]), bounds=(lo, hi), method="bounded",
                               options={"xatol": 1e-9 * max(1.0, abs(hi))})
         if -res.fun > best:
@@ -900,6 +920,8 @@ def _downburst_field_cached(case: Case, stamp: tuple[int, int] | None) -> Downbu
                 raise CaseError(f"the outflow at point p (x = {point_p:g} m) is too weak to reach V_ref; change "
                                 "distance/angle", file=src, key="wind.downburst")
         # the max over t of |affine in V_max| is convex in V_max with value < V_ref at 0: one root
+        from scipy.optimize import brentq
+
         v_max = brentq(excess, 0.0, hi, xtol=1e-13 * v_ref, rtol=1e-15, maxiter=200)
     return DownburstField(**{**field.__dict__, "v_max": float(v_max)})
 

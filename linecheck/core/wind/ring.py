@@ -45,7 +45,6 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from scipy.integrate import solve_ivp
 from scipy.special import ellipe, ellipk, erf
 
 # ---------------------------------------------------------------- closure constants (dimensionless)
@@ -154,6 +153,8 @@ def trajectory() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     (measured 8.7e-13; at RK45's 1e-10 they differed by 1.5e-9), well inside the golden results'
     1e-9 (tests/golden).  0.1 s, once per process.
     """
+    from scipy.integrate import solve_ivp  # here: scipy.integrate costs start-up time elsewhere
+
     tau = np.linspace(0.0, TAU_PATH, _TAU_GRID)
     sol = solve_ivp(_rhs, (0.0, TAU_PATH), [A0, H0], t_eval=tau, rtol=1e-13, atol=1e-15, method="DOP853")
     if not sol.success:  # pragma: no cover - a fixed ODE; kept as a guard

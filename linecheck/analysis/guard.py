@@ -1,0 +1,45 @@
+"""The resource guard and the checks of ``linecheck check`` beyond the case schema.
+
+Every job calls :func:`check_budget` before it allocates anything; :func:`check_case` adds what
+``check`` verifies without running (field file, V_ref at point p, record length).  Imports only
+the case model, the budget and (for downbursts) the mean-wind module: ``linecheck check`` answers
+without loading the solvers.  Nothing here prints.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from ..core import budget
+from ..core.case import Case
+from ..core.errors import CaseError
+
+Warn = Callable[[str], None]
+
+
+def check_budget(case: Case, job: str = "run", *, warn: Warn | None = None, **kwargs) -> budget.Estimate:
+    """Estimated peak memory and time of ``job`` (:mod:`linecheck.core.budget`); raises
+    :class:`~linecheck.core.errors.CaseError` (exit 2) above the memory limit and calls
+    ``warn(message)`` above the warning thresholds.  Every job calls it first."""
+    return budget.guard(case, job, warn, **kwargs)
+
+
+def check_case(case: Case, *, warn: Warn | None = None) -> budget.Estimate:
+    """Checks of ``linecheck check`` beyond the schema: the field file is read and validated,
+    the downburst is scaled to V_ref at p, the record has enough steps, and the run fits the
+    resource limits.  Raises :class:`~linecheck.core.errors.CaseError`."""
+    if case.wind.type == "downburst":
+        from ..core.wind.mean import downburst_field, load_field_table
+
+        db = case.wind.downburst
+        if db is not None and db.field_path is not None:
+            load_field_table(db.field_path)
+        downburst_field(case)
+    if not case.wind.v_ref > 0:
+        raise CaseError("value 0.0 is not allowed: expected v_ref > 0 for a run (turbulence is scaled by it)",
+                        file=str(case.source) if case.source else None, key="wind.v_ref")
+    est = budget.estimate(case, "run")
+    if est.n_steps < 4:
+        raise CaseError(f"value {case.analysis.time_step!r} gives {est.n_steps} steps: expected at least 4",
+                        file=str(case.source) if case.source else None, key="analysis.time_step")
+    return budget.check(est, case, warn)

@@ -15,6 +15,8 @@ import pytest
 
 from . import golden_support as gs
 
+pytestmark = pytest.mark.numerics  # repeated under another OpenBLAS core type by .ci/run
+
 FILES = gs.golden_files()
 
 

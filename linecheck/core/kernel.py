@@ -209,14 +209,6 @@ def available() -> bool:
     return mode() != "numpy" and any(p.on for p in status())
 
 
-def _reset() -> None:
-    """Forget the loaded state (tests: to load again under another ``LINECHECK_KERNEL``)."""
-    global _fns, _dgemm_address
-    with _lock:
-        _pieces.clear()
-        _fns = None
-        _dgemm_address = None
-
 
 
 # ---- load checks: each runs one piece on test data beside its numpy form and returns the

@@ -38,7 +38,12 @@ needs `"table"`, `jet_velocity` is for `"ring-jet"` only and `t1`/`t_f` are not 
 Hostile input: every key and string value is refused if it holds a control character (C0
 except tab, DEL, C1: they would inject terminal escape sequences and are illegal in Excel),
 e.g. `c.toml:1: name: control character U+001B at position 5 is not allowed: expected
-printable text`; tables and arrays nested more than 16 levels are refused. Only regular
+printable text`; the same rule holds for every cell of a tower CSV (`towers_file`), a quoted
+newline included. A message quotes a bad list item by its position and value (`item 5000 of
+10000 (value -3.5)`), a long list by its first items and length, never the whole list, and a
+list is checked in time linear in its length. A UTF-8 byte-order mark at the start of a case
+file or a tower CSV (spreadsheets write one) is ignored. Tables and arrays nested more than 16
+levels are refused. Only regular
 files are read (a FIFO, a socket or a link to a device such as `/dev/zero` is refused
 before any read, so `check` never hangs), and only up to a size cap checked before reading:
 10 MB for a case file, 200 MB for a field file (`field`; for an NPZ, the uncompressed
@@ -141,7 +146,11 @@ with `angle = 0`; `insulator_length` only on suspension towers and below `height
 0 (a clamp below ground is refused); `tension` > W L/2 on every span (sag W L²/8H0 below a
 quarter of the span) and the still-air parabola clear of the straight ground line between
 towers; not both `towers_file` and `[[line.towers]]`; a CSV with a missing column, an unknown
-column or a non-number is refused naming its row and column. `[wind] direction`,
+column or a non-number is refused naming its row and column. A file whose first row is not a
+tower header -- at least two comma-separated column names, each a short printable token, one of
+them a tower column or close to one -- is refused as `not a tower table` without quoting any of
+its content (`towers_file = "/etc/passwd"` says nothing of that file); a bad cell longer than 40
+characters is described by its length. `[wind] direction`,
 `profile_exponent` and `reference_height` apply to both forms (equal-span form: every node at
 `height`).
 

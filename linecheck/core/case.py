@@ -393,34 +393,53 @@ class _Ctx:
         return CaseError(message, file=self.file, key=dotted, line=_find_line(self.text, section, key))
 
 
+FMT_LIST_ITEMS = 5  # a list in a message shows its first items and its length, never the whole list
+
+
 def _fmt(value: Any) -> str:
+    """A value as a message shows it: strings quoted, TOML spellings, a long list abbreviated
+    (``[1.0, 2.0, 3.0, 4.0, 5.0, ... (10000 items)]``) so that a message stays one short line."""
     if isinstance(value, str):
         return f'"{value}"'
     if isinstance(value, bool):
         return "true" if value else "false"
-    if isinstance(value, list):
+    if isinstance(value, (list, tuple)):
+        if len(value) > FMT_LIST_ITEMS + 1:
+            head = ", ".join(_fmt(v) for v in value[:FMT_LIST_ITEMS])
+            return f"[{head}, ... ({len(value)} items)]"
         return "[" + ", ".join(_fmt(v) for v in value) + "]"
     if isinstance(value, dict):
         return "a table"
     return repr(value)
 
 
-def _check_number(spec: FieldSpec, v: Any, ctx: _Ctx, section: str, whole: Any = None) -> float:
-    shown = _fmt(whole if whole is not None else v)
+def _check_number(spec: FieldSpec, v: Any, ctx: _Ctx, section: str, item: tuple[int, int] | None = None) -> float:
+    """``v`` checked against ``spec``'s kind and range.  ``item``: (1-based position, list length)
+    of ``v`` in a list; a message then names that item and its value, never the whole list (the
+    value is formatted only when it is refused: checking a list is linear in its length)."""
+    if _number_ok(spec, v):
+        return v
+    shown = f"item {item[0]} of {item[1]} (value {_fmt(v)})" if item is not None else f"value {_fmt(v)}"
     if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise ctx.error(section, spec.name, f"value {shown} is not allowed: expected {spec.allowed()}")
+        raise ctx.error(section, spec.name, f"{shown} is not allowed: expected {spec.allowed()}")
     if spec.kind == "int" and not isinstance(v, int):
-        raise ctx.error(section, spec.name, f"value {shown} is not allowed: expected {spec.allowed()}")
+        raise ctx.error(section, spec.name, f"{shown} is not allowed: expected {spec.allowed()}")
     if not math.isfinite(float(v)):
-        raise ctx.error(section, spec.name, f"value {shown} is not allowed: expected {spec.allowed()}")
-    bad = False
-    if spec.low is not None:
-        bad |= v <= spec.low if spec.low_open else v < spec.low
-    if spec.high is not None:
-        bad |= v > spec.high
-    if bad:
-        raise ctx.error(section, spec.name, f"value {shown} is out of range: expected {spec.allowed()}")
-    return v
+        raise ctx.error(section, spec.name, f"{shown} is not allowed: expected {spec.allowed()}")
+    raise ctx.error(section, spec.name, f"{shown} is out of range: expected {spec.allowed()}")
+
+
+def _number_ok(spec: FieldSpec, v: Any) -> bool:
+    """Whether ``v`` is a number of ``spec``'s kind within its range (no message built)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return False
+    if spec.kind == "int" and not isinstance(v, int):
+        return False
+    if not math.isfinite(float(v)):
+        return False
+    if spec.low is not None and (v <= spec.low if spec.low_open else v < spec.low):
+        return False
+    return not (spec.high is not None and v > spec.high)
 
 
 def _check_value(spec: FieldSpec, v: Any, ctx: _Ctx, section: str) -> Any:
@@ -446,15 +465,15 @@ def _check_value(spec: FieldSpec, v: Any, ctx: _Ctx, section: str) -> Any:
     if spec.kind == "float_list":
         if not isinstance(v, list) or not v:
             raise ctx.error(section, spec.name, f"value {_fmt(v)} is not allowed: expected {spec.allowed()}")
-        return tuple(float(_check_number(spec, item, ctx, section, whole=v)) for item in v)
+        n = len(v)
+        return tuple(float(_check_number(spec, x, ctx, section, item=(i, n))) for i, x in enumerate(v, start=1))
     if spec.kind == "str_list":
         if not isinstance(v, list) or not v:
             raise ctx.error(section, spec.name, f"value {_fmt(v)} is not allowed: expected a list, each {spec.allowed()}")
-        for item in v:
-            if not isinstance(item, str) or (spec.choices and item not in spec.choices):
-                raise ctx.error(
-                    section, spec.name, f"item {_fmt(item)} in {_fmt(v)} is not allowed: expected each {spec.allowed()}"
-                )
+        for i, x in enumerate(v, start=1):
+            if not isinstance(x, str) or (spec.choices and x not in spec.choices):
+                raise ctx.error(section, spec.name, f"item {i} of {len(v)} (value {_fmt(x)}) is not allowed: "
+                                f"expected each {spec.allowed()}")
         return tuple(v)
     raise ValueError(spec.kind)  # pragma: no cover - schema bug
 
@@ -622,12 +641,48 @@ class _TowerCtx(_Ctx):
         return CaseError(message, file=self.file, key=dotted, line=_tower_line(self.text, self.k, key))
 
 
+# A tower CSV's column names are quoted in a message only when they are short printable tokens
+# like these; anything else -- a file that is not a tower table (towers_file = "/etc/shadow") --
+# is refused without quoting its content (issue 35).
+_COLUMN_TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_ .-]{0,31}")
+MAX_QUOTED_CELL = 40  # [characters] a longer cell is described by its length, not quoted
+
+
+def _not_a_tower_table(path: Path) -> CaseError:
+    return CaseError(f"not a tower table: expected a comma-separated (CSV) file whose first row names its columns "
+                     f"({', '.join(TOWER_COLUMNS)}; required: station, height, support) and one row per tower",
+                     file=str(path))
+
+
+def _reads_as_tower_header(header: list[str]) -> bool:
+    """A header row that makes the file a tower table: at least two cells, each a short printable
+    token (:data:`_COLUMN_TOKEN`), at least one of them a tower column or close to one."""
+    if len(header) < 2 or not all(_COLUMN_TOKEN.fullmatch(h) for h in header):
+        return False
+    lower = [c.lower() for c in TOWER_COLUMNS]
+    return any(h.lower() in lower or difflib.get_close_matches(h.lower(), lower, n=1, cutoff=0.6) for h in header)
+
+
+def _cell_text(cell: str) -> str:
+    """A data cell as a message quotes it: short cells quoted, longer ones by their length."""
+    return _fmt(cell) if len(cell) <= MAX_QUOTED_CELL else f"of {len(cell)} characters"
+
+
 def _read_towers_csv(path: Path) -> list[tuple[dict[str, Any], int]]:
-    """Rows of a tower CSV as raw dicts (numbers parsed) with their 1-based file row numbers."""
+    """Rows of a tower CSV as raw dicts (numbers parsed) with their 1-based CSV record numbers.
+
+    The same text rule as TOML strings (:data:`_CONTROL`: no control characters, a quoted newline
+    included) holds for every cell; a leading byte-order mark is dropped (:func:`read_text_file`).
+    A file whose first row is not a tower header (:func:`_reads_as_tower_header`) is "not a tower
+    table", and no message quotes its content."""
     import csv
     import io
 
-    rows = list(csv.reader(io.StringIO(read_text_file(path, "a CSV tower table", MAX_CASE_BYTES))))
+    text = read_text_file(path, "a CSV tower table", MAX_CASE_BYTES)
+    try:
+        rows = list(csv.reader(io.StringIO(text, newline="")))
+    except csv.Error:
+        raise _not_a_tower_table(path) from None
     # skip blank and comment lines, remembering file row numbers
     numbered = [(i + 1, r) for i, r in enumerate(rows) if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
     if not numbered:
@@ -635,14 +690,17 @@ def _read_towers_csv(path: Path) -> list[tuple[dict[str, Any], int]]:
                         file=str(path))
     head_row, header = numbered[0]
     header = [h.strip() for h in header]
+    if not _reads_as_tower_header(header):
+        raise _not_a_tower_table(path)
     for h in header:
         if h not in TOWER_COLUMNS:
             close = difflib.get_close_matches(h, TOWER_COLUMNS, n=1, cutoff=0.5)
             hint = f'; did you mean "{close[0]}"?' if close else ""
             raise CaseError(f"unknown column {_fmt(h)}{hint} (allowed: {', '.join(TOWER_COLUMNS)})", file=str(path),
                             key=f"row {head_row}")
-    if len(set(header)) != len(header):
-        raise CaseError(f"header {_fmt(header)} repeats a column: expected each of {', '.join(TOWER_COLUMNS)} at most once",
+    repeated = [h for h in TOWER_COLUMNS if header.count(h) > 1]
+    if repeated:
+        raise CaseError(f"header repeats column {_fmt(repeated[0])}: expected each of {', '.join(TOWER_COLUMNS)} at most once",
                         file=str(path), key=f"row {head_row}")
     for spec in SCHEMA["line.towers"]:
         if spec.required and spec.name not in header:
@@ -656,6 +714,10 @@ def _read_towers_csv(path: Path) -> list[tuple[dict[str, Any], int]]:
                             file=str(path), key=f"row {row_no}")
         d: dict[str, Any] = {}
         for col, cell in zip(header, r):
+            m = _CONTROL.search(cell)
+            if m:  # the TOML strings' rule (_check_text): ESC, NUL, a quoted newline ...
+                raise CaseError(f"control character U+{ord(m.group()):04X} at position {m.start() + 1} is not "
+                                "allowed: expected printable text", file=str(path), key=f"row {row_no}, column {col}")
             cell = cell.strip()
             if cell == "":
                 continue
@@ -663,7 +725,7 @@ def _read_towers_csv(path: Path) -> list[tuple[dict[str, Any], int]]:
                 try:
                     d[col] = float(cell)
                 except ValueError:
-                    raise CaseError(f"value {_fmt(cell)} is not a number: expected {specs[col].allowed()}",
+                    raise CaseError(f"value {_cell_text(cell)} is not a number: expected {specs[col].allowed()}",
                                     file=str(path), key=f"row {row_no}, column {col}") from None
             else:
                 d[col] = cell
@@ -778,7 +840,7 @@ def _finish_case(data, top, line: Line, wind_d, an_d, ctx: _Ctx, file, default_n
             raise ctx.error("wind", "downburst", "table [wind.downburst] given but type = \"synoptic\": remove it or set type = \"downburst\"")
         db = None
         if wind_d["span_speeds"] is not None and len(wind_d["span_speeds"]) != line.spans:
-            raise ctx.error("wind", "span_speeds", f"value {_fmt(list(wind_d['span_speeds']))} has {len(wind_d['span_speeds'])} entries: expected {line.spans}, one per span")
+            raise ctx.error("wind", "span_speeds", f"value {_fmt(wind_d['span_speeds'])} has {len(wind_d['span_speeds'])} entries: expected {line.spans}, one per span")
     wind = Wind(downburst=db, **wind_d)
 
     analysis = Analysis(**an_d)
@@ -883,10 +945,11 @@ def read_regular_file(path: str | Path, expected: str, max_bytes: int) -> bytes:
 def read_text_file(path: str | Path, expected: str, max_bytes: int = MAX_CASE_BYTES) -> str:
     """UTF-8 text of a user file; one-line :class:`CaseError` naming the file and ``expected``
     (e.g. "a TOML case file") when it is missing, a folder, not a regular file (FIFO, device),
-    larger than ``max_bytes``, unreadable or not UTF-8."""
+    larger than ``max_bytes``, unreadable or not UTF-8.  A leading UTF-8 byte-order mark (which
+    spreadsheets and some editors write) is dropped; the bytes, hence ``case_hash``, are as read."""
     data = read_regular_file(path, expected, max_bytes)
     try:
-        return data.decode("utf-8")
+        return data.decode("utf-8-sig")
     except UnicodeDecodeError:
         raise CaseError(f"not a UTF-8 text file (expected {expected})", file=str(path)) from None
 

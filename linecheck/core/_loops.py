@@ -464,33 +464,39 @@ def drag_loads(pv, pq, s2, v, s0, quad, loads):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def span_terms(ay, az, by, bz, H, EA, l, with_e, f, g, e):  # pragma: no cover - compiled
-    """The integrands of one Newton step of the span tension (static.span_terms), each product,
-    quotient and sum as the numpy form writes it:
-    p = a + b/H, u = sqrt((1 + p_y^2) + p_z^2), den = 1 + (H u)/EA, f = u/den,
-    g = ((-u^2)/EA)/den^2 + ((1/den^2) (-(p_y b_y + p_z b_z)/H^2))/u and, with with_e,
-    e = ((1/den^2) (-(p_y a_y + p_z a_z)/l))/u.  ay, az, H, l (n, n_spans); by, bz (1 or n,
-    n_spans, n_gp) (one for all states or one per state); f, g, e (n, n_spans, n_gp)."""
+    """The integrands of one Newton step of the span tension (static.span_terms):
+    p = a + b/H, u = sqrt(1 + p_y^2 + p_z^2), den = 1 + H u/EA, f = u/den,
+    g = -u^2/(EA den^2) - (p_y b_y + p_z b_z)/(H^2 den^2 u) and, with with_e,
+    e = -(p_y a_y + p_z a_z)/(l den^2 u); with the reciprocals of H, EA and l per span and two
+    divisions per point (1/den, 1/u) instead of the numpy form's seven (within rounding of it:
+    the kernel's load check).  ay, az, H, l (n, n_spans); by, bz (1 or n, n_spans, n_gp) (one for
+    all states or one per state); f, g, e (n, n_spans, n_gp)."""
     n, n_spans = H.shape
     n_gp = by.shape[2]
+    inv_ea = 1.0 / EA
     for i in range(n):
         iy = i if by.shape[0] > 1 else 0
         iz = i if bz.shape[0] > 1 else 0
         for j in range(n_spans):
             h = H[i, j]
-            h2 = h * h
-            a_y, a_z, lj = ay[i, j], az[i, j], l[i, j]
+            inv_h = 1.0 / h
+            inv_h2 = inv_h * inv_h
+            h_ea = h * inv_ea
+            a_y, a_z = ay[i, j], az[i, j]
+            inv_l = 1.0 / l[i, j]
             by_r, bz_r, f_r, g_r, e_r = by[iy, j], bz[iz, j], f[i, j], g[i, j], e[i, j]
             for q in range(n_gp):  # vectorised by LLVM (error_model="numpy": no zero-division branch)
                 b_y, b_z = by_r[q], bz_r[q]
-                py = a_y + b_y / h
-                pz = a_z + b_z / h
+                py = a_y + b_y * inv_h
+                pz = a_z + b_z * inv_h
                 u = np.sqrt(1.0 + py * py + pz * pz)
-                den = 1.0 + h * u / EA
-                fu = 1.0 / (den * den)
-                f_r[q] = u / den
-                g_r[q] = -(u * u) / EA / (den * den) + fu * (-(py * b_y + pz * b_z) / h2) / u
+                r = 1.0 / (1.0 + h_ea * u)  # 1/den
+                fu = r * r
+                inv_u = 1.0 / u
+                f_r[q] = u * r
+                g_r[q] = -(u * u) * inv_ea * fu - fu * (py * b_y + pz * b_z) * inv_h2 * inv_u
                 if with_e:
-                    e_r[q] = fu * (-(py * a_y + pz * a_z) / lj) / u
+                    e_r[q] = -fu * (py * a_y + pz * a_z) * inv_l * inv_u
 
 
 @numba.njit(cache=True, nogil=True)

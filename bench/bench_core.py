@@ -1,9 +1,9 @@
-"""Speed of the numerical core against the targets of issues 2, 4, 5 and 9.
+"""Speed of the numerical core against its targets (docs/performance.md, "Targets and current readings").
 
 Run: ``python bench/bench_core.py [--quick]`` (from the repository root).  Prints one table:
 measured value, target, and the ratio against a straightforward baseline run in the same
 process (dense matrices, factorised every step).  Results are recorded by hand in
-docs/performance.md with the date and the machine.
+docs/performance.md with the machine and its BLAS core (`linecheck info`).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Cost of the issue-16 options: drag = "quadratic" and tension = "second-order" (docs/performance.md).
+"""Cost of the non-linear options: drag = "quadratic" and tension = "second-order" (docs/performance.md).
 
 Run from the repository root:
 
@@ -97,7 +97,7 @@ def bench(cases: dict, repeat: int, threads: int) -> float:
     both = float(np.median([x[COMBOS[-1]] for x in rounds]))
     # the verdict rests on the median of the paired ratios: the runs of a round are adjacent in
     # time, so a phase of this shared VM affects both; the ratio of two best times pairs runs
-    # from different phases (docs/performance.md: the same code read +1 % and +29 % that way)
+    # from different phases (the same code once read +1 % and +29 % that way)
     print(f"both options, {threads} thread(s): +{100 * (both - 1):.1f} % (median of {repeat} rounds; target <= "
           f"+{100 * (TARGET - 1):.0f} %): {'met' if both <= TARGET else 'NOT met'}; "
           f"load average now {os.getloadavg()[0]:.1f}")

@@ -702,7 +702,7 @@ def run_tower(case: Case, *, realizations: list[int] | np.ndarray | None = None,
     """:func:`run_case` (no frequency-domain check, one thread) computing the dynamic
     reactions of the tower of interest only: a scan ranks positions by them (issue 20), and the
     other towers' reactions, statistics and frame rotations cost ≈ 15 % of a six-span downburst
-    position (1.34 → 1.13 s, docs/performance.md).  Each reaction is the same arithmetic as in
+    position (measured 1.34 → 1.13 s).  Each reaction is the same arithmetic as in
     :func:`run_case` (every reaction is a sum of its own, in a fixed order), so the statistics
     are bit-identical to ``run_case(...).stats`` at that tower (tested)."""
     return _run(case, realizations=realizations, interpolate_states=False, spectral_check=False,

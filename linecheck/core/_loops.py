@@ -29,7 +29,7 @@ __all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "dra
 # x is (n_groups, n_dof, 4): the realizations in groups of four lanes (padded with zeros),
 # every lane solved by itself in the same order; four independent chains per group hide the
 # latency of the dependent divide and multiply-adds (LLVM keeps the lanes scalar; measured:
-# four lanes cost ≈ 1.4 x one, docs/performance.md)
+# four lanes cost ≈ 1.4 x one)
 @numba.njit(cache=True, nogil=True, fastmath={"contract"})
 def band_solve(c, x):  # pragma: no cover - compiled
     """Solve U^T U x = b in place for every lane of x (n_groups, n, 4); U upper band,
@@ -146,7 +146,7 @@ def band_solve_1(c, x):  # pragma: no cover - compiled
     With the core's half-bandwidth (5) the five unknowns a row reads stay in registers (rolled
     along the rows) instead of being stored and loaded again at every row: the same operations
     in the same order (the same bits), without the store-to-load latency on the dependent chain
-    (≈ 6 → 3.5 µs for 177 DOFs, docs/performance.md)."""
+    (measured ≈ 6 → 3.5 µs for 177 DOFs)."""
     kd = c.shape[0] - 1
     n = c.shape[1]
     if kd != 5 or n < 6:
@@ -230,7 +230,7 @@ def rest_product(band, wp, t):  # pragma: no cover - compiled
     CSR row; the extra terms are products with an exact zero, which leave a sum unchanged
     (x + ±0 = x, and +0 + ±0 = +0): the same bits, but the rows' sums run side by side
     (vectorised over the rows) instead of one dependent chain after the other (177 DOFs: one
-    vector ≈ 4 → 0.6 µs, docs/performance.md)."""
+    vector measured ≈ 4 → 0.6 µs)."""
     n = t.shape[1]
     t[:, :] = 0.0
     for l in range(t.shape[0]):
@@ -753,7 +753,7 @@ def so_solve(c, inv, L, dirs, straight, i0, r, y, xr, s, Lt):  # pragma: no cove
     xr[n - 1 - j] = x_j (the algorithm of LAPACK dpbtrs, which the numpy form calls; no
     contraction).  y (n_dof, nb), s (nb,), Lt (n_free, nb): scratch.
 
-    Speed (measured, docs/performance.md): the rows with the core's full half-bandwidth (5) in
+    Speed (measured when written): the rows with the core's full half-bandwidth (5) in
     one pass, the band's sum in a register and the load placed in the same pass (no zeroed
     right-hand side), 2-D indexing (row views kept LLVM's overlap checks: 3x slower), loop bounds
     rather than a flag around the loop (it did not vectorise: 2.8x), and the back substitution

@@ -15,7 +15,7 @@ from typing import Annotated, Any, TypeVar
 
 import typer
 from rich.markup import escape
-from typer.core import TyperGroup, TyperOption
+from typer.core import TyperArgument, TyperGroup, TyperOption
 
 try:  # the click that Typer runs on: vendored in recent Typer releases, the click package before
     from typer._click.exceptions import NoArgsIsHelpError, UsageError
@@ -24,7 +24,7 @@ except ImportError:  # pragma: no cover - older Typer
 from rich.console import Console
 
 from ..core.case import Case, load_case
-from ..core.errors import LinecheckError
+from ..core.errors import LinecheckError, printable
 
 def usage_line(err: UsageError) -> str:
     """One line for a command-line usage error: what is wrong, the usage, where the help is."""
@@ -46,8 +46,7 @@ class LinecheckGroup(TyperGroup):
         except NoArgsIsHelpError:
             raise
         except UsageError as err:
-            err_console.print(f"[bold red]error:[/] {escape(usage_line(err))}", highlight=False, soft_wrap=True,
-                              emoji=False)
+            error_line(usage_line(err))
             raise typer.Exit(2) from None
 
 
@@ -55,7 +54,8 @@ def _flag_without_type(option_cls: type) -> None:
     """Show a flag (``--force``) without a ``<bool>`` type beside it in the help: it takes no value.
 
     Typer's rich help prints the type of every option, flags included; this leaves the type
-    column of flags empty (and keeps it for options that take a value).
+    column of flags empty (and keeps it for options that take a value).  A path parsed by
+    :func:`path_value` shows as ``<path>``, like a plain ``Path`` parameter.
     """
     show = getattr(option_cls, "display_type_rich", None)
     if show is None or getattr(show, "_linecheck", False):
@@ -64,13 +64,15 @@ def _flag_without_type(option_cls: type) -> None:
     def display_type_rich(self: Any, ctx: Any) -> str | None:
         if getattr(self, "is_flag", False) and getattr(self, "metavar", None) is None:
             return None
-        return show(self, ctx)
+        label = show(self, ctx)
+        return "<path>" if label == "<Path>" else label
 
     display_type_rich._linecheck = True  # type: ignore[attr-defined]
     option_cls.display_type_rich = display_type_rich
 
 
 _flag_without_type(TyperOption)
+_flag_without_type(TyperArgument)
 
 app = typer.Typer(
     cls=LinecheckGroup,
@@ -86,9 +88,29 @@ app = typer.Typer(
 console = Console(width=None if sys.stdout.isatty() else 160)
 err_console = Console(stderr=True, width=None if sys.stderr.isatty() else 160)
 
-CaseArg = Annotated[Path, typer.Argument(help="Case file (TOML).", show_default=False, metavar="CASE_FILE")]
-CasesArg = Annotated[list[Path], typer.Argument(help="Case files (TOML).", show_default=False, metavar="CASE_FILE")]
-JsonOpt = Annotated[Path | None, typer.Option("--json", help="Write the result as JSON to this file.")]
+def error_line(text: str, label: str = "error", style: str = "bold red") -> None:
+    """Print one message line to stderr, ``label: text``: no markup, no wrapping, hidden characters
+    (ESC, NUL, bidi overrides) shown escaped (:func:`linecheck.core.errors.printable`).  Every
+    error and warning line of the CLI goes through here."""
+    err_console.print(f"[{style}]{label}:[/] {escape(printable(text))}", highlight=False, soft_wrap=True, emoji=False)
+
+
+def path_value(value: str | Path) -> Path:
+    """Parser of every path argument and option: the path as given.  An empty one (``''``) is a
+    usage error saying so (a plain ``Path('')`` would be the current folder, ``.``)."""
+    if isinstance(value, Path):
+        return value
+    if not value:
+        raise typer.BadParameter("the path is empty: expected a file name")
+    return Path(value)
+
+
+CaseArg = Annotated[Path, typer.Argument(help="Case file (TOML).", show_default=False, metavar="CASE_FILE",
+                                         parser=path_value)]
+CasesArg = Annotated[list[Path], typer.Argument(help="Case files (TOML).", show_default=False, metavar="CASE_FILE",
+                                                parser=path_value)]
+JsonOpt = Annotated[Path | None, typer.Option("--json", help="Write the result as JSON to this file.",
+                                              parser=path_value)]
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -101,7 +123,7 @@ def handle_errors(fn: F) -> F:
         try:
             return fn(*args, **kwargs)
         except LinecheckError as err:
-            err_console.print(f"[bold red]error:[/] {escape(str(err))}", highlight=False, soft_wrap=True, emoji=False)
+            error_line(str(err))
             raise typer.Exit(err.exit_code) from None
         except KeyboardInterrupt:
             err_console.print("[bold red]interrupted[/]")
@@ -111,8 +133,8 @@ def handle_errors(fn: F) -> F:
         except Exception as err:  # a bug, not a user error: one line unless debugging
             if os.environ.get("LINECHECK_DEBUG"):
                 raise
-            err_console.print(f"[bold red]internal error:[/] {type(err).__name__}: {escape(str(err))} "
-                              "(set LINECHECK_DEBUG=1 for the traceback; please report it)", highlight=False, emoji=False)
+            error_line(f"{type(err).__name__}: {' '.join(str(err).split())} (set LINECHECK_DEBUG=1 for the traceback; "
+                       "please report it)", label="internal error")
             raise typer.Exit(1) from None
 
     return wrapper  # type: ignore[return-value]

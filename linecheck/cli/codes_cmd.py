@@ -8,6 +8,7 @@ import typer
 from rich.table import Table
 
 from ..io.atomic import check_target
+from ..io.outputs import case_inputs, check_outputs
 from ..io.document import CodeCheck
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .progress import progress_bar
@@ -48,6 +49,7 @@ def codes(
     from ..io.jsonout import codes_document, codes_to_dict, with_provenance, write_json
 
     case = read_case(case_file)
+    check_outputs([("--json", json_out)], case_inputs(case))
     if json_out is not None:
         check_target(json_out, what="JSON")
     loads = service.code_loads(case)  # validity limits first: a bad value fails before the run (exit 2)

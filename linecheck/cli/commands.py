@@ -8,7 +8,8 @@ from rich.table import Table
 
 from ..core.errors import CaseError
 from ..io.atomic import check_target
-from .app import CaseArg, CasesArg, JsonOpt, app, console, err_console, handle_errors, read_case
+from ..io.outputs import case_inputs, check_outputs
+from .app import CaseArg, CasesArg, JsonOpt, app, console, error_line, handle_errors, read_case
 from .limits import warn as limits_warn
 from .progress import progress_bar
 
@@ -25,7 +26,7 @@ def check(cases: CasesArg) -> None:
             case = read_case(path)
             check_case(case, warn=limits_warn)  # field file, V_ref at p, resource estimate
         except CaseError as err:
-            err_console.print(f"[bold red]error:[/] {escape(str(err))}", highlight=False, soft_wrap=True, emoji=False)
+            error_line(str(err))
             failed += 1
             continue
         console.print(f"[green]ok[/] {escape(str(path))}  [dim]{escape(case.name)}: {escape(case.description)}[/]",
@@ -55,6 +56,7 @@ def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     from ..io.section import tower_rows
 
     case = read_case(case_file)
+    check_outputs([("--json", json_out)], case_inputs(case))
     if json_out is not None:
         check_target(json_out, what="JSON")
     with progress_bar() as cb:

@@ -14,13 +14,13 @@ import typer
 
 from ..core.errors import CaseError
 from ..core.extremes import CONT_R_THRESHOLD
-from .app import app, console, handle_errors
+from .app import app, console, handle_errors, path_value
 
 ExcelOpt = Annotated[Path | None, typer.Option(
-    "--excel", help="Also write the Excel design sheet (.xlsx) to this file.", show_default=False)]
+    "--excel", help="Also write the Excel design sheet (.xlsx) to this file.", show_default=False, parser=path_value)]
 TemplateOpt = Annotated[Path | None, typer.Option(
     "--template", help="Excel template with the title-block defined names (default templates/design_sheet.xlsx).",
-    show_default=False)]
+    show_default=False, parser=path_value)]
 ForceOpt = Annotated[bool, typer.Option("--force", help="Replace an existing Excel file.")]
 ThresholdOpt = Annotated[float, typer.Option(
     "--cont-r-threshold",
@@ -81,8 +81,10 @@ def title_block(project: str | None, line: str | None, engineer: str | None, rev
 @handle_errors
 def export(
     results: Annotated[list[Path], typer.Argument(
-        help="Saved run results (JSON of `linecheck run --json` or of a batch).", show_default=False)],
-    excel: Annotated[Path, typer.Option("--excel", help="Excel design sheet (.xlsx) to write.", show_default=False)],
+        help="Saved run results (JSON of `linecheck run --json` or of a batch).", show_default=False,
+        parser=path_value)],
+    excel: Annotated[Path, typer.Option("--excel", help="Excel design sheet (.xlsx) to write.", show_default=False,
+                                        parser=path_value)],
     template: TemplateOpt = None,
     force: ForceOpt = False,
     cont_r_threshold: ThresholdOpt = CONT_R_THRESHOLD,
@@ -94,8 +96,10 @@ def export(
 ) -> None:
     """Write the Excel design sheet of saved run results (summary, peaks, one sheet per case)."""
     from ..excel.writer import check_excel_target, load_result_docs, write_workbook
+    from ..io.outputs import check_outputs
 
     fields = title_block(project, line, engineer, revision, title)
+    check_outputs([("--excel", excel)], [*(("result file", r) for r in results), ("template", template)])
     check_excel_target(excel, force=force, template=template)
     docs = load_result_docs(results)
     write_workbook(docs, excel, template=template, force=force, cont_r_threshold=cont_r_threshold,

@@ -11,10 +11,8 @@ import os
 from typing import Annotated
 
 import typer
-from rich.markup import escape
-
 from ..core.budget import ENV_MAX_MEMORY, parse_size
-from .app import err_console
+from .app import error_line
 
 MaxMemoryOpt = Annotated[str | None, typer.Option(
     "--max-memory", help="Refuse jobs estimated to need more memory than this (e.g. 8GB, 512MB; "
@@ -32,4 +30,4 @@ def apply_max_memory(value: str | None) -> None:
 
 def warn(message: str) -> None:
     """Print a resource warning (one line, stderr)."""
-    err_console.print(f"[yellow]warning:[/] {escape(message)}", highlight=False, soft_wrap=True, emoji=False)
+    error_line(message, label="warning", style="yellow")

@@ -12,10 +12,13 @@ from .app import err_console
 
 @contextlib.contextmanager
 def progress_bar() -> Iterator:
-    """Yield a callback ``cb(stage, done, total)`` that drives one bar per stage."""
+    """Yield a callback ``cb(stage, done, total)`` that drives one bar per stage.
+
+    Bars are drawn only on a terminal: on a pipe or a file they would leave nothing but an
+    empty line on stderr when they close (a successful command writes nothing there)."""
     bars = Progress(
         TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-        console=err_console, transient=True,
+        console=err_console, transient=True, disable=not err_console.is_terminal,
     )
     tasks: dict[str, int] = {}
 

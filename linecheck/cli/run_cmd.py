@@ -14,6 +14,7 @@ from ..core.results import REACTIONS
 from ..io.atomic import check_target
 from ..io.display import STAT_ROWS, SUMMARY_STATS, number_text, stat_text
 from ..io.document import RunDocument, StatDef
+from ..io.outputs import case_inputs, check_outputs
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .export_cmd import (
     EngineerOpt,
@@ -203,6 +204,7 @@ def run(
     threads = default_jobs() if jobs is None else jobs
     case = override(read_case(case_file), realizations, seed)
     target = parse_until(until)
+    check_outputs([("--json", json_out), ("--excel", excel)], [*case_inputs(case), ("template", template)])
     if json_out is not None:
         check_target(json_out, what="JSON")
     if excel is not None:
@@ -266,6 +268,7 @@ def modes(
     from ..io.jsonout import _num, with_provenance, write_json
 
     case = read_case(case_file)
+    check_outputs([("--json", json_out)], case_inputs(case))
     if json_out is not None:
         check_target(json_out, what="JSON")
     res = service.modes_analysis(case, n_modes=count, warn=limits_warn)

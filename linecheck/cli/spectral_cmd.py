@@ -7,6 +7,7 @@ from typing import Any
 from rich.table import Table
 
 from ..io.atomic import check_target
+from ..io.outputs import case_inputs, check_outputs
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .limits import warn as limits_warn
 
@@ -45,6 +46,7 @@ def spectral(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     from ..io.jsonout import spectral_document, spectral_to_dict, with_provenance, write_json
 
     case = read_case(case_file)
+    check_outputs([("--json", json_out)], case_inputs(case))
     if json_out is not None:
         check_target(json_out, what="JSON")
     res = service.spectral_analysis(case, warn=limits_warn)

@@ -7,11 +7,11 @@ from typing import Annotated
 
 import typer
 
-from .app import app, err_console
+from .app import app, error_line, path_value
 
 PathsArg = Annotated[
     list[Path] | None,
-    typer.Argument(help="Case files or folders to browse (default: ./cases).", show_default=False),
+    typer.Argument(help="Case files or folders to browse (default: ./cases).", show_default=False, parser=path_value),
 ]
 
 
@@ -20,7 +20,7 @@ def tui(paths: PathsArg = None) -> None:
     """Interactive terminal UI: browse cases, edit, run, plot, compare, export (press ? for help)."""
     missing = [p for p in paths or [] if not p.exists()]
     if paths and len(missing) == len(paths):
-        err_console.print(f"[bold red]error:[/] not found: {', '.join(map(str, missing))}", highlight=False)
+        error_line(f"not found: {', '.join(map(str, missing))}")
         raise typer.Exit(2)
     from ..tui.app import LinecheckApp  # lazy: other commands do not pay for Textual
 

@@ -10,7 +10,8 @@ import typer
 from rich.table import Table
 
 from ..io.atomic import check_target, write_text_atomic
-from .app import JsonOpt, app, console, handle_errors
+from ..io.outputs import check_outputs
+from .app import JsonOpt, app, console, handle_errors, path_value
 from .progress import progress_bar
 
 
@@ -18,12 +19,14 @@ from .progress import progress_bar
 @handle_errors
 def validate(
     json_out: JsonOpt = None,
-    markdown: Annotated[Path | None, typer.Option("--markdown", help="Also write the table as Markdown.")] = None,
+    markdown: Annotated[Path | None, typer.Option("--markdown", help="Also write the table as Markdown.",
+                                                  parser=path_value)] = None,
     quick: Annotated[bool, typer.Option("--quick", help="Skip the six-span time-vs-frequency runs and Table 5.")] = False,
 ) -> None:
     """Run the verification set: closed forms, Matheson & Holmes, time vs frequency domain, Table 5."""
     from .. import validation  # here, not at import: it loads the numerical core (start-up time)
 
+    check_outputs([("--json", json_out), ("--markdown", markdown)])
     for out in (json_out, markdown):
         if out is not None:
             check_target(out)

@@ -13,16 +13,18 @@ from rich.table import Table
 
 from ..core.case import Case
 from ..io.atomic import check_target, write_atomic, write_text_atomic
-from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
+from ..io.outputs import case_inputs, check_outputs
+from .app import CaseArg, JsonOpt, app, console, handle_errors, path_value, read_case
 
 if TYPE_CHECKING:  # annotations only: the wind modules are imported where they are used (start-up time)
     from ..core.wind.point import PointSeries
 
-CsvOpt = Annotated[Path | None, typer.Option("--csv", help="Write time, mean and total velocity at p as CSV to this file.")]
+CsvOpt = Annotated[Path | None, typer.Option("--csv", help="Write time, mean and total velocity at p as CSV to this file.",
+                                             parser=path_value)]
 FieldOpt = Annotated[
     Path | None,
     typer.Option("--field", help="Write the run's full wind (running mean and turbulence at every conductor node and "
-                 "time step of the realization) to this NPZ file (layout: docs/wind.md)."),
+                 "time step of the realization) to this NPZ file (layout: docs/wind.md).", parser=path_value),
 ]
 RealizationOpt = Annotated[
     int, typer.Option("--realization", min=1, help="Turbulence realization to show, 1 to analysis.realizations.")
@@ -126,6 +128,7 @@ def wind(
 ) -> None:
     """Wind at point p: running mean and mean + turbulence over the record (paper Fig. 3)."""
     case = read_case(case_file)
+    check_outputs([("--csv", csv_out), ("--json", json_out), ("--field", field_out)], case_inputs(case))
     if csv_out is not None:
         check_target(csv_out, what="CSV")
     if json_out is not None:

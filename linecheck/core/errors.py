@@ -7,9 +7,34 @@ exit with ``err.exit_code``.  Nothing in the core prints.
 - :class:`ConvergenceError` -- the static solver found no admissible equilibrium: exit 1.
 - :class:`NumericalError` -- NaN/inf or a non-positive-definite state: exit 1.
 - :class:`Cancelled` -- the user cancelled a long job: exit 130.
+
+Every message is shown through :func:`printable`: control characters (ESC, NUL, ...), bidi
+overrides (U+202E) and other invisible format characters a file or a name may carry are shown
+escaped (``\\x1b``, ``\\u202e``), never sent raw to a terminal.
 """
 
 from __future__ import annotations
+
+import unicodedata
+
+#: Unicode categories shown escaped: controls (Cc), format characters such as the bidi overrides
+#: and zero-width marks (Cf), lone surrogates (Cs), line and paragraph separators (Zl, Zp).
+_HIDDEN = frozenset({"Cc", "Cf", "Cs", "Zl", "Zp"})
+
+
+def _escaped(ch: str) -> str:
+    n = ord(ch)
+    return f"\\x{n:02x}" if n < 0x100 else (f"\\u{n:04x}" if n < 0x10000 else f"\\U{n:08x}")
+
+
+def printable(text: str) -> str:
+    r"""``text`` with every control, bidi or other invisible format character escaped
+    (ESC -> ``\x1b``, U+202E -> ``\u202e``); other text (accents, symbols,
+    any script) unchanged.  The one helper every message goes through before a terminal, a log
+    or a dialog shows it."""
+    if text.isprintable():  # the usual case: nothing hidden (str.isprintable is False for all of _HIDDEN)
+        return text
+    return "".join(_escaped(ch) if unicodedata.category(ch) in _HIDDEN else ch for ch in text)
 
 
 class LinecheckError(Exception):
@@ -22,8 +47,8 @@ class LinecheckError(Exception):
         super().__init__(message)
         self.message = message
 
-    def __str__(self) -> str:  # one line, always
-        return " ".join(self.message.split())
+    def __str__(self) -> str:  # one line, always; hidden characters shown escaped
+        return printable(" ".join(self.message.split()))
 
 
 class CaseError(LinecheckError):

@@ -7,7 +7,6 @@ import re
 from collections.abc import Sequence
 from typing import Any
 
-from openpyxl.cell.cell import ILLEGAL_CHARACTERS_RE
 from openpyxl.styles import Alignment, Font
 from openpyxl.worksheet.hyperlink import Hyperlink
 from openpyxl.worksheet.worksheet import Worksheet
@@ -67,6 +66,20 @@ _RESERVED = {"summary", "peaks"}
 FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
 
 
+#: Characters an .xlsx (XML 1.0 in UTF-8) cannot hold: control characters but tab, line feed and
+#: carriage return (openpyxl's ILLEGAL_CHARACTERS_RE), lone surrogates (no UTF-8 form; JSON's
+#: "\ud800" reads as one) and the non-characters U+FFFE, U+FFFF.
+XML_ILLEGAL_RE = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
+
+
+def clean_text(text: Any) -> str:
+    """``text`` as the workbook can hold it: every character of :data:`XML_ILLEGAL_RE` replaced by
+    U+FFFD.  Cell texts, sheet names (and with them defined names and chart references), chart
+    titles and page headers all go through here: one such character anywhere in the XML makes
+    the whole workbook unreadable."""
+    return XML_ILLEGAL_RE.sub("\ufffd", str(text))
+
+
 def set_value(cell, value: Any) -> Any:
     """Put ``value`` into ``cell``; a text is always stored as a text, never as a formula.
 
@@ -78,7 +91,7 @@ def set_value(cell, value: Any) -> Any:
     XML 1.0 cannot hold (control characters) are replaced by U+FFFD.
     """
     if isinstance(value, str):
-        value = ILLEGAL_CHARACTERS_RE.sub("\ufffd", value)
+        value = clean_text(value)
         cell.value = value
         cell.data_type = "s"
         if value.startswith(FORMULA_START):
@@ -90,7 +103,7 @@ def set_value(cell, value: Any) -> Any:
 
 def header_text(text: Any) -> str:
     """``text`` for a page header/footer: ``&`` starts a field code there, ``&&`` is a literal ampersand."""
-    return ILLEGAL_CHARACTERS_RE.sub("\ufffd", str(text)).replace("&", "&&")
+    return clean_text(text).replace("&", "&&")
 
 
 def is_num(v: Any) -> bool:
@@ -102,8 +115,12 @@ def kn(v: Any) -> Any:
 
 
 def sheet_name(name: str, taken: set[str]) -> str:
-    """A valid, unique (case-insensitive) sheet name from a case name."""
-    base = re.sub(r"[\[\]:*?/\\]", "_", str(name)).strip("' ") or "case"
+    r"""A valid, unique (case-insensitive) sheet name from a case name: cleaned like cell text
+    (:func:`clean_text`; the name reaches the workbook's sheet list, its defined names such as
+    the print area, hyperlinks and every chart reference), tabs and line breaks as spaces, the
+    characters Excel forbids (``[]:*?/\``) as ``_``, at most 31 characters."""
+    base = re.sub(r"[\t\n\r]", " ", clean_text(name))
+    base = re.sub(r"[\[\]:*?/\\]", "_", base).strip("' ") or "case"
     base = base[:31]
     cand, k = base, 2
     while cand.lower() in taken or cand.lower() in _RESERVED:

@@ -12,7 +12,7 @@ from openpyxl.chart.title import Title
 from openpyxl.drawing.text import CharacterProperties, Paragraph, ParagraphProperties, RegularTextRun
 from openpyxl.worksheet.worksheet import Worksheet
 
-from .cells import is_num, set_value
+from .cells import clean_text, is_num, set_value
 
 #: Layout of a case sheet: charts to the right of the tables (columns A-H), data outside the print area.
 CHART_COL = 10  # J
@@ -64,7 +64,7 @@ def _line_series(ws: Worksheet, xcol: int, ycol: int, row0: int, n: int, color: 
 def chart_title(text: str, size: int = 1100) -> Title:
     """A chart title in a moderate font (openpyxl's default is 18 pt)."""
     cp = CharacterProperties(sz=size, b=True)
-    para = Paragraph(pPr=ParagraphProperties(defRPr=cp), r=[RegularTextRun(rPr=cp, t=text)])
+    para = Paragraph(pPr=ParagraphProperties(defRPr=cp), r=[RegularTextRun(rPr=cp, t=clean_text(text))])
     return Title(tx=Text(rich=RichText(p=[para])), overlay=False)
 
 

@@ -27,7 +27,6 @@ block's extremes, unless the result was saved with ``--full-histories``.
 from __future__ import annotations
 
 import io
-import json
 import os
 from collections.abc import Iterable, Sequence
 from pathlib import Path
@@ -35,11 +34,10 @@ from typing import Any
 
 from openpyxl import Workbook
 
-from ..core.case import MAX_RESULT_BYTES, read_text_file
 from ..core.errors import CaseError
 from ..core.extremes import CONT_R_THRESHOLD
 from ..io.atomic import atomic_path, check_target
-from ..io.document import FailedRun, RunDocument, load_document
+from ..io.document import FailedRun, RunDocument, load_document, read_result_file
 from . import template as tpl
 from .case_sheet import write_case
 from .cells import (
@@ -182,11 +180,7 @@ def load_result_docs(paths: Iterable[str | Path]) -> list[RunDocument | FailedRu
     docs: list[RunDocument | FailedRun] = []
     for path in paths:
         p = Path(path)
-        text = read_text_file(p, "a JSON result of `linecheck run --json`", MAX_RESULT_BYTES)
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise CaseError(f"invalid JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}", file=str(p)) from None
+        data = read_result_file(p)  # one line naming the file for anything unreadable
         items = data if isinstance(data, list) else [data]
         for k, doc in enumerate(items):
             docs.append(validate_doc(doc, str(p) if len(items) == 1 else f"{p}[{k}]"))

@@ -19,13 +19,13 @@ from rich.markup import escape
 from rich.progress import BarColumn, Progress, TaskID, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from ..core.errors import CaseError
+from ..core.errors import CaseError, printable
 from ..core.extremes import (
     CONT_R_THRESHOLD as CONT_R_FLAG,  # Cont_R flag, paper Sect. 5 (one definition)
 )
 from ..io.display import STAT_ROWS
 from ..io.document import RunDocument, SanityItem
-from .app import CaseArg, app, console, err_console, handle_errors, read_case
+from .app import CaseArg, app, console, err_console, error_line, handle_errors, path_value, read_case
 from .export_cmd import (
     EngineerOpt,
     LineOpt,
@@ -47,13 +47,14 @@ ConnectTimeoutOpt = Annotated[float, typer.Option(
     "--connect-timeout", help="With --scheduler: seconds allowed for the connection and the scheduler's handshake "
                               "(each step; an unreachable or silent address exits 2).", min=0.001, max=3600.0)]
 BatchExcelOpt = Annotated[Path | None, typer.Option(
-    "--excel", help="Also write the Excel design sheet (.xlsx) of all cases to this file.", show_default=False)]
+    "--excel", help="Also write the Excel design sheet (.xlsx) of all cases to this file.", show_default=False,
+    parser=path_value)]
 BatchTemplateOpt = Annotated[Path | None, typer.Option(
-    "--template", help="Excel template with the title-block defined names.", show_default=False)]
+    "--template", help="Excel template with the title-block defined names.", show_default=False, parser=path_value)]
 BatchForceOpt = Annotated[bool, typer.Option("--force", help="Replace an existing Excel file.")]
 JsonDirOpt = Annotated[Path | None, typer.Option(
     "--json-dir", help="Folder of the per-case JSON results (default: results/ next to --excel, else ./results).",
-    show_default=False)]
+    show_default=False, parser=path_value)]
 ChunkOpt = Annotated[int | None, typer.Option(
     "--chunk", help="Realizations per task (default 10, fewer when there are fewer realizations than workers); "
                     "results do not depend on it.",
@@ -75,6 +76,30 @@ def expand_cases(paths: list[Path]) -> list[Path]:
                 seen.add(key)
                 out.append(Path(m))
     return out
+
+
+def _check_outputs(jobs: list[Any], plan: Any, excel: Path | None, template: Path | None, out_dir: Path) -> None:
+    """Refuse (exit 2, before any work) a workbook or a per-case JSON result that would overwrite
+    an input of the batch: a case file, its tower table or field file, the template."""
+    from ..io.outputs import case_inputs, check_outputs
+
+    inputs: list[tuple[str, Any]] = [("template", template)]
+    outputs: list[tuple[str, Any]] = [("--excel", excel)]
+    seen: set[Path] = set()
+    for job in jobs:
+        path = Path(getattr(job, "path", job))
+        if path not in seen:
+            seen.add(path)
+            try:
+                inputs += case_inputs(read_case(path))
+            except CaseError:  # a bad case fails alone in the batch, with its message
+                inputs.append(("case file", path))
+        name = getattr(job, "json_name", None) or f"{path.stem}.json"
+        outputs.append((f"result {name} in --json-dir", out_dir / name))
+    for path in plan or ():  # --models: one combined <stem>.json per case file besides the runs
+        outputs.append((f"result {path.stem}.json in --json-dir", out_dir / f"{path.stem}.json"))
+    outs = list(dict.fromkeys(outputs))  # a --models case's own run and its combined document share a name
+    check_outputs(outs, inputs)
 
 
 def _check_excel(excel: Path | None, force: bool, template: Path | None) -> None:
@@ -173,7 +198,7 @@ class BatchDisplay:
         return f"{ev.cases_done}/{ev.cases_total} cases, {self._count(ev.overall_done, ev.overall_total)} realizations"
 
     def _line(self, text: str) -> None:
-        self.console.print(text, highlight=False, soft_wrap=True, markup=False, emoji=False)
+        self.console.print(printable(text), highlight=False, soft_wrap=True, markup=False, emoji=False)
         self.last_line = time.monotonic()
 
     def __call__(self, ev: Any) -> None:
@@ -223,7 +248,8 @@ class BatchDisplay:
                 b.console.print(f"[cyan]skipped[/] {escape(ev.name)} [dim](saved result matches the case file)[/]",
                                 highlight=False)
             else:
-                b.console.print(f"[red]failed[/]  {escape(ev.name)}: {escape(ev.message)}", highlight=False, soft_wrap=True)
+                b.console.print(f"[red]failed[/]  {escape(printable(f'{ev.name}: {ev.message}'))}", highlight=False,
+                                soft_wrap=True)
 
 
 def _kn(doc: RunDocument | None, reaction: str, stat: str, fmt: str = "{:.2f}") -> str:
@@ -323,7 +349,7 @@ def summary_notes(report: Any) -> list[str]:
 @handle_errors
 def batch(
     cases: Annotated[list[Path], typer.Argument(help="Case files (TOML); shell globs like cases/paper/*.toml.",
-                                                show_default=False)],
+                                                show_default=False, parser=path_value)],
     excel: BatchExcelOpt = None,
     json_dir: JsonDirOpt = None,
     jobs: JobsOpt = None,
@@ -366,8 +392,9 @@ def batch(
         from ..batch.models import model_jobs
 
         paths, plan = model_jobs(paths, models)
-    _check_excel(excel, force, template)
     out_dir = json_dir if json_dir is not None else ((excel.parent if excel is not None else Path.cwd()) / "results")
+    _check_outputs(paths, plan, excel, template, out_dir)
+    _check_excel(excel, force, template)
     kernel_off = kernel_warning()  # compiled pieces off (Numba installed): one line, before the batch
     if kernel_off:
         limits_warn(kernel_off)
@@ -408,8 +435,7 @@ def batch(
         _write_excel(docs, excel, force, template, fields)
         console.print(f"wrote {excel}")
     if report.failed:
-        err_console.print(f"[bold red]error:[/] {len(report.failed)} case(s) failed: "
-                          + escape(", ".join(o.name for o in report.failed)), highlight=False, soft_wrap=True)
+        error_line(f"{len(report.failed)} case(s) failed: " + ", ".join(o.name for o in report.failed))
     raise typer.Exit(report.exit_code)
 
 
@@ -503,8 +529,8 @@ def _scan_each_model(case_file: Path, case: Any, grid: Any, names: tuple[str | N
                           "event.[/]", highlight=False)
             if result.n_failed:
                 first = next(e for e in result.errors if e)
-                err_console.print(f"[yellow]warning:[/] {result.n_failed} configuration(s) failed and were left out, "
-                                  f"e.g.: {escape(first)}", highlight=False, soft_wrap=True)
+                error_line(f"{result.n_failed} configuration(s) failed and were left out, e.g.: {first}",
+                           label="warning", style="yellow")
             if csv_out is not None:
                 target = csv_out if model is None else csv_out.with_name(f"{csv_out.stem}.{model}{csv_out.suffix}")
                 write_scan_csv(result, target)
@@ -539,7 +565,7 @@ def scan(
         "--jet-diameter", help="D_j values START:STOP:STEP or a list, metres (default: the case's D_j).",
         show_default=False)] = None,
     csv_out: Annotated[Path | None, typer.Option("--csv", help="Write every scan point to this CSV file.",
-                                                 show_default=False)] = None,
+                                                 show_default=False, parser=path_value)] = None,
     hold: Annotated[str, typer.Option(
         "--hold", help="Storm strength over the grid: 'jet' = one storm (V_max of the case's own configuration) "
                        "moved around; 'vref' = the case's V_ref at point p in every configuration.")] = "jet",
@@ -552,7 +578,7 @@ def scan(
         help="With --dynamic: realizations per position for the expected peak (their mean).")] = 3,
     json_dir: Annotated[Path | None, typer.Option(
         "--json-dir", help="With --dynamic: save the critical runs' JSON results in this folder.",
-        show_default=False)] = None,
+        show_default=False, parser=path_value)] = None,
     jobs: JobsOpt = None,
     scheduler: SchedulerOpt = None,
     max_memory: MaxMemoryOpt = None,
@@ -568,11 +594,14 @@ def scan(
 
     case = read_case(case_file)
     grid = ScanGrid.from_options(case, distance, angle, jet_diameter)
-    if csv_out is not None:
-        check_target(csv_out, what="CSV")
     from .. import service
+    from ..io.outputs import case_inputs, check_outputs
 
     names = service.parse_models(case, models) if models is not None else (None,)  # None: the case's own model
+    if csv_out is not None:  # --models: one CSV per model, <stem>.<model>.csv
+        check_outputs([(f"--csv ({m})" if m else "--csv", csv_out if m is None else
+                        csv_out.with_name(f"{csv_out.stem}.{m}{csv_out.suffix}")) for m in names], case_inputs(case))
+        check_target(csv_out, what="CSV")
     _scan_each_model(case_file, case, grid, names, hold=hold, csv_out=csv_out, dynamic=dynamic, json_dir=json_dir,
                      jobs=jobs, scheduler=scheduler, connect_timeout=connect_timeout,
                      dynamic_realizations=dynamic_realizations)

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import csv
 import math
+import zipfile
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -366,6 +367,17 @@ def _read_csv(path: Path) -> FieldTable:
     return _grid_from_rows(path, cols, np.asarray(lines))
 
 
+def _check_real(path: Path, name: str, a: np.ndarray) -> None:
+    """CaseError unless ``a`` holds real numbers (floating point or integer): a complex array would
+    lose its imaginary part, text, booleans, dates or objects are not velocities or coordinates."""
+    if a.dtype.kind in "fiu":
+        return
+    what = {"c": "complex numbers", "b": "booleans", "U": "text", "S": "bytes", "O": "Python objects",
+            "M": "dates", "m": "time spans", "V": "records"}.get(a.dtype.kind, "not numbers")
+    raise _field_error(path, f'array "{name}" has dtype {a.dtype} ({what}): expected real numbers '
+                       "(a floating-point array, or integers)")
+
+
 def _read_npz(path: Path) -> FieldTable:
     try:
         with np.load(path, allow_pickle=False) as npz:
@@ -375,8 +387,12 @@ def _read_npz(path: Path) -> FieldTable:
                 raise _field_error(path, f"arrays of {inflated / 2**20:.0f} MB uncompressed are too large: expected "
                                    f"at most {MAX_FIELD_BYTES / 2**20:.0f} MB")
             arrays = {k: np.asarray(npz[k]) for k in npz.files}
-    except (OSError, ValueError) as exc:
-        raise _field_error(path, f"not a readable NPZ file ({exc}): expected arrays {_ALLOWED_TEXT}") from None
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, zipfile.LargeZipFile, NotImplementedError) as exc:
+        # BadZipFile: a file that starts like a zip archive ("PK\x03\x04...") but is not one;
+        # NotImplementedError: a member compressed with a method zipfile cannot read
+        reason = " ".join(str(exc).split()) or type(exc).__name__
+        raise _field_error(path, f"not a readable NPZ file ({reason}): expected a zip archive of arrays "
+                           f"{_ALLOWED_TEXT} (numpy.savez)") from None
     for name in arrays:
         if name not in FIELD_COLUMNS:
             raise _field_error(path, f'array "{name}" is not allowed: expected {_ALLOWED_TEXT}')
@@ -386,7 +402,8 @@ def _read_npz(path: Path) -> FieldTable:
     axes = []
     for name in ("r_over_dj", "z_over_dj", "t"):
         a = arrays[name]
-        if a.ndim != 1 or not np.issubdtype(a.dtype, np.number):
+        _check_real(path, name, a)
+        if a.ndim != 1:
             raise _field_error(path, f'array "{name}" has shape {a.shape}: expected a 1-D array of numbers')
         a = a.astype(float)
         if not np.all(np.isfinite(a)):
@@ -404,7 +421,8 @@ def _read_npz(path: Path) -> FieldTable:
         if name not in arrays:
             continue
         a = arrays[name]
-        if a.shape != shape or not np.issubdtype(a.dtype, np.number):
+        _check_real(path, name, a)
+        if a.shape != shape:
             raise _field_error(path, f'array "{name}" has shape {a.shape}: expected numbers of shape '
                                f"(len(r_over_dj), len(z_over_dj), len(t)) = {shape}")
         a = a.astype(float)

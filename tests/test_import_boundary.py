@@ -28,6 +28,7 @@ CORE_MODULES = [
     "linecheck.core.wind.turbulence",
     "linecheck.core.wind.point",
     "linecheck.core.wind.ring",
+    "linecheck.core.wind.profiles",
     "linecheck.service",
     "linecheck.io.jsonout",
     "linecheck.io.display",

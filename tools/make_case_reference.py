@@ -33,7 +33,8 @@ has one entry per span; a `preset` and explicit `jet_diameter`/`distance`/`angle
 elevation `height` is `height` − `sag`/3; insulator swing lifts the conductor, so no swing
 allowance is added); with suspension towers, `insulator_length` < `height`; downburst `model`
 (default `"table"` with a `field`, else `"holmes-oliver"`): `"table"` needs `field`, `field`
-needs `"table"`, `jet_velocity` is for `"ring-jet"` only and `t1`/`t_f` are not (docs/wind.md).
+needs `"table"`, `jet_velocity` is for `"ring-jet"` and `"ring-jet-inviscid"` only and `t1`/`t_f`
+are not (docs/wind.md).
 
 Hostile input: every key and string value is refused if it holds a control character (C0
 except tab, DEL, C1: they would inject terminal escape sequences and are illegal in Excel),

@@ -31,10 +31,13 @@ SUPPORT_TYPES = ("strain", "suspension")
 WIND_TYPES = ("synoptic", "downburst")
 DOWNBURST_PRESETS = ("Db_x", "Db_y")
 # Downburst running-mean models (issue 15; docs/wind.md).  "holmes-oliver": separable
-# Holmes-Oliver x Wood x Chay; "table": the user field file; "ring-jet": travelling ring vortex +
-# wall jet (linecheck/core/wind/ring.py).  A file without ``model`` keeps its meaning: "table" when
-# it names a ``field``, else "holmes-oliver" (see docs/wind.md for the choice of default).
-DOWNBURST_MODELS = ("holmes-oliver", "table", "ring-jet")
+# Holmes-Oliver x Wood x Chay; "table": the user field file; "ring-jet": travelling ring vortex
+# kinematics with a wall-layer outflow; "ring-jet-inviscid": the ring + image field itself (what
+# "ring-jet" was before the wall layer; linecheck/core/wind/ring.py).  A file without ``model``
+# keeps its meaning: "table" when it names a ``field``, else "holmes-oliver" (see docs/wind.md for
+# the choice of default).
+RING_MODELS = ("ring-jet", "ring-jet-inviscid")  # time scale D_j/V_j, key jet_velocity (ring.MODELS)
+DOWNBURST_MODELS = ("holmes-oliver", "table", *RING_MODELS)
 DAMPING_MODELS = ("quasi-steady", "paper")
 CODE_TERRAINS = ("sea", "open", "suburban", "urban")  # [codes] terrain (docs/codes.md)
 DRAG_MODELS = ("linear", "quadratic")
@@ -154,7 +157,7 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         _f("translation_speed", "m/s", "storm translation speed (Holmes & Oliver vector sum)", default=0.0, low=0.0, high=100.0),
         _f("translation_direction", "deg", "direction of storm travel, from +x toward +y", default=90.0, low=-360.0, high=360.0),
         FieldSpec("field", "str", "", "user running-mean field file (CSV or NPZ), relative to the case file"),
-        _f("jet_velocity", "m/s", 'model "ring-jet": downdraft speed V_j setting the time scale D_j/V_j (default: from v_ref at p)', low=0.0, high=200.0, low_open=True),
+        _f("jet_velocity", "m/s", 'models "ring-jet", "ring-jet-inviscid": downdraft speed V_j setting the time scale D_j/V_j (default: from v_ref at p)', low=0.0, high=200.0, low_open=True),
     ),
     "analysis": (
         _f("duration", "s", "analysed record length (downburst default: 0 to T_f)", low=0.0, high=1e5, low_open=True),
@@ -268,7 +271,7 @@ class Downburst:
     field: str | None = None  # path as written in the file
     field_path: Path | None = None  # resolved path
     model: str | None = None  # None: derived, see model_name
-    jet_velocity: float | None = None  # [m/s] V_j ("ring-jet")
+    jet_velocity: float | None = None  # [m/s] V_j ("ring-jet", "ring-jet-inviscid")
 
     @property
     def model_name(self) -> str:
@@ -874,12 +877,12 @@ def _build_downburst(d: dict[str, Any], line: Line, ctx: _Ctx, base_dir: Path | 
         raise ctx.error(sec, "model", 'value "table" needs a field file: give field = "file.csv" (or .npz), see docs/wind.md')
     if model != "table" and d["field"] is not None:
         raise ctx.error(sec, "field", f'is read by model "table" only, but model = "{model}": remove field or set model = "table"')
-    if model != "ring-jet" and d["jet_velocity"] is not None:
-        raise ctx.error(sec, "jet_velocity", f'is a parameter of model "ring-jet" only, but model = "{model}": remove it')
-    if model == "ring-jet":
+    if model not in RING_MODELS and d["jet_velocity"] is not None:
+        raise ctx.error(sec, "jet_velocity", f'is a parameter of model "ring-jet" (and "ring-jet-inviscid") only, but model = "{model}": remove it')
+    if model in RING_MODELS:
         for key in ("t1", "t_f"):
             if d[key] is not None:
-                raise ctx.error(sec, key, f'shapes the "holmes-oliver" time history only; model "ring-jet" takes its time scale from D_j/V_j (jet_velocity): remove {key}')
+                raise ctx.error(sec, key, f'shapes the "holmes-oliver" time history only; model "{model}" takes its time scale from D_j/V_j (jet_velocity): remove {key}')
     path = None
     if d["field"] is not None:
         path = Path(d["field"])

@@ -46,12 +46,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.special import erf
 
 from ..case import Case, Downburst, read_regular_file
 from ..errors import CaseError
 from ..system import LineSystem
 from . import ring as ring_model
+# Wood et al. (2001) f_z and z/delta of its maximum: one source, shared with the ring-jet models
+from .profiles import ETA_PEAK, wood as _wood
 
 if TYPE_CHECKING:
     from scipy.interpolate import RegularGridInterpolator
@@ -67,29 +68,6 @@ Z_MAX_OVER_DJ = 0.025  # z_max = 0.025 D_j (Wood et al. 2001 / Hangan & Kim 2007
 T1_DEFAULT = 120.0  # [s]
 T_F_DEFAULT = 600.0  # [s]
 SYNOPTIC_DURATION_DEFAULT = 600.0  # [s] ten-minute record (standard averaging period)
-
-# Wood et al. (2001): f_z peaks at z/delta = ETA_PEAK (root of d f_z / d z = 0, computed below)
-_WOOD_A, _WOOD_B = 1.55, 0.70
-
-
-def _wood(eta: np.ndarray | float) -> np.ndarray:
-    eta = np.maximum(np.asarray(eta, dtype=float), 0.0)
-    # Wood, Kwok, Motteram & Fletcher (2001), J. Wind Eng. Ind. Aerodyn. 89: V/V_max
-    return _WOOD_A * eta ** (1.0 / 6.0) * (1.0 - erf(_WOOD_B * eta))
-
-
-def _wood_peak() -> float:
-    """The maximum of f_z, found numerically (tests/test_ring.py checks :data:`ETA_PEAK` against it)."""
-    from scipy.optimize import minimize_scalar
-
-    res = minimize_scalar(lambda e: -float(_wood(e)), bounds=(1e-6, 2.0), method="bounded",
-                          options={"xatol": 1e-13})
-    return float(res.x)
-
-
-#: z/delta of the maximum of Wood et al.'s f_z, as :func:`_wood_peak` finds it (xatol 1e-13); a
-#: constant, so that every machine uses the same value and importing costs no optimisation
-ETA_PEAK = 0.18358363375664333  # z_max = ETA_PEAK * delta
 
 
 # ------------------------------------------------------------------------- MeanWind
@@ -510,7 +488,7 @@ class DownburstField:
     t1: float = math.nan
     t_f: float = math.nan
     table: FieldTable | None = None
-    ring: ring_model.RingJet | None = None  # model "ring-jet" (issue 15)
+    ring: ring_model.RingJet | None = None  # models "ring-jet", "ring-jet-inviscid" (issue 15)
     point_xy: tuple[float, float] | None = None  # [m] plan position of p (section form; None: (point_p, 0))
 
     # -- model pieces
@@ -724,8 +702,9 @@ def event_window(case: Case) -> tuple[float, float]:
     dur = case.analysis.duration
     if case.wind.type == "synoptic":
         return 0.0, float(dur if dur is not None else SYNOPTIC_DURATION_DEFAULT)
-    if _downburst(case).model_name == "ring-jet":
-        return 0.0, float(dur if dur is not None else ring_model.TAU_END * _ring_scale(case).time_scale)
+    if _downburst(case).model_name in ring_model.MODELS:
+        tau_end = ring_model.closure(_downburst(case).model_name).tau_end
+        return 0.0, float(dur if dur is not None else tau_end * _ring_scale(case).time_scale)
     table = _table_of(case)
     if table is None:
         t_f = _downburst(case).t_f if _downburst(case).t_f is not None else T_F_DEFAULT
@@ -742,30 +721,23 @@ def event_window(case: Case) -> tuple[float, float]:
 
 @lru_cache(maxsize=64)
 def _ring_scale(case: Case) -> ring_model.RingJet:
-    """D_j and V_j of a "ring-jet" case: ``jet_velocity``, else V_ref / (peak over the event of the
-    stationary dimensionless outflow at p, at the conductor height), i.e. V_j = V_max."""
+    """D_j and V_j of a "ring-jet" / "ring-jet-inviscid" case: ``jet_velocity``, else V_ref / (peak
+    over the event of the stationary dimensionless outflow at p, at the reference height), i.e.
+    V_j = V_max."""
     db = _downburst(case)
     dj = db.jet_diameter
+    model = db.model_name
     if db.jet_velocity is not None:
-        return ring_model.RingJet(dj, float(db.jet_velocity))
+        return ring_model.RingJet(dj, float(db.jet_velocity), model)
     rho_p = abs(db.distance * math.cos(math.radians(db.angle))) / dj
     if abs(math.cos(math.radians(db.angle))) < 1e-12:
         rho_p = 0.0
-    tau = np.linspace(0.0, ring_model.TAU_END, 6001)
     z_ref = reference_height(case)  # the height of V_ref at p (equal-span form: the conductor height)
-    s = np.abs(ring_model.radial_speed(rho_p, z_ref / dj, tau))
-    k = int(np.argmax(s))
-    peak = float(s[k])
-    lo, hi = tau[max(k - 1, 0)], tau[min(k + 1, tau.size - 1)]
-    from scipy.optimize import minimize_scalar
-
-    res = minimize_scalar(lambda tt: -abs(float(ring_model.radial_speed(rho_p, z_ref / dj, tt))),
-                          bounds=(lo, hi), method="bounded", options={"xatol": 1e-10})
-    peak = max(peak, float(-res.fun))
+    peak = ring_model.peak_over_event(rho_p, z_ref / dj, model)[0]
     if not peak > 0.0:
         raise CaseError("the outflow at point p is zero (the centre lies on the line): change distance/angle",
                         file=str(case.source) if case.source else None, key="wind.downburst")
-    return ring_model.RingJet(dj, case.wind.v_ref / peak)
+    return ring_model.RingJet(dj, case.wind.v_ref / peak, model)
 
 
 def _max_speed_at_p(field: DownburstField, v_max: float, times: np.ndarray) -> tuple[float, float]:
@@ -861,7 +833,7 @@ def _downburst_field_cached(case: Case, stamp: tuple[int, int] | None) -> Downbu
         translation = (translation[0], 0.0)
     window = event_window(case)
     table = _table_of(case)
-    if db.model_name == "ring-jet":
+    if db.model_name in ring_model.MODELS:
         rj = _ring_scale(case)
         if db.t1 is not None or db.t_f is not None:  # guarded by the loader too
             raise CaseError("t1/t_f shape the holmes-oliver model only", file=src, key="wind.downburst.t1")
@@ -904,7 +876,7 @@ def _downburst_field_cached(case: Case, stamp: tuple[int, int] | None) -> Downbu
     special = special[(special >= window[0]) & (special <= window[1])]
     r_p = _distance_to_p(centre, point_p, point_xy)
     v_ref = case.wind.v_ref
-    if translation == (0.0, 0.0) and db.model_name == "ring-jet":
+    if translation == (0.0, 0.0) and db.model_name in ring_model.MODELS:
         # stationary ring-jet: |V(p,t)| = V_max |s(r_p, t)|, maximum found by grid + refinement
         peak = _max_speed_at_p(field, 1.0, special)[0]
         if not peak > 0.0:

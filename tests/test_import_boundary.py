@@ -29,6 +29,7 @@ CORE_MODULES = [
     "linecheck.core.wind.point",
     "linecheck.core.wind.ring",
     "linecheck.core.wind.profiles",
+    "linecheck.core.wind.line_peak",
     "linecheck.service",
     "linecheck.io.jsonout",
     "linecheck.io.display",

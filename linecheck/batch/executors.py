@@ -25,6 +25,7 @@ to install it.  Nothing here prints or imports a UI library.
 from __future__ import annotations
 
 import contextlib
+import logging
 import multiprocessing
 import os
 import signal
@@ -427,12 +428,36 @@ def _open_client(distributed: Any, address: str, timeout: float) -> Any:
     return box["client"]
 
 
+#: the loggers whose records about a lost scheduler connection :class:`DaskExecutor` drops
+#: (reconnection attempts, ``ConnectionRefusedError -> CommClosedError -> CancelledError``
+#: tracebacks): the batch reports the loss itself, one line per case
+DASK_CONNECTION_LOGGERS = ("distributed.client", "distributed.utils", "distributed.core", "distributed.comm",
+                           "distributed.comm.tcp", "distributed.comm.core", "distributed.batched")
+#: :class:`~.tasks.Failure` kind of a task lost with the connection to the Dask scheduler
+SCHEDULER_LOST = "SchedulerLost"
+
+
+class _LostSchedulerFilter:
+    """Logging filter: drops the records of a client whose scheduler connection is gone."""
+
+    def __init__(self, executor: DaskExecutor) -> None:
+        self.executor = executor
+
+    def filter(self, record: Any) -> bool:
+        return not self.executor.lost()
+
+
 class DaskExecutor(Executor):
     """Tasks on a Dask distributed cluster (``--scheduler tcp://HOST:PORT``).
 
     Pass either the scheduler ``address`` (a client is opened and closed here) or an
     existing ``client`` (left open).  Workers need linecheck installed and the case
     files (and any downburst field files) at the same paths -- a shared file system.
+
+    A lost scheduler (its process ended, the network gone) cancels every task the client
+    holds: :meth:`outcome` reports each as a :data:`SCHEDULER_LOST` failure naming the
+    scheduler, and while the connection is lost distributed's own log records about it
+    (reconnection attempts and their tracebacks) are dropped (:data:`DASK_CONNECTION_LOGGERS`).
     """
 
     name = "dask"
@@ -455,6 +480,21 @@ class DaskExecutor(Executor):
             client = _open_client(distributed, address, timeout)
         self.client = client
         self.address = address or getattr(client.scheduler, "address", "")
+        self._lost = False
+        self._filter = _LostSchedulerFilter(self)
+        for name in DASK_CONNECTION_LOGGERS:
+            logging.getLogger(name).addFilter(self._filter)
+
+    def lost(self) -> bool:
+        """True once the client has lost its scheduler (it is reconnecting, or closed since)."""
+        if not self._lost:
+            status = getattr(self.client, "status", "running")
+            self._lost = str(getattr(status, "value", status)) not in ("running", "newly-created")
+        return self._lost
+
+    def _lost_failure(self) -> Failure:
+        return Failure(SCHEDULER_LOST, f"lost the connection to the Dask scheduler at {self.address} before the "
+                                       "case finished", 1)
 
     @property
     def workers(self) -> int:
@@ -481,10 +521,16 @@ class DaskExecutor(Executor):
 
     def outcome(self, handle: Any) -> Any:
         if handle.status == "cancelled":
+            exc = getattr(getattr(handle, "_state", None), "exception", None)
+            if getattr(exc, "reason", None) == "scheduler-connection-lost" or self.lost():
+                self._lost = True
+                return self._lost_failure()
             return Failure("Cancelled", "cancelled", 130)
         try:
             return handle.result()
         except Exception as exc:  # noqa: BLE001 - KilledWorker, lost scheduler, bugs
+            if self.lost():
+                return self._lost_failure()
             return Failure.of(exc)
 
     def cancel(self, handles: Sequence[Any]) -> None:
@@ -499,8 +545,16 @@ class DaskExecutor(Executor):
         self.cancel(handles)
 
     def close(self) -> None:
-        if self._own:
-            self.client.close()
+        try:
+            if self._own:
+                if self.lost():  # the reconnection attempt ends now: its CancelledError is not logged
+                    with contextlib.suppress(Exception):
+                        self.client.close(timeout=5)
+                else:
+                    self.client.close()
+        finally:
+            for name in DASK_CONNECTION_LOGGERS:
+                logging.getLogger(name).removeFilter(self._filter)
 
 
 def make_executor(jobs: int | None = None, scheduler: str | None = None,

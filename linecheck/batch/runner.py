@@ -58,13 +58,25 @@ class _OutputError(Exception):
     """A result could not be written (disk full, ...): the batch stops, saved results stay."""
 
 
+def _write_failure(exc: BaseException) -> str:
+    """Why a result could not be written: the operating system's reason (``No space left on
+    device``), also when the atomic writer reported it as a one-line CaseError naming the file."""
+    cause = exc if isinstance(exc, OSError) else (exc.__cause__ or exc.__context__)
+    if isinstance(cause, OSError):
+        return cause.strerror or str(cause) or type(cause).__name__
+    text = str(exc)
+    file = getattr(exc, "file", None)
+    return text[len(file) + 2:] if file and text.startswith(f"{file}: ") else text
+
+
 # --------------------------------------------------------------------------- public data
 @dataclass(frozen=True)
 class BatchEvent:
     """One progress report of a batch.
 
-    kind: ``"start"`` (batch planned), ``"case_start"``, ``"case_progress"``,
-    ``"case_done"``, ``"case_skipped"`` (resume), ``"case_failed"``, ``"finish"``.
+    kind: ``"start"`` (batch planned), ``"case_warning"`` (the resource guard's warning for a
+    case, in ``message``: above half the memory limit or a long run), ``"case_start"``,
+    ``"case_progress"``, ``"case_done"``, ``"case_skipped"`` (resume), ``"case_failed"``, ``"finish"``.
     ``case`` is the case index (-1 for batch-level events); ``done``/``total`` count
     that case's realizations (``done`` is fractional while chunks run: tasks report
     their progress at least once per realization), ``overall_done``/``overall_total``
@@ -108,6 +120,7 @@ class CaseOutcome:
     error: str | None = None
     error_kind: str | None = None
     elapsed: float = 0.0
+    warning: str | None = None  # the resource guard's warning (above half the memory limit, a long run)
 
     @property
     def ok(self) -> bool:
@@ -368,8 +381,8 @@ def run_batch(
         if st.case is None or o.status != "pending":
             continue
         n = max(2, min(o.realizations, int(until[1]))) if until is not None else o.realizations  # run_until's start
-        try:
-            budget.guard(st.case, "run", realizations=n)
+        try:  # above half the limit or about 10 minutes: the case runs with a warning (case_warning)
+            budget.guard(st.case, "run", realizations=n, warn=lambda m, o=o: setattr(o, "warning", m))
         except CaseError as err:
             o.status, o.error, o.error_kind = "failed", str(err), type(err).__name__
             st.done = o.realizations  # its own progress complete; none of it in the overall count
@@ -377,6 +390,8 @@ def run_batch(
 
     emit("start", None, executor.describe())
     for st in states:
+        if st.outcome.warning and st.outcome.status == "pending":
+            emit("case_warning", st, st.outcome.warning)
         if st.outcome.status == "failed":
             emit("case_failed", st, st.outcome.error or "")
         elif st.outcome.status == "skipped":
@@ -461,17 +476,18 @@ def run_batch(
         try:
             merged = merge_runs([p for p in st.parts])
             doc = result_document(merged, st.job.path, o.hash, st.job.changes)
-            if o.json_path is not None:
-                from ..io.jsonout import write_json
-
-                write_json(o.json_path, doc)
         except LinecheckError as err:
             fail_case(st, Failure.of(err))
             return
-        except OSError as exc:  # disk full, folder gone read-only...: stop, keep what is saved
-            msg = f"cannot save the result {o.json_path}: {exc.strerror or exc}"
-            fail_case(st, Failure("OSError", msg, 2))
-            raise _OutputError(msg) from None
+        if o.json_path is not None:
+            from ..io.jsonout import write_json
+
+            try:
+                write_json(o.json_path, doc)
+            except (OSError, CaseError) as exc:  # disk full, folder gone read-only...: stop, keep what is saved
+                msg = f"cannot save the result {o.json_path}: {_write_failure(exc)}"
+                fail_case(st, Failure("OutputError", msg, 2))
+                raise _OutputError(msg) from None
         o.status, o.doc = "done", doc
         o.result = merged if keep_results else None
         o.elapsed = time.perf_counter() - st.t0

@@ -307,6 +307,7 @@ def run_scan(
     cancel: threading.Event | None = None,
     model: str | None = None,
     dynamic_realizations: int = 0,
+    warn: Callable[[str], None] | None = None,
 ) -> ScanResult:
     """Step 1 at every grid point of ``grid`` for the case in ``case_path``.
 
@@ -319,12 +320,16 @@ def run_scan(
             configuration; ``"vref"``: every configuration keeps the case's V_ref at p.
         executor: where points run (default sequential, in this process); not closed here.
         chunk_size: points per task (default :func:`default_scan_chunk`).
-        progress: ``progress("scan", points_done, points_total)``.
+        progress: ``progress("scan", points_done, points_total)``: once before any task is
+            submitted, then as points finish (per point in this process, per chunk elsewhere).
         cancel: a threading.Event; when set the scan stops with :class:`Cancelled`.
+        warn: ``warn(message)`` gets the resource guard's warning (:func:`scan_estimate`: above
+            half the memory limit, or longer than about 10 minutes).
 
     Raises:
-        CaseError: the case is not a valid downburst case.  Cancelled.  LinecheckError
-            when a worker crashed.
+        CaseError: the case is not a valid downburst case, or one position is estimated above
+            the memory limit (before anything runs).  Cancelled.  LinecheckError when a worker
+            crashed.
     """
     t0 = time.perf_counter()
     executor = executor or SequentialExecutor()
@@ -344,13 +349,19 @@ def run_scan(
 
         v_max = float(downburst_field(case).v_max)  # CaseError if the case's own configuration is invalid
     digest = case_hash(path)
+    scan_estimate(case, grid.size, dynamic_realizations=dynamic_realizations, workers=executor.workers, warn=warn)
     pts = grid.points()
     n = pts.shape[0]
     size = chunk_size or default_scan_chunk(n, executor.workers)
+    done = 0
+    if progress is not None:
+        progress("scan", 0, n)
     handles = []
     for a in range(0, n, size):
         chunk = [tuple(map(float, p)) for p in pts[a:a + size]]
-        kwargs = {"cancel": cancel} if executor.in_process and cancel is not None else {}
+        kwargs: dict[str, Any] = {"cancel": cancel} if executor.in_process and cancel is not None else {}
+        if executor.in_process and progress is not None:  # per point: a chunk of --dynamic positions is long
+            kwargs["progress"] = lambda i, a=a: progress("scan", a + i, n)
         if model is not None:
             kwargs["model"] = model
         if dynamic_realizations > 0:
@@ -361,10 +372,7 @@ def run_scan(
     tt = np.full((n, 3), np.nan)
     vref = np.full(n, np.nan)
     errors: list[str | None] = [None] * n
-    done = 0
     pending = list(range(len(handles)))
-    if progress is not None:
-        progress("scan", 0, n)
     try:
         while pending:
             if cancel is not None and cancel.is_set():
@@ -394,6 +402,17 @@ def run_scan(
         raise
     return ScanResult(case, path, pts, peak, tt, vref, tuple(errors), hold, v_max,
                       time.perf_counter() - t0, executor.describe(), model, dyn, int(dynamic_realizations))
+
+
+def scan_estimate(case: Case, points: int, *, dynamic_realizations: int = 0, workers: int = 1,
+                  warn: Callable[[str], None] | None = None) -> Any:
+    """The resource guard of a scan (:func:`linecheck.core.budget.estimate_scan`): CaseError
+    (exit 2) when one position is above the memory limit; ``warn(message)`` above half of it or
+    when the scan is estimated to take longer than about 10 minutes on ``workers``."""
+    from ..core import budget
+
+    return budget.check(budget.estimate_scan(case, points, dynamic_realizations=dynamic_realizations,
+                                             workers=workers), case, warn)
 
 
 def critical_jobs(result: ScanResult, reactions: Sequence[str] = ("Rx", "Ry"), by: str | None = None) -> list[RunJob]:

@@ -210,8 +210,11 @@ def scan_chunk(
     cancel: threading.Event | None = None,
     model: str | None = None,
     dynamic_realizations: int = 0,
+    progress: Callable[[int], None] | None = None,
 ) -> Any:
     """Step 1 at each (distance R [m], angle Theta [deg], jet diameter D_j [m]) of ``points``.
+
+    ``progress(points_done)``: called after each point (only when run in the coordinating process).
 
     ``model``: the downburst running-mean model to scan under (issue 15; ``None``: the case's own).
     ``dynamic_realizations``: k > 0 also runs steps 1-3 with realizations 0..k-1 at every point
@@ -250,6 +253,8 @@ def scan_chunk(
             raise
         except LinecheckError as err:
             errors[i] = str(err)
+        if progress is not None:
+            progress(i + 1)
     return ScanChunk(start, peak, time, vref, tuple(errors), dyn)
 
 

@@ -35,6 +35,8 @@ from .export_cmd import (
     title_block,
 )
 from .limits import MaxMemoryOpt, apply_max_memory
+from .scan_progress import ScanDisplay
+from .signals import sigterm_as_interrupt
 from .stats_view import MaxRealOpt, UntilOpt, parse_until
 
 JobsOpt = Annotated[int | None, typer.Option(
@@ -219,6 +221,8 @@ class BatchDisplay:
             extra = f": {ev.message}" if ev.kind == "case_failed" else ""
             self._line(f"{word:<8}{ev.name}{extra}  [{self.rate.summary(ev)}]")
             self.last_whole = int(ev.overall_done)
+        elif ev.kind == "case_warning":
+            self._line(f"warning: {ev.name}: {ev.message}")
         elif ev.kind == "case_progress":
             whole = int(ev.overall_done)
             if whole > self.last_whole and time.monotonic() - self.last_line >= self.interval:
@@ -234,6 +238,9 @@ class BatchDisplay:
         if self.overall is not None:
             b.update(self.overall, completed=ev.overall_done, count=self._overall_count(ev),
                      eta=f"ETA {self.rate.eta(ev.overall_done, ev.overall_total)}")
+        if ev.kind == "case_warning":
+            b.console.print(f"[yellow]warning:[/] {escape(printable(f'{ev.name}: {ev.message}'))}", highlight=False,
+                            soft_wrap=True)
         if ev.kind in ("case_start", "case_progress") and ev.case not in self.cases:
             self.cases[ev.case] = b.add_task(f"  {escape(ev.name)}", total=max(ev.total, 1),
                                              count=self._count(ev.done, ev.total), eta="")
@@ -347,6 +354,7 @@ def summary_notes(report: Any) -> list[str]:
 
 @app.command()
 @handle_errors
+@sigterm_as_interrupt()  # SIGTERM stops the batch like Ctrl-C: summary, results kept, exit 130
 def batch(
     cases: Annotated[list[Path], typer.Argument(help="Case files (TOML); shell globs like cases/paper/*.toml.",
                                                 show_default=False, parser=path_value)],
@@ -435,7 +443,12 @@ def batch(
         _write_excel(docs, excel, force, template, fields)
         console.print(f"wrote {excel}")
     if report.failed:
-        error_line(f"{len(report.failed)} case(s) failed: " + ", ".join(o.name for o in report.failed))
+        from ..batch.executors import SCHEDULER_LOST
+
+        lost = sum(o.error_kind == SCHEDULER_LOST for o in report.failed)
+        hint = (f"; the connection to the Dask scheduler at {scheduler} was lost ({lost} of them): start it again "
+                f"and run the same command with --resume (finished cases are saved in {out_dir})") if lost else ""
+        error_line(f"{len(report.failed)} case(s) failed: " + ", ".join(o.name for o in report.failed) + hint)
     raise typer.Exit(report.exit_code)
 
 
@@ -502,20 +515,24 @@ def dynamic_table(report: Any) -> Table:
 
 def _scan_each_model(case_file: Path, case: Any, grid: Any, names: tuple[str | None, ...], *, hold: str,
                      csv_out: Path | None, dynamic: bool, json_dir: Path | None, jobs: int | None,
-                     scheduler: str | None, connect_timeout: float = 10.0, dynamic_realizations: int = 3) -> None:
+                     scheduler: str | None, connect_timeout: float = 10.0, dynamic_realizations: int = 3,
+                     progress_interval: float = 5.0) -> None:
     """The scan under each downburst model of ``names`` (None: the case's own model; ``scan
-    --models`` gives several), then the critical position per model."""
+    --models`` gives several), then the critical position per model.  The resource guard's
+    warning (a long scan, memory) is printed once, before the first model's scan."""
     from ..batch import make_executor, run_critical, run_scan, write_scan_csv
-    from .progress import progress_bar
+    from .limits import warn as limits_warn
 
     cancel = threading.Event()
     with make_executor(jobs, scheduler, connect_timeout) as executor:
         summary = []
-        for model in names:
+        for k, model in enumerate(names):
+            what = "scan" + (f" [{model}]" if model else "") + (" --dynamic" if dynamic else "")
             try:
-                with progress_bar() as cb:
+                with ScanDisplay(f"{what} on {executor.describe()}", interval=progress_interval) as cb:
                     result = run_scan(case_file, grid, executor=executor, hold=hold, progress=cb, cancel=cancel,
-                                      model=model, dynamic_realizations=dynamic_realizations if dynamic else 0)
+                                      model=model, dynamic_realizations=dynamic_realizations if dynamic else 0,
+                                      warn=limits_warn if k == 0 else None)
             except KeyboardInterrupt:
                 cancel.set()
                 raise
@@ -554,6 +571,7 @@ def _scan_each_model(case_file: Path, case: Any, grid: Any, names: tuple[str | N
 
 @app.command()
 @handle_errors
+@sigterm_as_interrupt()  # SIGTERM stops the scan like Ctrl-C
 def scan(
     case_file: CaseArg,
     distance: Annotated[str | None, typer.Option(
@@ -586,6 +604,10 @@ def scan(
     models: Annotated[str | None, typer.Option(
         "--models", help='Scan under "all" built-in downburst running-mean models (or a comma list) and report '
                          "the critical position per model.", show_default=False)] = None,
+    progress_interval: Annotated[float, typer.Option(
+        "--progress-interval", help="Output not a terminal (CI, logs): print a progress line at most every this "
+                                    "many seconds, when more positions are done (0: at every report).",
+        min=0.0)] = 5.0,
 ) -> None:
     """Find the critical downburst configurations: step 1 over a grid of positions and sizes."""
     apply_max_memory(max_memory)  # each step-1 task checks its memory estimate
@@ -604,4 +626,4 @@ def scan(
         check_target(csv_out, what="CSV")
     _scan_each_model(case_file, case, grid, names, hold=hold, csv_out=csv_out, dynamic=dynamic, json_dir=json_dir,
                      jobs=jobs, scheduler=scheduler, connect_timeout=connect_timeout,
-                     dynamic_realizations=dynamic_realizations)
+                     dynamic_realizations=dynamic_realizations, progress_interval=progress_interval)

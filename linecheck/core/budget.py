@@ -52,6 +52,11 @@ T_STATE = 5e-5  # per mean state x DOF (Newton iterations of step 1)
 T_DENSE = 1.5e-9  # per DOF^3 (dense eigensolvers of the condensed model)
 T_SPECTRAL = 2e-9  # per frequency-grid point x node^2 (random-vibration quadrature)
 SPECTRAL_POINTS = 2000  # frequency-grid points of the spectral check (order of magnitude)
+# --- time of one downburst scan position [s] (a warm worker: step 1 without the job's set-up, and the
+# tower of interest's steps 2-3; six-span and single-span paper lines, 2-core x86-64, with and
+# without the compiled kernel: 1.9e-6 and 0.6e-6 per state x DOF, 1.6e-7 and 2.3e-7 per r x step x node)
+T_SCAN_STATE = 2e-6  # per mean state x DOF of a position's step 1
+T_SCAN_REALIZATION = 2e-7  # per realization x step x node of a position's steps 2-3 (--dynamic)
 WINDOW_SPANS = 20  # lines longer than this: burn-in and check on windows of about this many spans
 
 
@@ -68,12 +73,17 @@ class Estimate:
     realizations: int
     mean_states: int
     dominant: str  # what drives the memory
+    points: int = 0  # scan: grid positions (the memory is one position's, held by each worker)
+    workers: int = 1  # scan: tasks at once (the time is the wall time on that many)
 
     def text(self) -> str:
         sizes = [f"{self.n_dof} DOF", f"{self.mean_states} mean state(s)"]
         if self.n_steps:
             sizes[1:1] = [f"{self.realizations} realization(s)"] if self.job == "run" else []
             sizes.insert(0, f"{self.n_steps} steps")
+        if self.points:
+            per = f" x {self.realizations} realization(s)" if self.realizations else ""
+            sizes.insert(0, f"{self.points} positions{per} on {self.workers} worker(s)")
         return (f"{self.job} needs about {fmt_bytes(self.memory)} of memory and {fmt_seconds(self.seconds)} "
                 f"({self.dominant}; {', '.join(sizes)})")
 
@@ -220,6 +230,24 @@ def estimate(case: Case, job: str = "run", *, realizations: int | None = None, b
     memory = sum(parts.values())
     dominant = max(parts, key=parts.get)
     return Estimate(job, memory, secs, n_steps, n_nodes, n_dof, n_real, n_k, dominant)
+
+
+def estimate_scan(case: Case, points: int, *, dynamic_realizations: int = 0, workers: int = 1) -> Estimate:
+    """Estimate of a downburst scan (``linecheck scan``): step 1 at each of ``points`` positions
+    and, with ``dynamic_realizations`` = k > 0 (``--dynamic``), steps 2-3 of realizations 0..k-1
+    at the tower of interest.  memory: one position's job (each worker holds one at a time);
+    seconds: the wall time with ``workers`` tasks at once, from the per-position costs
+    :data:`T_SCAN_STATE` and :data:`T_SCAN_REALIZATION` (a scan's positions run warm: no set-up)."""
+    a = case.analysis
+    n_nodes, n_dof, _ = _sizes(case)
+    k = max(0, int(dynamic_realizations))
+    one = estimate(case, "run", realizations=k, spectral_check=False) if k else estimate(case, "static")
+    n_k = 1 if case.wind.type == "synoptic" else a.mean_states
+    per_point = n_k * T_SCAN_STATE * n_dof + k * float(one.n_steps) * T_SCAN_REALIZATION * n_nodes
+    w = max(1, int(workers))
+    seconds = T_FIXED + int(points) * per_point / min(w, max(1, int(points)))
+    return Estimate("scan", one.memory, seconds, one.n_steps, n_nodes, n_dof, k, one.mean_states, one.dominant,
+                    points=int(points), workers=w)
 
 
 def memo_bytes(n_real: int, n_steps: int, n_nodes: int) -> float:

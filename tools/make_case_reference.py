@@ -54,10 +54,11 @@ arrays), 1 GB for a saved JSON result read back by `export` or `batch --resume`.
 at point p and estimates the run's memory and time, so errors that used to appear only at
 `run` appear at `check`.
 
-Resource guard: before any work, `run`, `batch` (per task), `scan`, `static`, `modes`,
-`spectral`, `wind` and `check` estimate the job's peak memory and time from the number of
-steps (`duration`/`time_step`), nodes (`spans` × `elements_per_span`), `realizations` and
-`mean_states`. Above the memory limit the job is refused (exit 2) with the estimate:
+Resource guard: before any work, `run`, `batch` (every case before the batch starts, then each
+task), `scan` (the whole grid), `static`, `modes`, `spectral`, `wind` and `check` estimate the
+job's peak memory and time from the number of steps (`duration`/`time_step`), nodes (`spans` ×
+`elements_per_span`), `realizations` and `mean_states` (and a scan's positions). Above the
+memory limit the job is refused (exit 2; in a batch that case fails alone) with the estimate:
 
 ```
 error: c.toml: run needs about 4.22 PB of memory and 3.82 years (time histories; 12001 steps,

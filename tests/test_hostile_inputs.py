@@ -222,3 +222,33 @@ def test_a_byte_order_mark_in_a_saved_result_is_read_back(tmp_path):
     p = tmp_path / "r.json"
     p.write_bytes(b"\xef\xbb\xbf" + json.dumps({"a": 1}).encode())
     assert json.loads(read_text_file(p, "a JSON result", MAX_RESULT_BYTES)) == {"a": 1}
+
+
+# --------------------------------------------------------------------------- 4, 15. the field file too
+FIELD_CASE = CASES / "examples" / "downburst-user-field.toml"
+FIELD_CSV = CASES / "fields" / "example-field.csv"
+
+
+def field_case(tmp_path: Path, csv_text: str) -> Path:
+    toml = FIELD_CASE.read_text(encoding="utf-8").replace('field = "../fields/example-field.csv"', 'field = "f.csv"')
+    assert 'field = "f.csv"' in toml
+    (tmp_path / "f.csv").write_text(csv_text, encoding="utf-8")
+    path = tmp_path / "user-field.toml"
+    path.write_text(toml, encoding="utf-8")
+    return path
+
+
+def test_a_field_file_that_is_not_a_field_table_is_refused_without_its_content(tmp_path):
+    line = one_error_line(cli("check", str(field_case(tmp_path, SHADOW))))
+    assert f"{tmp_path / 'f.csv'}:1: not a field table: expected a comma-separated (CSV) file" in line
+    assert "root:" not in line and "daemon" not in line and "20228" not in line
+    # a field table's own unknown column is still named, a long bad value described by its length
+    line = one_error_line(cli("check", str(field_case(tmp_path, "r_over_dj,z,t,v_radial\n0,0,0,1\n"))))
+    assert 'header column 2 "z" is not allowed' in line
+    line = one_error_line(cli("check", str(field_case(tmp_path, "r_over_dj,z_over_dj,t,v_radial\n0,0,0," + "q" * 80))))
+    assert "value of 80 characters is not a number" in line and "qqq" not in line
+
+
+def test_a_byte_order_mark_is_accepted_in_a_field_csv(tmp_path):
+    r = cli("check", str(field_case(tmp_path, "\ufeff" + FIELD_CSV.read_text(encoding="utf-8"))))
+    assert r.exit_code == 0, r.output

@@ -657,18 +657,24 @@ def _not_a_tower_table(path: Path) -> CaseError:
                      file=str(path))
 
 
-def _reads_as_tower_header(header: list[str]) -> bool:
-    """A header row that makes the file a tower table: at least two cells, each a short printable
-    token (:data:`_COLUMN_TOKEN`), at least one of them a tower column or close to one."""
+def reads_as_header(header: list[str], columns: tuple[str, ...]) -> bool:
+    """Whether a CSV file's first row makes it a table of ``columns`` (a tower table, a field
+    file), so that its column names may be quoted in messages: at least two cells, each a short
+    printable token (:data:`_COLUMN_TOKEN`), at least one of them one of ``columns`` or close to one."""
     if len(header) < 2 or not all(_COLUMN_TOKEN.fullmatch(h) for h in header):
         return False
-    lower = [c.lower() for c in TOWER_COLUMNS]
+    lower = [c.lower() for c in columns]
     return any(h.lower() in lower or difflib.get_close_matches(h.lower(), lower, n=1, cutoff=0.6) for h in header)
 
 
-def _cell_text(cell: str) -> str:
-    """A data cell as a message quotes it: short cells quoted, longer ones by their length."""
-    return _fmt(cell) if len(cell) <= MAX_QUOTED_CELL else f"of {len(cell)} characters"
+def _reads_as_tower_header(header: list[str]) -> bool:
+    return reads_as_header(header, TOWER_COLUMNS)
+
+
+def cell_text(cell: str) -> str:
+    """A CSV data cell as a message quotes it: a short printable cell quoted (``"abc"``), anything
+    longer or holding a control character described by its length (``of 60 characters``)."""
+    return _fmt(cell) if len(cell) <= MAX_QUOTED_CELL and not _CONTROL.search(cell) else f"of {len(cell)} characters"
 
 
 def _read_towers_csv(path: Path) -> list[tuple[dict[str, Any], int]]:
@@ -728,7 +734,7 @@ def _read_towers_csv(path: Path) -> list[tuple[dict[str, Any], int]]:
                 try:
                     d[col] = float(cell)
                 except ValueError:
-                    raise CaseError(f"value {_cell_text(cell)} is not a number: expected {specs[col].allowed()}",
+                    raise CaseError(f"value {cell_text(cell)} is not a number: expected {specs[col].allowed()}",
                                     file=str(path), key=f"row {row_no}, column {col}") from None
             else:
                 d[col] = cell

@@ -47,7 +47,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..case import Case, Downburst, read_regular_file
+from ..case import Case, Downburst, cell_text, read_regular_file, reads_as_header
 from ..errors import CaseError
 from ..system import LineSystem
 from . import ring as ring_model
@@ -291,7 +291,7 @@ MAX_FIELD_BYTES = 200 * 2**20  # [bytes] size cap of a field file (docs/wind.md,
 def _read_csv(path: Path) -> FieldTable:
     raw = read_regular_file(path, "a CSV running-mean field file", MAX_FIELD_BYTES)  # bounded read (issue 14)
     try:
-        text = raw.decode("utf-8")
+        text = raw.decode("utf-8-sig")  # a leading byte-order mark (spreadsheets write one) is dropped
     except UnicodeDecodeError:
         raise _field_error(path, "not a UTF-8 text file: expected a CSV running-mean field (see docs/wind.md)") from None
     header: list[str] | None = None
@@ -305,6 +305,9 @@ def _read_csv(path: Path) -> FieldTable:
         fields = [f.strip() for f in next(csv.reader([s]))]
         if header is None:
             header, header_line = fields, lineno
+            if not reads_as_header(fields, FIELD_COLUMNS):  # not quoted: any file may be named here
+                raise _field_error(path, f"not a field table: expected a comma-separated (CSV) file whose first "
+                                   f"row names its columns, {_ALLOWED_TEXT} (see docs/wind.md)", line=lineno)
             for k, name in enumerate(fields, start=1):
                 if name not in FIELD_COLUMNS:
                     raise _field_error(path, f'header column {k} "{name}" is not allowed: expected {_ALLOWED_TEXT}',
@@ -324,8 +327,8 @@ def _read_csv(path: Path) -> FieldTable:
             try:
                 v = float(value)
             except ValueError:
-                raise _field_error(path, f'column "{name}": value "{value}" is not a number: expected a finite number',
-                                   line=lineno) from None
+                raise _field_error(path, f'column "{name}": value {cell_text(value)} is not a number: expected a '
+                                   "finite number", line=lineno) from None
             if not math.isfinite(v):
                 raise _field_error(path, f'column "{name}": value "{value}" is not allowed: expected a finite number',
                                    line=lineno)

@@ -252,3 +252,18 @@ def test_a_field_file_that_is_not_a_field_table_is_refused_without_its_content(t
 def test_a_byte_order_mark_is_accepted_in_a_field_csv(tmp_path):
     r = cli("check", str(field_case(tmp_path, "\ufeff" + FIELD_CSV.read_text(encoding="utf-8"))))
     assert r.exit_code == 0, r.output
+
+
+# --------------------------------------------------------------------------- 18. TOML dates in messages
+@pytest.mark.parametrize("value, shown", [("1979-05-27T07:32:00Z", "1979-05-27T07:32:00+00:00"),
+                                          ("1979-05-27", "1979-05-27"), ("07:32:00", "07:32:00")])
+def test_a_toml_date_or_time_is_shown_as_toml_text(tmp_path, value, shown):
+    """A date where a number belongs is named in its TOML spelling (RFC 3339), not as a Python
+    repr such as datetime.datetime(1979, 5, 27, ...)."""
+    text = (CASES / "paper" / "case09-single.toml").read_text().replace("realizations = 10", f"realizations = {value}")
+    path = tmp_path / "dated.toml"
+    path.write_text(text)
+    with pytest.raises(CaseError) as err:
+        load_case(path)
+    msg = str(err.value)
+    assert f"analysis.realizations: value {shown} is not allowed" in msg and "datetime" not in msg

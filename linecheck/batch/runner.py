@@ -203,11 +203,11 @@ def saved_result(json_path: Path, digest: str, changes: Mapping[str, Any] | None
     """The saved document at ``json_path``, typed, if it carries ``digest`` as its case hash
     (and the same key ``changes``, for runs that alter the file's case); None when it is
     missing, damaged, of another schema version or of another case (it is then run again)."""
-    from ..core.case import MAX_RESULT_BYTES, read_text_file
+    from ..io.document import read_result_file
 
-    try:  # only a regular file of bounded size (a FIFO or /dev/zero there must not hang; issue 14)
-        doc = json.loads(read_text_file(json_path, "a saved JSON result", MAX_RESULT_BYTES))
-    except (CaseError, ValueError):
+    try:  # a regular file of bounded size (a FIFO there must not hang), parsable JSON (not 100,000
+        doc = read_result_file(json_path)  # nested brackets, not a 5,001-digit integer): else run it again
+    except CaseError:
         return None
     try:  # saved by an older linecheck, or damaged: run it again
         typed = RunDocument.from_json(doc, source=str(json_path))

@@ -12,6 +12,7 @@ the dataclasses (converted where used).
 from __future__ import annotations
 
 import dataclasses
+import datetime
 import difflib
 import hashlib
 import math
@@ -413,6 +414,8 @@ def _fmt(value: Any) -> str:
         return "[" + ", ".join(_fmt(v) for v in value) + "]"
     if isinstance(value, dict):
         return "a table"
+    if isinstance(value, (datetime.date, datetime.time)):  # a TOML date/time: its TOML text
+        return value.isoformat()
     return repr(value)
 
 

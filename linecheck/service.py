@@ -1560,7 +1560,7 @@ def model_changes(case: Case, model: str) -> dict:
     changes: dict = {"wind.downburst.model": model}
     if model != "table":
         changes["wind.downburst.field"] = None
-    if model != "ring-jet":
+    if model not in ("ring-jet", "ring-jet-inviscid"):  # the ring models read jet_velocity
         changes["wind.downburst.jet_velocity"] = None
     if model != "holmes-oliver":
         changes["wind.downburst.t1"] = None

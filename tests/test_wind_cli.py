@@ -83,3 +83,27 @@ def test_wind_errors_are_one_line_with_exit_2(tmp_path):
     assert res.exit_code == 2
     assert 'bad.csv:1: header column 4 "speed" is not allowed' in " ".join(res.output.split())
     assert not (tmp_path / "o.csv").exists()
+
+
+def test_wind_json_reports_the_line_peak_beside_v_ref(tmp_path):
+    """The downburst block carries the field's largest running mean on the line over the event
+    (where and when) beside V_ref at p: for case 5 (Db_y, the storm centred on p's normal) that is
+    V_ref itself, at p (x = 900 m), at the running mean's peak (t1 = 120 s); the console says so."""
+    out = tmp_path / "w.json"
+    res = runner.invoke(app, ["wind", str(CASES / "paper" / "case05-six.toml"), "--json", str(out)])
+    assert res.exit_code == 0, res.output
+    lp = json.loads(out.read_text())["downburst"]["line_peak"]
+    assert lp["speed"] == pytest.approx(40.0, rel=1e-9) and lp["over_v_ref"] == pytest.approx(1.0, rel=1e-9)
+    assert lp["station"] == pytest.approx(900.0) and lp["time"] == pytest.approx(120.0, abs=0.05)
+    assert "largest running mean on the line" in res.output
+
+
+def test_a_model_spread_keeps_the_jet_velocity_of_both_ring_models():
+    """Switching a case to either ring model keeps its jet_velocity (both read it); the other
+    models drop it."""
+    from linecheck import service
+    from linecheck.core.case import load_case
+
+    case = load_case(CASES / "examples" / "downburst-ring-jet.toml")
+    assert "wind.downburst.jet_velocity" not in service.model_changes(case, "ring-jet-inviscid")
+    assert service.model_changes(case, "holmes-oliver")["wind.downburst.jet_velocity"] is None

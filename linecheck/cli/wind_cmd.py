@@ -114,6 +114,10 @@ def series_summary(case: Case, s: PointSeries) -> dict[str, Any]:
             "model": db.model_name,
             "jet_velocity": _f(fld.ring.jet_velocity) if fld.ring is not None else None,
         }
+        from ..core.wind.line_peak import line_peak
+
+        # the field's largest running mean anywhere on the line over the event, beside V_ref at p
+        doc["downburst"]["line_peak"] = line_peak(case).to_dict()
     return doc
 
 
@@ -157,6 +161,9 @@ def wind(
     ]
     if case.wind.type == "downburst":
         rows.insert(1, ("V_max scale (m/s)", f"{s.v_max:.2f}"))
+        lp = doc["downburst"]["line_peak"]
+        rows.insert(2, ("largest running mean on the line (m/s)",
+                        f"{lp['speed']:.2f} = {lp['over_v_ref']:.3f} V_ref at {lp['station']:.0f} m, t = {lp['time']:.1f} s"))
     for q, v in rows:
         table.add_row(q, v)
     console.print(table)

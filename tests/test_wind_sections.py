@@ -361,7 +361,10 @@ def test_equal_span_wind_is_unchanged_by_sections(name):
     for key, value in got.items():
         ref = gold[f"{k}/{key}"]
         assert value.shape == ref.shape, key
-        assert_close(value, ref, RTOL_OP, key)
+        # the ring-jet's path comes from an adaptive integrator (rtol 1e-13) whose step choice follows
+        # the last bits of its BLAS combinations: two CPUs' paths differ by ~1e-12 (measured 1.15e-12
+        # SkylakeX vs Haswell), so 1e-10 there (still 10x inside the golden results' 1e-9)
+        assert_close(value, ref, 1e-10 if "ring-jet" in name else RTOL_OP, key)
 
 
 def test_equal_span_downburst_with_a_reference_height_scales_there_and_loads_at_the_conductor():

@@ -76,3 +76,14 @@ def pytest_terminal_summary(terminalreporter):
     n = _SCHEMA_STATS["validated"]
     if n:
         terminalreporter.write_line(f"result documents validated against docs/results.schema.json: {n}")
+
+
+def one_error_line(result) -> str:
+    """The single line of a refused command (CliRunner result): exit 2, no traceback, exactly one
+    non-empty line, starting with ``error: ``; returns it."""
+    assert result.exit_code == 2, result.output
+    assert "Traceback" not in result.output
+    lines = [ln for ln in result.output.splitlines() if ln.strip()]
+    assert len(lines) == 1, lines
+    assert lines[0].startswith("error: ")
+    return lines[0]

@@ -25,7 +25,7 @@ from linecheck.core import case as case_module
 from linecheck.core.case import case_hash, load_case
 from linecheck.core.errors import CaseError
 
-from .conftest import CASES
+from .conftest import CASES, one_error_line
 
 EXAMPLE = CASES / "examples" / "section-12span.toml"
 CSV = CASES / "examples" / "section-12span.csv"
@@ -46,14 +46,6 @@ def section(tmp_path: Path, csv_text: str, *, csv_name: str = "towers.csv", bom:
     path.write_text(("\ufeff" if bom else "") + toml, encoding="utf-8")
     return path
 
-
-def one_error_line(result) -> str:
-    assert result.exit_code == 2, result.output
-    assert "Traceback" not in result.output
-    lines = [ln for ln in result.output.splitlines() if ln.strip()]
-    assert len(lines) == 1, lines
-    assert lines[0].startswith("error: ")
-    return lines[0]
 
 
 def with_first_name(name_cell: str) -> str:

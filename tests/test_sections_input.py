@@ -15,7 +15,7 @@ from typer.testing import CliRunner
 
 from linecheck.cli.app import app
 
-from .conftest import CASES
+from .conftest import CASES, one_error_line
 
 EXAMPLE = CASES / "examples" / "section-12span.toml"
 CSV = CASES / "examples" / "section-12span.csv"
@@ -44,15 +44,6 @@ def _csv_with(old: str, new: str) -> str:
     return text.replace(old, new)
 
 
-def _one_error_line(result) -> str:
-    """The single error line of a failed ``check`` (exit 2, no traceback)."""
-    assert result.exit_code == 2, result.output
-    assert "Traceback" not in result.output
-    lines = [ln for ln in result.output.splitlines() if ln.strip()]
-    assert len(lines) == 1, lines
-    assert lines[0].startswith("error: ")
-    return lines[0]
-
 
 # CSV row numbers count the file's lines (the comment line is row 1, the header row 2, T1 row 3).
 CSV_CASES = [
@@ -74,7 +65,7 @@ CSV_CASES = [
 @pytest.mark.parametrize(("old", "new", "where", "value", "allowed"), CSV_CASES)
 def test_bad_csv_row_names_file_row_value_and_what_is_allowed(tmp_path, old, new, where, value, allowed):
     path = _section(tmp_path, _csv_with(old, new))
-    line = _one_error_line(cli("check", str(path)))
+    line = one_error_line(cli("check", str(path)))
     assert f"{tmp_path / CSV.name}: {where}: " in line
     assert value in line and allowed in line
 
@@ -85,7 +76,7 @@ def test_csv_missing_column(tmp_path):
     text = "\n".join(ln if ln.startswith("#") else ",".join(ln.split(",")[:3] + ln.split(",")[4:])
                      for ln in lines) + "\n"
     assert "height" not in text.splitlines()[1]
-    line = _one_error_line(cli("check", str(_section(tmp_path, text))))
+    line = one_error_line(cli("check", str(_section(tmp_path, text))))
     assert f"{tmp_path / CSV.name}: row 2: " in line
     assert 'missing column "height"' in line and "required: station, height, support" in line
 
@@ -94,7 +85,7 @@ def test_tension_too_low_for_a_span(tmp_path):
     # span 1 (T1-T2) is 310 m: its parabolic sag W L^2 / 8 H0 reaches L/4 below H0 = W L / 2
     # = 17.92 * 310 / 2 = 2777.6 N (Irvine 1981 Eq. 2.8); 2500 N is below that.
     path = _section(tmp_path, toml_edit=("tension = 22000.0", "tension = 2500.0"))
-    line = _one_error_line(cli("check", str(path)))
+    line = one_error_line(cli("check", str(path)))
     assert re.search(rf"{re.escape(str(path))}:\d+: line\.tension: value 2500\.0 is too low for span 1 \(T1-T2, 310 m\)",
                      line), line
     assert "expected tension > W L/2 = 2777.6 N" in line
@@ -104,7 +95,7 @@ def test_tension_letting_a_span_reach_the_ground(tmp_path):
     # above W L / 2 but the 310 m span sags 17.92 * 310^2 / (8 * 6000) = 35.9 m below a chord
     # whose lower end is 27 m above ground: the clearance check names the span and the tension.
     path = _section(tmp_path, toml_edit=("tension = 22000.0", "tension = 6000.0"))
-    line = _one_error_line(cli("check", str(path)))
+    line = one_error_line(cli("check", str(path)))
     assert "line.tension: value 6000.0 lets span 1 (T1-T2) reach the ground" in line
     assert "expected a higher tension or taller towers" in line
 
@@ -112,7 +103,7 @@ def test_tension_letting_a_span_reach_the_ground(tmp_path):
 def test_towers_file_and_inline_towers_together(tmp_path):
     inline = '\n[[line.towers]]\nstation = 0.0\nheight = 30.0\nsupport = "strain"\n'
     path = _section(tmp_path, toml_edit=("elements_per_span = 10\n", "elements_per_span = 10\n" + inline))
-    line = _one_error_line(cli("check", str(path)))
+    line = one_error_line(cli("check", str(path)))
     assert re.search(rf"{re.escape(str(path))}:\d+: line\.towers_file: value \"section-12span\.csv\" is not "
                      r"allowed together with \[\[line\.towers\]\]", line), line
     assert "not both" in line
@@ -155,7 +146,7 @@ v_ref = 30.0
 def test_inline_towers_name_the_table_key_and_file_line(tmp_path, angle, station, key, value, allowed):
     path = tmp_path / "inline.toml"
     path.write_text(INLINE.format(angle=angle, station=station), encoding="utf-8")
-    line = _one_error_line(cli("check", str(path)))
+    line = one_error_line(cli("check", str(path)))
     text = path.read_text(encoding="utf-8").splitlines()
     m = re.match(rf"error: {re.escape(str(path))}:(\d+): {re.escape(key)}: ", line)
     assert m, line

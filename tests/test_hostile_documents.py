@@ -9,7 +9,6 @@ import copy
 import dataclasses
 import json
 import re
-import shutil
 import warnings
 import zipfile
 import xml.etree.ElementTree as ET
@@ -22,7 +21,7 @@ from typer.testing import CliRunner
 
 from linecheck import service
 from linecheck.cli.app import app
-from linecheck.core.case import case_to_toml, load_case
+from linecheck.core.case import load_case
 from linecheck.core.errors import CaseError
 from linecheck.core.wind.mean import load_field_table
 from linecheck.excel.cells import clean_text, sheet_name

@@ -12,7 +12,6 @@ from scipy.linalg import lapack, solve
 from linecheck import service
 from linecheck.core.case import load_case
 from linecheck.core.model import build_model
-from linecheck.core import second_order
 from linecheck.core.second_order import second_order_of_loads, second_order_operator, second_order_reactions
 from linecheck.core.static import solve_static, span_loads_uniform
 from linecheck.core.system import LineSystem

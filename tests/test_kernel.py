@@ -31,6 +31,14 @@ pytestmark = pytest.mark.numerics
 needs_kernel = pytest.mark.skipif(not kernel.installed(), reason="Numba (linecheck[fast]) not installed")
 
 
+@pytest.fixture(autouse=True)
+def _kernel_asked_for(monkeypatch):
+    """Every test here starts with the kernel asked for (also when the suite runs under
+    LINECHECK_KERNEL=numpy), so a test comparing the two forms never compares numpy with itself;
+    a test that wants the numpy form sets it."""
+    monkeypatch.setenv("LINECHECK_KERNEL", "numba")
+
+
 def _short(path, **analysis):
     case = load_case(path)
     return dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, **analysis))

@@ -198,9 +198,10 @@ def use(piece: str) -> bool:
     """Whether ``piece`` runs compiled in this process (loads the kernel on the first call).  The
     answer depends only on the installation, ``LINECHECK_KERNEL`` and the piece's load check, so
     every run of a case on one machine takes the same path."""
-    if mode() == "numpy":
+    if os.environ.get("LINECHECK_KERNEL") is not None and mode() == "numpy":  # asked per call: cheap
         return False
-    _ensure()
+    if not _pieces:
+        _ensure()
     return _pieces[piece].on
 
 

@@ -1442,7 +1442,8 @@ def design_peaks(run: RunResult, component: int) -> np.ndarray:
 
 
 def code_loads(case: Case, *, strict: bool = True) -> list:
-    """Each code's :class:`~linecheck.core.codes.CodeLoad` for ``case`` (at ``v_ref``).
+    """Each code's :class:`~linecheck.core.codes.CodeLoad` for ``case``: at the case's mean speed at
+    the conductor height ``line.height``, v_ref (z/z_ref)^alpha (the case's own profile).
 
     ``strict``: a value outside a code's validity raises :class:`CaseError`; otherwise the
     code is reported with no load and the message in its note.
@@ -1458,7 +1459,12 @@ def code_loads(case: Case, *, strict: bool = True) -> list:
     # Eq. 17's L_x at the tower of interest (docs/codes.md "Sections")
     system = LineSystem(line)
     span = system.common_span_length if system.equal_spans else system.span_lengths_at_tower(line.tower_of_interest - 1)
-    args = (wind.v_ref, line.height, span, line.diameter, line.drag_coefficient)
+    # the case's 10-minute mean at the codes' height h: v_ref carried from its reference height by
+    # the case's own power law (wind.profile_exponent), as steps 1-3 load the wire
+    from .core.wind.mean import profile_factor
+
+    v_h = float(wind.v_ref * profile_factor(case, np.array(line.height)))
+    args = (v_h, line.height, span, line.diameter, line.drag_coefficient)
     calls = {
         "ASCE74": lambda: C.asce74_wire_load(*args, cc.asce74_exposure or C.TERRAIN_MAP["ASCE74"][cc.terrain],
                                              source=src),

@@ -6,8 +6,9 @@ span (half the sum of the adjacent spans) to give the load on a tower's transver
 No code defines a longitudinal conductor wind load for a straight line, so only ``Ry`` is
 compared.
 
-Reference wind.  A linecheck case gives ``v_ref``, the 10-minute mean speed at conductor
-height h (the paper's synoptic records are 600 s long).  Each code defines its design wind on
+Reference wind.  The callers pass ``v_ref`` as the case's 10-minute mean speed at conductor
+height h (the case's v_ref carried to h by its own profile; the paper's synoptic records are
+600 s long).  Each code defines its design wind on
 its own basis (3-s gust at 10 m in exposure C; 10-min mean at 10 m in terrain B or II;
 0.2/3-s gust at height).  Each function converts ``v_ref`` to its code's basis by inverting
 the code's *own* profile and gust model at height h, so that the code, applied forward,

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .analysis.guard import check_budget, check_case  # noqa: F401 - the front ends' entry points
+from .analysis.guard import check_budget, check_case, warn_case  # noqa: F401 - the front ends' entry points
 from .core import budget, kernel
 from .core.case import Case
 from .core.damping import (aerodynamic_damping, aerodynamic_damping_stack, stiffness_proportional,
@@ -98,7 +98,9 @@ def static_analysis(
 ) -> StaticResult:
     """Step 1 of the method: non-linear static analysis under the running-mean wind.
 
-    ``warn(message)`` receives resource warnings (:func:`check_budget`)."""
+    ``warn(message)`` receives the case's warnings (:func:`warn_case`) and resource warnings
+    (:func:`check_budget`)."""
+    warn_case(case, warn)
     check_budget(case, "static", warn=warn)
     return _static_analysis(case, progress=progress, cancel=cancel)
 
@@ -1021,6 +1023,7 @@ def modes_analysis(case: Case, *, n_modes: int = 20, warn: Warn | None = None) -
     """Natural frequencies and mode shapes of the still-air and the mean state."""
     from .core.modes import natural_modes
 
+    warn_case(case, warn)
     check_budget(case, "modes", warn=warn)
     st = _static_analysis(case)
     system, mean = st.system, st.mean

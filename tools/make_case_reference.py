@@ -79,6 +79,17 @@ estimate is rough (within about a factor of 2 on the paper
 cases, see docs/performance.md); command-line overrides (`-n`, `--seed`) are checked against
 the same ranges as the file and the message names the option.
 
+A value inside its range can still be mistyped: `check`, `static`, `modes` and `run` warn in one
+line (and run) when `line.weight` over g·πD²/4 — the wire's bulk density — is outside
+1,500–9,000 kg/m³ (the paper's conductor: 4,805; a weight typed in kg/m gives about 490). The
+line names the file, key, value and density, and the weight in N/m a kg/m value would be:
+
+```
+warning: c.toml:8: line.weight: value 1.827 N/m with diameter 0.022 m gives a bulk density
+W/(g pi D^2/4) of 490 kg/m3, outside 1,500-9,000 (the paper's conductor: 4,805): a weight in
+kg/m? In N/m it would be 1.827 x 9.81 = 17.92 N/m
+```
+
 Example (paper case 9, single span):
 
 ```toml

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from ..core import budget
-from ..core.case import Case
+from ..core.case import Case, case_warnings
 from ..core.errors import CaseError
 
 Warn = Callable[[str], None]
@@ -24,10 +24,21 @@ def check_budget(case: Case, job: str = "run", *, warn: Warn | None = None, **kw
     return budget.guard(case, job, warn, **kwargs)
 
 
+def warn_case(case: Case, warn: Warn | None) -> None:
+    """Hand each of :func:`~linecheck.core.case.case_warnings` (values the schema allows but
+    that are probably mistyped, e.g. a weight in kg/m) to ``warn(message)``.  A job calls it once,
+    before its work."""
+    if warn is not None:
+        for message in case_warnings(case):
+            warn(message)
+
+
 def check_case(case: Case, *, warn: Warn | None = None) -> budget.Estimate:
     """Checks of ``linecheck check`` beyond the schema: the field file is read and validated,
     the downburst is scaled to V_ref at p, the record has enough steps, and the run fits the
-    resource limits.  Raises :class:`~linecheck.core.errors.CaseError`."""
+    resource limits; :func:`warn_case`'s warnings go to ``warn``.  Raises
+    :class:`~linecheck.core.errors.CaseError`."""
+    warn_case(case, warn)
     if case.wind.type == "downburst":
         from ..core.wind.mean import downburst_field, load_field_table
 

@@ -212,6 +212,7 @@ def run(
 
         check_excel_target(excel, force=force, template=template)
     names = service.parse_models(case, models) if models is not None else ()
+    service.warn_case(case, limits_warn)  # values probably mistyped (a weight in kg/m): once, before the work
     kernel_off = kernel_warning()  # compiled pieces off (Numba installed): one line, before the work
     if kernel_off:
         limits_warn(kernel_off)

@@ -365,6 +365,43 @@ GRAVITY = 9.81  # [m/s2], paper Eq. 8
 _SUBTABLES = {"": ("line", "wind", "analysis", "codes"), "wind": ("downburst",)}
 
 
+#: Bulk density of a conductor, W / (g pi D^2 / 4) [kg/m3], outside which ``line.weight`` is
+#: probably mistyped: aluminium 2,700 to copper 8,900 with strands' voids (the paper's
+#: conductor: 4,805); a weight typed in kg/m gives about 1/9.81 of it (490 for the paper's).
+DENSITY_RANGE = (1500.0, 9000.0)
+
+
+def case_warnings(case: Case) -> list[str]:
+    """One-line warnings about values the schema allows but that are probably mistyped: the
+    weight against the conductor's bulk density (:data:`DENSITY_RANGE`).  Names the file (and
+    line when the file is readable), key, value and what is expected.  Never prints."""
+    out: list[str] = []
+    ln = case.line
+    density = ln.weight / (GRAVITY * math.pi * ln.diameter**2 / 4.0)
+    low, high = DENSITY_RANGE
+    if not low <= density <= high:
+        text = None
+        if case.source is not None:
+            try:
+                text = Path(case.source).read_text(encoding="utf-8", errors="replace")
+            except OSError:
+                text = None
+        where = ""
+        if case.source is not None:
+            line_no = _find_line(text, "line", "weight")
+            where = f"{case.source}" + (f":{line_no}" if line_no is not None else "") + ": "
+        if density < low:
+            hint = (f"a weight in kg/m? In N/m it would be {ln.weight:g} x {GRAVITY:g} = "
+                    f"{ln.weight * GRAVITY:.4g} N/m")
+        else:
+            hint = (f"a bundle's weight with one sub-conductor's diameter, or a unit slip? "
+                    f"{high:,.0f} kg/m3 would be a weight of {high * GRAVITY * math.pi * ln.diameter**2 / 4.0:.4g} N/m")
+        out.append(f"{where}line.weight: value {ln.weight:g} N/m with diameter {ln.diameter:g} m gives a "
+                   f"bulk density W/(g pi D^2/4) of {density:,.0f} kg/m3, outside {low:,.0f}-{high:,.0f} "
+                   f"(the paper's conductor: 4,805): {hint}")
+    return out
+
+
 # --------------------------------------------------------------------------- loading
 def _find_line(text: str | None, section: str, key: str | None) -> int | None:
     """1-based line of ``key`` inside ``[section]`` (or of the header when key is None)."""

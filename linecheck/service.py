@@ -1017,11 +1017,16 @@ class ModesResult:
     mean: "Modes"
     mean_time: float
     damped: "object" = None  # ComplexModes of the mean state with the case's damping
+    #: per undamped mean-state mode, its damped counterpart (:func:`~linecheck.core.modes.pair_by_shape`):
+    #: frequency [Hz], damping ratio [-] and MAC [-] of the paired complex mode (NaN where none)
+    paired_hz: np.ndarray | None = None
+    paired_ratio: np.ndarray | None = None
+    paired_mac: np.ndarray | None = None
 
 
 def modes_analysis(case: Case, *, n_modes: int = 20, warn: Warn | None = None) -> ModesResult:
     """Natural frequencies and mode shapes of the still-air and the mean state."""
-    from .core.modes import natural_modes
+    from .core.modes import natural_modes, pair_by_shape
 
     warn_case(case, warn)
     check_budget(case, "modes", warn=warn)
@@ -1034,11 +1039,16 @@ def modes_analysis(case: Case, *, n_modes: int = 20, warn: Warn | None = None) -
     still = natural_modes(build_model(system, mean.still_air), n_modes)
     model = build_model(system, mean.state(k))
     at_mean = natural_modes(model, n_modes)
-    cm = complex_modes(model, damping_matrices(case, st, [model], states=[k])[0])
+    cm = complex_modes(model, damping_matrices(case, st, [model], states=[k])[0], vectors=True)
+    index, mac = pair_by_shape(at_mean, model, cm.right, cm.S)  # the damped counterpart of each mode
+    ok = index >= 0
+    paired_hz, paired_ratio = np.full(index.size, np.nan), np.full(index.size, np.nan)
+    paired_hz[ok], paired_ratio[ok] = cm.frequencies_hz[index[ok]], cm.damping_ratio[index[ok]]
     n = min(n_modes, cm.poles.size)
     damped = dataclasses.replace(cm, frequencies_hz=cm.frequencies_hz[:n], damping_ratio=cm.damping_ratio[:n],
-                                 poles=cm.poles[:n])
-    return ModesResult(case, still, at_mean, float(mean.time[k]), damped)
+                                 poles=cm.poles[:n], right=None, left=None, S=None, mass=None, expansion=None,
+                                 norm=None)
+    return ModesResult(case, still, at_mean, float(mean.time[k]), damped, paired_hz, paired_ratio, mac)
 
 
 @dataclass(frozen=True)

@@ -273,37 +273,51 @@ def modes(
     if json_out is not None:
         check_target(json_out, what="JSON")
     res = service.modes_analysis(case, n_modes=count, warn=limits_warn)
-    t = Table(title=f"{case.name}: natural frequencies (Hz)", title_justify="left")
-    for c in ("mode", "still air", "direction", "mean state", "direction", "damped (Hz)", "damping ratio"):
-        t.add_column(c, justify="right")
-    dirs = "xyz"
-    ds, dm = res.still_air.dominant_direction(), res.mean.dominant_direction()
-    cm = res.damped
-    for i in range(res.still_air.frequencies_hz.size):
-        damped = ("", "")
-        if cm is not None and i < cm.frequencies_hz.size:
-            z = cm.damping_ratio[i]
-            style = "[bold red]" if z < 0.005 else ""
-            damped = (f"{cm.frequencies_hz[i]:.4f}", f"{style}{z:.3g}{'[/]' if style else ''}")
-        t.add_row(str(i + 1), f"{res.still_air.frequencies_hz[i]:.4f}", dirs[ds[i]],
-                  f"{res.mean.frequencies_hz[i]:.4f}", dirs[dm[i]], *damped)
-    console.print(t)
-    console.print(f"[dim]damped modes: complex eigenvalues of the mean state with damping = "
-                  f"\"{case.analysis.damping}\" (structural {case.analysis.structural_ratio:g}); "
-                  "red: damping ratio below 0.5 %.[/]")
+    console.print(modes_table(res))
+    console.print(f"[dim]damped (Hz), damping ratio: the complex mode of the mean state with damping = "
+                  f"\"{case.analysis.damping}\" (structural {case.analysis.structural_ratio:g}) whose shape matches "
+                  "the row's mean-state mode (MAC: mass-weighted modal assurance criterion, 1 = the same shape); "
+                  "still air and mean state: each state's modes in order of frequency, the same number not "
+                  "necessarily the same shape; red: damping ratio below 0.5 %.[/]")
     if case.wind.type == "downburst":
         console.print(f"[dim]mean state at t = {res.mean_time:.1f} s (largest mean reaction at the tower of interest)[/]")
     if json_out is not None:
+        dirs = "xyz"
+        ds, dm = res.still_air.dominant_direction(), res.mean.dominant_direction()
         doc = {"case": case.name, "units": "SI",
                "still_air": {"frequencies_hz": _num(res.still_air.frequencies_hz),
                              "direction": [dirs[i] for i in ds]},
                "mean": {"frequencies_hz": _num(res.mean.frequencies_hz), "direction": [dirs[i] for i in dm],
                         "time": res.mean_time,
                         "damped_frequencies_hz": _num(res.damped.frequencies_hz),
-                        "damping_ratios": _num(res.damped.damping_ratio)},
+                        "damping_ratios": _num(res.damped.damping_ratio),
+                        "paired_damped": {"frequencies_hz": _num(res.paired_hz),
+                                          "damping_ratios": _num(res.paired_ratio),
+                                          "mac": _num(res.paired_mac)}},
                "damping": case.analysis.damping}
         if shapes:
             doc["still_air"]["shapes"] = _num(res.still_air.shapes)
             doc["mean"]["shapes"] = _num(res.mean.shapes)
         write_json(json_out, with_provenance(doc))
         console.print(f"wrote {json_out}")
+
+
+def modes_table(res) -> Table:
+    """The ``modes`` table: per row the still-air and the mean-state mode of that rank, and the
+    damped mode paired with the mean-state one by shape (``ModesResult.paired_*``), not by rank."""
+    import numpy as np
+
+    t = Table(title=f"{res.case.name}: natural frequencies (Hz)", title_justify="left")
+    for c in ("mode", "still air", "direction", "mean state", "direction", "damped (Hz)", "damping ratio", "MAC"):
+        t.add_column(c, justify="right")
+    dirs = "xyz"
+    ds, dm = res.still_air.dominant_direction(), res.mean.dominant_direction()
+    for i in range(res.still_air.frequencies_hz.size):
+        damped = ("", "", "")
+        if res.paired_hz is not None and i < res.paired_hz.size and np.isfinite(res.paired_hz[i]):
+            z = res.paired_ratio[i]
+            style = "[bold red]" if z < 0.005 else ""
+            damped = (f"{res.paired_hz[i]:.4f}", f"{style}{z:.3g}{'[/]' if style else ''}", f"{res.paired_mac[i]:.2f}")
+        t.add_row(str(i + 1), f"{res.still_air.frequencies_hz[i]:.4f}", dirs[ds[i]],
+                  f"{res.mean.frequencies_hz[i]:.4f}", dirs[dm[i]], *damped)
+    return t

@@ -91,3 +91,35 @@ def _natural_modes_sparse(model: LinearModel, n_modes: int) -> Modes:
     phi = phi * np.sign(phi[big, np.arange(phi.shape[1])])
     return _modes(model, w2, phi)
 
+
+
+def pair_by_shape(modes: Modes, model: LinearModel, right: np.ndarray, S) -> tuple[np.ndarray, np.ndarray]:
+    """The damped counterpart of each undamped mode of ``model``: the pairing of the undamped
+    ``modes`` with the complex modes (displacement halves ``right`` (n_t, n_c) in the condensed
+    coordinates, u = ``S`` t; :class:`~linecheck.core.spectral.ComplexModes`) that maximises the
+    sum of the mass-weighted modal assurance criteria
+    MAC = |phi^T M psi|^2 / ((phi^T M phi)(psi^H M psi)) (Allemang & Brown 1982), one complex
+    mode per undamped mode (the assignment problem, ``scipy.optimize.linear_sum_assignment``).
+    Sorting both sets by frequency is not a pairing: damping splits and shifts near-degenerate
+    modes (in-plane/out-of-plane) differently.
+
+    Returns the index of the paired complex mode (n_modes,), -1 where there are fewer complex
+    modes than undamped ones, and its MAC [-] in [0, 1] (NaN where unpaired).
+    """
+    from scipy.optimize import linear_sum_assignment
+
+    n = modes.frequencies_hz.size
+    free = model.dofs.free_nodes
+    phi = modes.shapes[:, free, :].reshape(n, -1).T  # (n_dof, n), the full DOFs of the model
+    psi = np.asarray(S @ right)  # (n_dof, n_c) complex
+    m = model.mass
+    cross = np.abs(phi.T @ (m[:, None] * psi)) ** 2  # (n, n_c)
+    norm_phi = np.einsum("ik,ik->k", phi, m[:, None] * phi)
+    norm_psi = np.einsum("ik,ik->k", psi.conj(), m[:, None] * psi).real
+    mac = cross / np.maximum(norm_phi[:, None] * norm_psi[None, :], np.finfo(float).tiny)
+    rows, cols = linear_sum_assignment(-mac)
+    index = np.full(n, -1, dtype=int)
+    best = np.full(n, np.nan)
+    index[rows] = cols
+    best[rows] = mac[rows, cols]
+    return index, best

@@ -21,6 +21,7 @@ import numpy as np
 from .analysis.guard import check_budget, check_case, warn_case  # noqa: F401 - the front ends' entry points
 from .core import budget, kernel
 from .core.case import Case
+from .core.codes import CODES_PEAK  # what ``linecheck_peak`` is: one text for every front end
 from .core.damping import (aerodynamic_damping, aerodynamic_damping_stack, stiffness_proportional,
                            stiffness_proportional_stack)
 from .core.dynamics import DynamicResponse, integrate
@@ -1435,11 +1436,6 @@ class CodesResult:
     case: Case
     checks: tuple
     peak: str
-
-
-CODES_PEAK = ("design value of peak_dynamic (Gumbel fit at analysis.design_fractile, issue 18; the mean over "
-              "realizations when a single realization gives no fit) of the wind-induced peak |M + B + R| of the "
-              "reaction, still air excluded: the same wind-induced quantity as the code's conductor wind load")
 
 
 def design_peaks(run: RunResult, component: int) -> np.ndarray:

@@ -312,6 +312,9 @@ def test_excel_codes_sheet(short_run):
     asce = doc["codes"]["ASCE74"]["towers"][0]["Ry"]
     assert rows[0][1] == "ASCE74" and rows[0][4] == 1 and rows[0][5] == "Ry"
     assert rows[0][6] == pytest.approx(asce["code_load"] / 1e3) and rows[0][9] == asce["verdict"]
+    # the note says what the number is: the Gumbel design value, not the mean of the peak (issue 34)
+    notes = [c for row in ws.iter_rows(values_only=True) for c in row if isinstance(c, str) and "linecheck peak:" in c]
+    assert len(notes) == 1 and C.CODES_PEAK in notes[0] and "mean over realizations of the wind" not in notes[0]
 
 
 async def test_tui_codes_tab_shows_the_run_document(short_run):
@@ -335,6 +338,8 @@ async def test_tui_codes_tab_shows_the_run_document(short_run):
         ry = doc["codes"]["ASCE74"]["towers"][0]["Ry"]
         assert first[:4] == ["ASCE74", "yes", "1", "Ry"]
         assert first[4] == f"{ry['code_load'] / 1e3:.3f}" and first[7] == ry["verdict"]
+        note = str(app.query_one("#codes-notes").render())
+        assert "design value of peak_dynamic (Gumbel fit" in note and "mean over realizations of the wind" not in note
 
 
 def test_the_same_wind_written_two_ways_gives_the_same_code_loads():

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from openpyxl.worksheet.worksheet import Worksheet
 
+from ..core.codes import CODES_PEAK
 from ..io.document import RunDocument
 
 from .cells import KN3, RATIO, Cursor, kn, page_setup
@@ -47,7 +48,7 @@ def write_codes(ws: Worksheet, docs: list[RunDocument], like: Worksheet | None =
                     cur.row += 1
                     n += 1
     cur.row += 1
-    cur.note("linecheck peak: mean over realizations of the wind-induced dynamic peak (peak_dynamic); "
+    cur.note(f"linecheck peak: {CODES_PEAK}; "
              "ratio = linecheck peak / code load. Unverified codes are shown, not judged (docs/codes.md).")
     ws.freeze_panes = "A4"
     page_setup(ws, like)

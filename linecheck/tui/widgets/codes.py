@@ -11,10 +11,11 @@ from textual.app import ComposeResult
 from textual.containers import Vertical
 from textual.widgets import DataTable, Static
 
+from ...core.codes import CODES_PEAK
 from ...io.document import CodeCheck, RunDocument
 
 HELP = "No result yet. Run a case (r): the four design codes' conductor wind loads appear here beside its peaks."
-PEAK_NOTE = ("linecheck peak: mean over realizations of the wind-induced dynamic peak; ratio = peak / code load. "
+PEAK_NOTE = (f"linecheck peak: {CODES_PEAK}; ratio = peak / code load. "
              "Unverified codes are shown, not judged (docs/codes.md).")
 
 

@@ -147,7 +147,28 @@ def test_static_table_shows_tower_names_and_stations():
     ref = csv_towers()
     for k, t in enumerate(ref):
         mark = r"\s\*" if k + 1 == 7 else ""
-        assert re.search(rf"│\s+{k + 1}{mark} │ {t['name']}\s+│\s+{t['station']} │\s+{t['support']} │", r.output), t
+        assert re.search(rf"│\s+{k + 1}{mark} │ {t['name']}\s+│\s+{t['station']} │\s+[-\d.]+ │\s+{t['support']} │",
+                         r.output), t
+
+
+def test_static_table_is_in_each_towers_frame_as_the_json(tmp_path):
+    """Every number of the static console table equals the JSON's (each tower's own frame, not the
+    global frame: T13's Ry 1.870 kN, global -4.050 kN; T5's wind Ry 5.631 kN, as the Excel), and a
+    caption names the frame."""
+    out = tmp_path / "s.json"
+    r = CliRunner(env={"COLUMNS": "250"}).invoke(app, ["static", str(EXAMPLE), "--json", str(out)])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(out.read_text(encoding="utf-8"))
+    keys = ("Rx", "Ry", "Rz", "Rx_wind", "Ry_wind", "Rz_wind")
+    rows = [ln.split("│")[1:-1] for ln in r.output.splitlines() if re.match(r"│\s+\d+", ln)]
+    assert len(rows) == len(doc["towers"]) == 13
+    for cells, t in zip(rows, doc["towers"]):
+        assert float(cells[3]) == pytest.approx(t["heading"], abs=0.05)
+        assert [float(c) for c in cells[-6:]] == [round(t[k] / 1e3, 3) for k in keys], t["name"]
+    t13, t5 = doc["towers"][12], doc["towers"][4]
+    assert round(t13["Ry"] / 1e3, 3) == 1.870 and round(t13["global"]["Ry"] / 1e3, 3) == -4.050
+    assert round(t5["Ry_wind"] / 1e3, 3) == 5.631
+    assert "own frame" in r.output and "tower frame: x along the line bisector" in r.output
 
 
 def test_static_table_of_a_paper_case_has_no_name_column():
@@ -300,3 +321,15 @@ def test_tui_codes_rows_name_the_section_towers():
                       towers=(CodeTower(7, {"Ry": CodeVerdict(4000.0, 5000.0, 1.25, "code exceeded by 25 %")}),))
     assert codes_rows({"ASCE74": block}, {7: "T7"})[0][2] == "7 T7"
     assert codes_rows({"ASCE74": block})[0][2] == "7"  # the equal-span form: numbers only
+
+
+def test_tui_summary_names_the_tower_frame():
+    """The TUI's summary notes name the frame of the tower of interest's reactions (its own frame,
+    as the console, the JSON and the Excel), with its heading on a section."""
+    from linecheck.io.display import doc_frame_caption
+
+    towers = (SimpleNamespace(section={"heading": 0.0}), SimpleNamespace(section={"heading": 9.0}))
+    text = doc_frame_caption(SimpleNamespace(tower_of_interest=2, towers=towers))
+    assert text.startswith("tower frame: x along the line bisector") and "heading 9.0 deg" in text
+    paper = doc_frame_caption(SimpleNamespace(tower_of_interest=1, towers=(SimpleNamespace(section=None),)))
+    assert "tower frame" in paper and "deg from the global x" not in paper

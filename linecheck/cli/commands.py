@@ -47,13 +47,41 @@ def section_line(case) -> str:
             f"tower of interest {toi} ({rows[toi - 1].name})")
 
 
+def _at(v, k: int) -> float:
+    """Value ``k`` of a static document's entry (a list over the step-1 instants of a downburst)."""
+    return float(v[k] if isinstance(v, list) else v)
+
+
+def static_table(doc: dict, name: str) -> Table:
+    """The console table of a step-1 document (:func:`linecheck.io.jsonout.static_to_dict`): the
+    same numbers as its JSON, every tower's reactions in its own frame (``heading``: its x axis
+    from the global x, sections only).  Downburst: each row is the instant of that tower's
+    largest wind-induced |Ry|."""
+    towers = doc["towers"]
+    section = "name" in towers[0]
+    table = Table(title=f"{name}: step-1 mean reactions (kN), each tower in its own frame", title_justify="left")
+    names = ("name", "station (m)", "heading (deg)") if section else ()
+    for col in ("tower", *names, "support", "Rx", "Ry", "Rz", "Rx wind", "Ry wind", "Rz wind"):
+        table.add_column(col, justify="left" if col == "name" else "right")
+    toi = doc["tower_of_interest"]
+    for t in towers:
+        ry = t["Ry_wind"]
+        k = max(range(len(ry)), key=lambda i: abs(ry[i])) if isinstance(ry, list) else 0
+        ident = (escape(t["name"]), f"{t['station']:g}", f"{t['heading']:.1f}") if section else ()
+        table.add_row(
+            f"{t['index']}{' *' if t['index'] == toi else ''}", *ident, t["support"],
+            *(f"{_at(t[c], k) / 1e3:.3f}" for c in ("Rx", "Ry", "Rz", "Rx_wind", "Ry_wind", "Rz_wind")),
+        )
+    return table
+
+
 @app.command()
 @handle_errors
 def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     """Step 1: non-linear static analysis under the (running-)mean wind."""
     from .. import service
+    from ..io.display import tower_frame_caption
     from ..io.jsonout import static_to_dict, write_json
-    from ..io.section import tower_rows
 
     case = read_case(case_file)
     check_outputs([("--json", json_out)], case_inputs(case))
@@ -63,26 +91,10 @@ def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
         res = service.static_analysis(case, progress=cb, warn=limits_warn)
     doc = static_to_dict(res)
     m = res.mean
-    toi = case.line.tower_of_interest - 1
-    table = Table(title=f"{case.name}: step-1 mean reactions (kN)", title_justify="left")
-    rows = tower_rows(case.line)  # sections: tower names and stations (issue 17)
-    names = ("name", "station (m)") if rows else ()
-    for col in ("tower", *names, "support", "Rx", "Ry", "Rz", "Rx wind", "Ry wind", "Rz wind"):
-        table.add_column(col, justify="left" if col == "name" else "right")
-    rw = m.reactions_wind
-    for j in range(res.system.n_towers):
-        k = int(abs(rw[:, j, 1]).argmax()) if case.wind.type == "downburst" else 0
-        mark = " *" if j == toi else ""
-        ident = (escape(rows[j].name), f"{rows[j].station:g}") if rows else ()
-        table.add_row(
-            f"{j + 1}{mark}", *ident, case.line.supports[j],
-            *(f"{m.reactions[k, j, c] / 1e3:.3f}" for c in range(3)),
-            *(f"{rw[k, j, c] / 1e3:.3f}" for c in range(3)),
-        )
-    console.print(table)
-    console.print(f"[dim]* tower of interest (line.tower_of_interest = {toi + 1}); Rx, Ry, Rz total reactions "
-                  "(conductor weight included), \"wind\" their wind-induced part (still air subtracted).[/]",
-                  highlight=False)
+    console.print(static_table(doc, case.name))
+    console.print(f"[dim]* tower of interest (line.tower_of_interest = {case.line.tower_of_interest}); Rx, Ry, Rz total "
+                  "reactions (conductor weight included), \"wind\" their wind-induced part (still air subtracted); "
+                  f"{escape(tower_frame_caption(straight=res.system.straight_in_plan))}.[/]", highlight=False)
     series = case.wind.type == "downburst"
     tens = ", ".join(f"{h / 1e3:.2f}" for h in (m.tension.max(axis=0) if series else m.tension[0]))
     console.print(f"span tensions H (kN{', largest over the event' if series else ''}): {tens}   "

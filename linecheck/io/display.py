@@ -28,6 +28,33 @@ HOW_TO_READ_NEGATIVE_CONT_BG = (
     "Cont_BG < 0: the background lowered the peak below the largest mean (GF_QS < 1) in these "
     "realizations; it is sampling, not a relief the design can count on.")
 
+#: The frame every tower's reactions are given in (docs/method.md, "Reactions in tower frames"):
+#: the console, the TUI, the JSON and the Excel sheets all use it and name it.
+TOWER_FRAME = ("tower frame: x along the line bisector (the mean heading of the tower's two spans; an end "
+               "tower: its span's), y = x turned +90 deg in plan (transverse, to the line's left), z down")
+
+
+def tower_frame_caption(heading: float | None = None, straight: bool = True) -> str:
+    """The caption naming the frame of a tower's reactions: :data:`TOWER_FRAME`, with the
+    tower's ``heading`` [deg] (its x axis from the global x) when given, and on a line that
+    is not straight in plan (``straight`` False) the note that the frames differ per tower."""
+    text = TOWER_FRAME
+    if heading is not None:
+        text += f"; heading {heading:.1f} deg from the global x (the first span)"
+    if not straight:
+        text += "; each tower in its own frame (the JSON's \"global\" block: x along the first span)"
+    return text
+
+
+def doc_frame_caption(doc: Any) -> str:
+    """The frame caption of a run document's tower of interest (a RunDocument): its heading
+    when the run is on a section (``towers[].heading``)."""
+    towers = getattr(doc, "towers", ()) or ()
+    k = doc.tower_of_interest - 1
+    section = towers[k].section if 0 <= k < len(towers) else None
+    heading = section.get("heading") if section else None
+    return tower_frame_caption(heading)
+
 
 def number_text(value: float | None, stat: StatDef) -> str:
     """``value`` (SI) in the statistic's shown unit and format, "" when None."""

@@ -12,7 +12,7 @@ from textual.widgets import DataTable, RadioButton, RadioSet, Static, TabbedCont
 from .. import figures
 from ..formatting import (REACTIONS, cont_r_flags, davenport_lines, how_to_read, sanity_rows, spectral_compare_rows,
                           summary_rows, summary_title)
-from ...io.display import STAT_ROWS, number_text
+from ...io.display import STAT_ROWS, doc_frame_caption, number_text
 from ...io.document import RunDocument
 from ..plotting import PlotView
 from ..runner import RunOutput
@@ -132,7 +132,8 @@ class ResultsView(Vertical):
                     Text(c, style="bold black on yellow") if r in flagged else c for r, c in zip(REACTIONS, cells[2:])]
             t.add_row(*cells, key=row[0])
         notes = Text()
-        notes.append("Wind-induced reactions (still air removed) at the tower of interest; "
+        notes.append("Wind-induced reactions (still air removed) at the tower of interest, "
+                     f"{doc_frame_caption(doc)}; "
                      "** : GF undefined, mean zero by symmetry or < 1 % of the largest mean. "
                      "Cont_R: share of the peak a quasi-static analysis misses.", style="dim")
         if flagged:

@@ -85,7 +85,7 @@ def test_batch_warns_a_case_estimated_to_run_long(short_cases, monkeypatch):
 # --------------------------------------------------------------------------- 9. scan: guard and progress
 def test_a_scan_of_100000_positions_is_estimated_and_warned_before_it_starts(tmp_path):
     case = load_case(CASES / "paper" / "case01-six.toml")
-    grid = ScanGrid.from_options(case, "1:5882:1", None, None)  # 5882 x 17 = 99,994 positions
+    grid = ScanGrid.from_options(case, "1:5882:1m", None, None)  # 5882 x 17 = 99,994 positions
     warned: list[str] = []
     from linecheck.batch.scan import scan_estimate
 

@@ -39,18 +39,60 @@ def paper_line_case(tmp_path: Path, spans: str = "six", mean_states: int = 40) -
 # --------------------------------------------------------------------------- grid
 def test_parse_values_ranges_lists_and_dj():
     assert parse_values("0:90:30", "--angle") == ((0.0, 30.0, 60.0, 90.0), False)
-    assert parse_values("1.0:1.6:0.2Dj", "--distance") == ((1.0, 1.2, 1.4, 1.6), True)
-    assert parse_values("600, 900", "--jet-diameter") == ((600.0, 900.0), False)
-    assert parse_values("1.2 Dj", "--distance") == ((1.2,), True)
+    assert parse_values("1.0:1.6:0.2Dj", "--distance", LENGTH) == ((1.0, 1.2, 1.4, 1.6), True)
+    assert parse_values("600, 900 m", "--jet-diameter", ("m",)) == ((600.0, 900.0), False)
+    assert parse_values("1.2 Dj", "--distance", LENGTH) == ((1.2,), True)
     assert parse_values("90:0:-45", "--angle")[0] == (90.0, 45.0, 0.0)
-    for bad in ("", "1:2", "a:b:c", "0:10:0", "0:10:-1", "nan"):
+    for bad in ("", "1:2m", "a:b:cm", "0:10:0m", "0:10:-1m", "nan m"):
         with pytest.raises(CaseError):
-            parse_values(bad, "--distance")
+            parse_values(bad, "--distance", LENGTH)
+
+
+LENGTH = ("m", "Dj")
+
+
+@pytest.mark.parametrize("text, values, relative", [
+    ("720m", (720.0,), False),
+    ("1.2Dj", (1.2,), True),
+    ("1.2 * D_j", (1.2,), True),
+    ("1.2Dj,1.6Dj", (1.2, 1.6), True),  # a unit after every number
+    ("1.2,1.6Dj", (1.2, 1.6), True),  # or once after the last, for all of them
+    ("720m, 960m", (720.0, 960.0), False),
+    ("600:900:100m", (600.0, 700.0, 800.0, 900.0), False),  # a range: one unit for the range
+    ("600m:900m:100m", (600.0, 700.0, 800.0, 900.0), False),  # or one per number
+    ("0.5:1.5:0.5dj", (0.5, 1.0, 1.5), True),
+])
+def test_scan_lengths_accepted_with_their_unit(text, values, relative):
+    assert parse_values(text, "--distance", LENGTH) == (values, relative)
+
+
+@pytest.mark.parametrize("option, text, why", [
+    ("--distance", "1.2,1.6", "a length needs its unit, m (metres) or Dj (multiples of the jet diameter)"),
+    ("--distance", "720", "a length needs its unit"),
+    ("--distance", "0.5:2.5:0.1", "a length needs its unit"),
+    ("--distance", "1.2Dj,720m", "one unit for every number (Dj and m given"),
+    ("--distance", "1.2Dj,1.6", "a unit after every number, or once after the last for all of them"),
+    ("--distance", "600:900m:100", "a unit after every number, or once after the last"),
+    ("--jet-diameter", "600,900", "a length needs its unit, m (metres)"),
+    ("--jet-diameter", "1.2Dj", "--jet-diameter takes m (metres), not Dj"),
+    ("--angle", "0:1:1Dj", "(no unit)"),
+])
+def test_scan_refuses_a_length_without_its_unit_in_one_line(option, text, why):
+    """A bare number is refused (``--distance 1.2,1.6`` used to scan 1.2 m and 1.6 m, a storm on
+    the tower), exit 2, one line naming the option, the value and what is allowed."""
+    path = CASES / "paper" / "case01-single.toml"
+    r = runner.invoke(app, ["scan", str(path), option, text, "--jobs", "1"])
+    assert r.exit_code == 2, r.output
+    out = " ".join(r.output.split())
+    assert f"{option}: value {text!r} is not allowed: " in out and why in out, out
+    if option != "--angle":
+        assert "e.g." in out
+    assert len([ln for ln in r.output.splitlines() if ln.strip()]) == 1, r.output
 
 
 def test_grid_points_relative_distance_and_defaults():
     case = load_case(CASES / "paper" / "case01-single.toml")
-    g = ScanGrid.from_options(case, "1.2:1.6:0.4Dj", "0,30", "600,900")
+    g = ScanGrid.from_options(case, "1.2:1.6:0.4Dj", "0,30", "600,900m")
     pts = g.points()
     assert pts.shape == (8, 3) and g.size == 8
     np.testing.assert_allclose(pts[:4], [[720, 0, 600], [720, 30, 600], [960, 0, 600], [960, 30, 600]])
@@ -60,7 +102,7 @@ def test_grid_points_relative_distance_and_defaults():
     synoptic = load_case(CASES / "paper" / "case09-single.toml")
     with pytest.raises(CaseError, match="downburst"):
         ScanGrid.from_options(synoptic)
-    with pytest.raises(CaseError, match="degrees"):
+    with pytest.raises(CaseError, match="no unit"):
         ScanGrid.from_options(case, angle="0:1:1Dj")
 
 
@@ -136,6 +178,12 @@ def test_cli_scan_table_csv_and_dynamic(tmp_path):
     assert "critical downburst configurations" in r.output and "Db_x: R = 1.6 D_j" in r.output
     assert "full analysis at the critical configurations" in r.output
     assert "by the expected dynamic peak" in r.output and "same position" in r.output
+    # one table says which number to design for: the full analysis at the case's V_ref at p,
+    # beside the scan's expected peak and the V_ref at p it was ranked at (issue 34)
+    flat = " ".join(r.output.replace("│", " ").split())
+    assert "design values: full analysis at the critical configurations at the case's V_ref = 40 m/s at point p" in flat
+    assert 'design for the "design peak" columns' in flat and "a ranking, not a design value" in flat
+    assert re.search(r"done Rx \d+\.\d{3}, Ry", flat), flat  # the scan peak of the run's reactions
     assert len(out.read_text().splitlines()) == 1 + 4
     assert list((tmp_path / "dyn").glob("*.json"))
 
@@ -164,7 +212,7 @@ def test_scan_ranks_by_the_expected_dynamic_peak(tmp_path):
 
 def test_cli_scan_usage_errors(tmp_path):
     path = CASES / "paper" / "case01-single.toml"
-    r = runner.invoke(app, ["scan", str(path), "--distance", "1:2"])
+    r = runner.invoke(app, ["scan", str(path), "--distance", "1:2m"])
     assert r.exit_code == 2 and "START:STOP:STEP" in r.output
     r = runner.invoke(app, ["scan", str(CASES / "paper" / "case09-single.toml")])
     assert r.exit_code == 2 and "downburst" in r.output

@@ -50,48 +50,83 @@ MAX_POINTS = 1_000_000
 DEFAULT_DISTANCE = "0.5:2.5:0.1Dj"
 DEFAULT_ANGLE = "-80:80:10"
 HOLDS = ("jet", "vref")
-_RELATIVE = re.compile(r"\s*\*?\s*d_?j\s*", re.IGNORECASE)
+#: A number with an optional unit: "720", "720m", "1.2Dj", "1.2 D_j", "1.2*Dj".
+_NUMBER = re.compile(r"^\s*(?P<num>[^:,]*?)\s*(?:(?P<dj>\*?\s*d_?j)|(?P<m>m))?\s*$", re.IGNORECASE)
+#: The units of the scan's options: a length in metres ("m") or in multiples of the jet diameter ("Dj").
+UNIT_WORDS = {"m": "m (metres)", "Dj": "Dj (multiples of the jet diameter)"}
 
 
-# --------------------------------------------------------------------------- grid
-def parse_values(text: str, option: str) -> tuple[tuple[float, ...], bool]:
+def parse_values(text: str, option: str, units: tuple[str, ...] = ()) -> tuple[tuple[float, ...], bool]:
     """Values of a scan option: ``A:B:STEP`` (B included), a comma list or one number.
 
-    A ``Dj`` suffix (``0.5:2.5:0.1Dj``, ``1.2Dj``) makes the values multiples of the
-    jet diameter.  Returns (values, relative).  Raises CaseError (exit 2) on bad text.
+    ``units``: the units the option allows, of ``"m"`` and ``"Dj"`` (lengths); every value
+    then needs one -- after every number (``1.2Dj,1.6Dj``, ``600m:900m:100m``) or once after
+    the last, for all of them (``0.5:2.5:0.1Dj``, ``600,900m``); a bare number, two units or
+    a unit the option does not take is refused.  Empty ``units``: plain numbers (degrees).
+    Returns (values, relative: in multiples of D_j).  Raises CaseError (exit 2) on bad text,
+    one line naming the option, the value and what is allowed.
     """
     raw = text.strip()
-    relative = bool(_RELATIVE.search(raw))
-    body = _RELATIVE.sub("", raw).strip()
-    expected = "expected START:STOP:STEP (STOP included), a comma-separated list or a number, optionally followed by Dj"
+    sep = ":" if ":" in raw else ","
+    form = "START:STOP:STEP (STOP included), a comma-separated list or a number"
+    allowed = " or ".join(UNIT_WORDS[u] for u in units)
+    examples = {"--distance": "720m; 1.2Dj; 1.2Dj,1.6Dj; 0.5:2.5:0.1Dj",
+                "--jet-diameter": "600m; 600m,900m; 600:900:100m"}
+    eg = examples.get(option, "; ".join(f"1.2{u}" for u in units))
+    with_unit = (f"{form}, in {allowed}: a unit after every number, or once after the last for all "
+                 f"of them (e.g. {eg})")
+    expected = with_unit if units else form
 
-    def num(s: str) -> float:
+    def refuse(why: str) -> CaseError:
+        return CaseError(f"{option}: value {text!r} is not allowed: {why}")
+
+    if not raw:
+        raise CaseError(f"{option}: empty value: expected {expected}")
+    tokens = [p for p in raw.split(sep) if p.strip()] if sep == "," else raw.split(sep)
+    if not tokens:
+        raise CaseError(f"{option}: empty value: expected {expected}")
+    nums, found = [], []
+    for tok in tokens:
+        mt = _NUMBER.match(tok)
+        if mt is None:
+            raise refuse(f"expected {expected}")
+        found.append("Dj" if mt["dj"] else "m" if mt["m"] else "")
         try:
-            v = float(s)
+            v = float(mt["num"])
         except ValueError:
-            raise CaseError(f"{option}: value {text!r} is not allowed: {expected}") from None
+            raise refuse(f"expected {expected}") from None
         if not math.isfinite(v):
-            raise CaseError(f"{option}: value {text!r} is not allowed: expected finite numbers")
-        return v
-
-    if not body:
-        raise CaseError(f"{option}: empty value: {expected}")
-    if ":" in body:
-        parts = body.split(":")
-        if len(parts) != 3:
-            raise CaseError(f"{option}: value {text!r} is not allowed: {expected}")
-        a, b, step = (num(p) for p in parts)
+            raise refuse("expected finite numbers")
+        nums.append(v)
+    given = {u for u in found if u}
+    if not units:
+        if given:
+            raise refuse(f"expected plain numbers, {form} (no unit)")
+        unit = ""
+    else:
+        if not given:
+            raise refuse(f"a length needs its unit, {allowed} (e.g. {eg}; one unit after the last number "
+                         "applies to all)")
+        if len(given) > 1:
+            raise refuse(f"one unit for every number ({' and '.join(sorted(given))} given; e.g. {eg})")
+        (unit,) = given
+        if unit not in units:
+            raise refuse(f"{option} takes {allowed}, not {unit} (e.g. {eg})")
+        if not (all(found) or (found[-1] and not any(found[:-1]))):
+            raise refuse(f"a unit after every number, or once after the last for all of them (e.g. {eg})")
+    if sep == ":":
+        if len(nums) != 3:
+            raise refuse(f"expected {expected}")
+        a, b, step = nums
         if step == 0 or (b - a) * step < 0:
-            raise CaseError(f"{option}: value {text!r} is not allowed: STEP must be non-zero and go from A toward B")
+            raise refuse("STEP must be non-zero and go from A toward B")
         n = int(math.floor((b - a) / step + 1e-9)) + 1
         if n > MAX_POINTS:
             raise CaseError(f"{option}: value {text!r} gives {n} values: expected at most {MAX_POINTS}")
         values = tuple(float(round(a + i * step, 10)) for i in range(n))
     else:
-        values = tuple(num(p) for p in body.split(",") if p.strip())
-        if not values:
-            raise CaseError(f"{option}: empty value: {expected}")
-    return values, relative
+        values = tuple(nums)
+    return values, unit == "Dj"
 
 
 @dataclass(frozen=True)
@@ -117,16 +152,12 @@ class ScanGrid:
         if case.wind.type != "downburst" or db is None:
             raise CaseError('wind.type: a scan needs a downburst case (type = "downburst")',
                             file=str(case.source) if case.source else None)
-        dist, rel = parse_values(distance or DEFAULT_DISTANCE, "--distance")
-        ang, ang_rel = parse_values(angle or DEFAULT_ANGLE, "--angle")
-        if ang_rel:
-            raise CaseError(f"--angle: value {angle!r} is not allowed: angles are in degrees (no Dj)")
+        dist, rel = parse_values(distance or DEFAULT_DISTANCE, "--distance", ("m", "Dj"))
+        ang, _ = parse_values(angle or DEFAULT_ANGLE, "--angle")  # degrees, plain numbers
         if jet_diameter is None:
             dj: tuple[float, ...] = (float(db.jet_diameter),)
         else:
-            dj, dj_rel = parse_values(jet_diameter, "--jet-diameter")
-            if dj_rel:
-                raise CaseError(f"--jet-diameter: value {jet_diameter!r} is not allowed: give D_j in metres")
+            dj, _ = parse_values(jet_diameter, "--jet-diameter", ("m",))
         for v in dj:
             if v <= 0:
                 raise CaseError(f"--jet-diameter: value {v:g} is out of range: expected D_j > 0 m")
@@ -415,16 +446,24 @@ def scan_estimate(case: Case, points: int, *, dynamic_realizations: int = 0, wor
                                              workers=workers), case, warn)
 
 
+def critical_groups(result: ScanResult, reactions: Sequence[str] = ("Rx", "Ry"),
+                    by: str | None = None) -> list[tuple[tuple[float, float, float], list[Critical]]]:
+    """The distinct critical configurations (R, Theta, D_j) of a scan, each with the criticals
+    that share it, in the order of :func:`critical_jobs`'s runs; ``by`` as there."""
+    by = by or ("peak" if result.dynamic is not None else "mean")
+    groups: dict[tuple[float, float, float], list[Critical]] = {}
+    for c in result.criticals(reactions, by):
+        groups.setdefault((c.distance, c.angle, c.jet_diameter), []).append(c)
+    return list(groups.items())
+
+
 def critical_jobs(result: ScanResult, reactions: Sequence[str] = ("Rx", "Ry"), by: str | None = None) -> list[RunJob]:
     """One run per distinct critical configuration (reactions sharing one are grouped);
     ``by``: "mean" or "peak" (default: "peak" when the scan has dynamic peaks, else "mean")."""
-    by = by or ("peak" if result.dynamic is not None else "mean")
-    groups: dict[tuple[float, float, float], list[str]] = {}
-    for c in result.criticals(reactions, by):
-        groups.setdefault((c.distance, c.angle, c.jet_diameter), []).append(c.reaction)
     stem = result.case_path.stem
     jobs = []
-    for (r, th, dj), names in groups.items():
+    for (r, th, dj), crits in critical_groups(result, reactions, by):
+        names = [c.reaction for c in crits]
         tag = "-".join(names)
         changes = {"name": f"{result.case.name} critical {', '.join(names)}", **scan_changes(r, th, dj)}
         suffix = ""

@@ -484,9 +484,11 @@ def scan_table(result: Any) -> Table:
 def peak_scan_table(result: Any) -> Table:
     """Critical configurations by the expected dynamic peak beside those by the mean (issue 20)."""
     t = Table(title=f"critical configurations by the expected dynamic peak |M + B + R| "
-                    f"(mean of {result.dynamic_realizations} realization(s) per position) and by the mean",
+                    f"(mean of {result.dynamic_realizations} realization(s) per position) and by the mean, "
+                    "at the scanned storm (V_ref at p): they rank the positions, the design values follow",
               title_justify="left")
-    for col in ("reaction", "ranked by", "R m", "R/D_j", "Θ deg", "D_j m", "value kN", "same position"):
+    for col in ("reaction", "ranked by", "R m", "R/D_j", "Θ deg", "D_j m", "value kN", "V_ref at p m/s",
+                "same position"):
         t.add_column(col, justify="right" if col not in ("reaction", "ranked by", "same position") else "left")
     for r in ("Rx", "Ry"):
         cm, cp = result.critical(r, "mean"), result.critical(r, "peak")
@@ -496,20 +498,44 @@ def peak_scan_table(result: Any) -> Table:
             same = "yes" if (cm is not None and cp is not None and cm.index == cp.index) else "no"
             label = "expected peak" if by == "peak" else "max |mean|"
             t.add_row(r, label, f"{c.distance:.0f}", f"{c.distance_over_dj:.2f}", f"{c.angle:g}", f"{c.jet_diameter:.0f}",
-                      f"{c.value / 1e3:.3f}", same)
+                      f"{c.value / 1e3:.3f}", f"{c.v_ref:.1f}", same)
     return t
 
 
-def dynamic_table(report: Any) -> Table:
-    t = Table(title="full analysis at the critical configurations", title_justify="left")
-    for col in ("run", "status", "peak Rx kN", "peak Ry kN", "GF_Dy Rx", "GF_Dy Ry", "Cont_R Rx %", "Cont_R Ry %"):
-        t.add_column(col, justify="right" if col not in ("run", "status") else "left")
-    for o in report.outcomes:
+#: The caption of :func:`dynamic_table`: which of the scan's numbers is the design value.
+DESIGN_CAPTION = ("design for the \"design peak\" columns: the full analysis at the case's V_ref at point p. "
+                  "\"scan peak\" is the expected peak that ranked the position, with the storm of the scan "
+                  "(V_ref at p of that position, --hold) and {k} realization(s): a ranking, not a design value.")
+
+
+def dynamic_table(report: Any, result: Any = None, v_ref: float | None = None) -> Table:
+    """The full analysis at the critical configurations of a dynamic scan: the design peaks (the
+    case's ``v_ref`` at point p) beside the scan's expected peak that ranked each position and
+    the V_ref at p it was ranked at (``result``: the :class:`~linecheck.batch.ScanResult`)."""
+    from ..batch.scan import critical_groups
+
+    at = f" at the case's V_ref = {v_ref:g} m/s at point p" if v_ref is not None else ""
+    t = Table(title=f"design values: full analysis at the critical configurations{at}", title_justify="left")
+    groups = critical_groups(result) if result is not None else []
+    scan_cols = ("scan peak kN", "scan V_ref at p m/s") if groups else ()
+    for col in ("run", "status", *scan_cols, "design peak Rx kN", "design peak Ry kN", "V_ref at p m/s",
+                "GF_Dy Rx", "GF_Dy Ry", "Cont_R Rx %", "Cont_R Ry %"):
+        t.add_column(col, justify="right" if col not in ("run", "status", "scan peak kN") else "left")
+    for k, o in enumerate(report.outcomes):
         d = o.doc
-        t.add_row(escape(o.name), o.status if not o.error else escape(f"failed: {o.error}"),
-                  _kn(d, "Rx", "peak_dynamic"), _kn(d, "Ry", "peak_dynamic"),
+        scan = ()
+        if groups:
+            crits = groups[k][1] if k < len(groups) else []
+            scan = (", ".join(f"{c.reaction} {abs(c.value) / 1e3:.3f}" for c in crits),
+                    ", ".join(sorted({f"{c.v_ref:.1f}" for c in crits})))
+        vr = "" if d is None or d.v_ref is None else f"{d.v_ref:g}"
+        t.add_row(escape(o.name), o.status if not o.error else escape(f"failed: {o.error}"), *scan,
+                  _kn(d, "Rx", "peak_dynamic"), _kn(d, "Ry", "peak_dynamic"), vr,
                   _kn(d, "Rx", "GF_Dy", "{:.3f}"), _kn(d, "Ry", "GF_Dy", "{:.3f}"),
                   _kn(d, "Rx", "Cont_R", "{:.1f}"), _kn(d, "Ry", "Cont_R", "{:.1f}"))
+    if groups:
+        t.caption = DESIGN_CAPTION.format(k=result.dynamic_realizations)
+        t.caption_justify = "left"
     return t
 
 
@@ -560,7 +586,7 @@ def _scan_each_model(case_file: Path, case: Any, grid: Any, names: tuple[str | N
                               f"with the case's V_ref = {case.wind.v_ref:g} m/s at point p[/]", highlight=False)
                 with BatchDisplay() as display:
                     report = run_critical(result, executor=executor, json_dir=json_dir, progress=display, cancel=cancel)
-                console.print(dynamic_table(report))
+                console.print(dynamic_table(report, result, case.wind.v_ref))
                 if report.cancelled:
                     raise typer.Exit(130)
                 if report.failed:
@@ -575,12 +601,14 @@ def _scan_each_model(case_file: Path, case: Any, grid: Any, names: tuple[str | N
 def scan(
     case_file: CaseArg,
     distance: Annotated[str | None, typer.Option(
-        "--distance", help="R values START:STOP:STEP (metres, or with a Dj suffix multiples of D_j) or a list "
-                           "(default 0.5:2.5:0.1Dj).", show_default=False)] = None,
+        "--distance", help="R values START:STOP:STEP or a list, each with its unit: m (metres) or Dj (multiples "
+                           "of D_j), after every number or once after the last (720m, 1.2Dj,1.6Dj, 0.5:2.5:0.1Dj; "
+                           "default 0.5:2.5:0.1Dj). A bare number is refused.", show_default=False)] = None,
     angle: Annotated[str | None, typer.Option(
         "--angle", help="Θ values START:STOP:STEP or a list, degrees (default -80:80:10).", show_default=False)] = None,
     jet_diameter: Annotated[str | None, typer.Option(
-        "--jet-diameter", help="D_j values START:STOP:STEP or a list, metres (default: the case's D_j).",
+        "--jet-diameter", help="D_j values START:STOP:STEP or a list in m, the unit after every number or once "
+                               "after the last (600m, 600:900:100m; default: the case's D_j).",
         show_default=False)] = None,
     csv_out: Annotated[Path | None, typer.Option("--csv", help="Write every scan point to this CSV file.",
                                                  show_default=False, parser=path_value)] = None,

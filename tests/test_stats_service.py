@@ -219,6 +219,7 @@ def test_excel_summary_design_block(run9, tmp_path):
     (still air + wind) design reaction, intervals and the flag state, from the JSON values."""
     from openpyxl import load_workbook
 
+    from linecheck.excel.design import HEADERS
     from linecheck.excel.writer import write_workbook
 
     doc = json.loads(json.dumps(run_to_dict(run9)))
@@ -234,8 +235,33 @@ def test_excel_summary_design_block(run9, tmp_path):
         assert body[r][cols["design total\n(kN)"]] == pytest.approx(e["peak_dynamic_total"]["gumbel"]["design"] / 1e3)
         assert body[r][cols["design peak\nwind (kN)"]] == pytest.approx(e["peak_dynamic"]["gumbel"]["design"] / 1e3)
         assert body[r][cols["still air\n(kN)"]] == pytest.approx(doc["still_air"]["reactions"][r] / 1e3)
-    lo, hi = doc["reactions"]["Ry"]["GF_Dy"]["ci"]
-    assert body["Ry"][cols["GF_Dy\n95 % CI"]] == f"[{lo:.3f}, {hi:.3f}]"
+    # each 95 % interval is two numbers (low, high) in the statistic's own format (issue 34)
+    for key, mean, low, high in (("GF_Dy", "GF_Dy", "GF_Dy 95 %\nCI low", "GF_Dy 95 %\nCI high"),
+                                 ("GF_QS", "GF_QS", "GF_QS 95 %\nCI low", "GF_QS 95 %\nCI high"),
+                                 ("Cont_R", "Cont_R\n(%)", "Cont_R 95 %\nCI low (%)", "Cont_R 95 %\nCI high (%)")):
+        lo, hi = doc["reactions"]["Ry"][key]["ci"]
+        assert body["Ry"][cols[low]] == pytest.approx(lo) and body["Ry"][cols[high]] == pytest.approx(hi)
+        mean_fmt = ws.cell(row=head + 3, column=cols[mean] + 1).number_format
+        assert ws.cell(row=head + 3, column=cols[low] + 1).number_format == mean_fmt
+    assert not any(isinstance(v, str) and v.startswith("[") for r in rows[head + 1:head + 4] for v in r)
+    # printing: the print area holds the design block and every note; the notes wrap inside it
+    from openpyxl.utils import column_index_from_string, get_column_letter
+
+    area = ws.print_area.split("!")[1].replace("$", "")
+    right, bottom = area.split(":")[1].rstrip("0123456789"), int(area.split(":")[1].lstrip("ABCDEFGHIJKLMNOPQRSTUVWXYZ"))
+    right_col = column_index_from_string(right)
+    assert right_col >= max(cols.values()) + 1 and bottom >= len(rows)
+    notes = [r for r in range(1, ws.max_row + 1) if ws.cell(row=r, column=1).style == "lc_note"
+             and isinstance(ws.cell(row=r, column=1).value, str)]
+    assert len(notes) >= 5
+    merged = {str(m) for m in ws.merged_cells.ranges}
+    for r in notes:
+        assert f"A{r}:{right}{r}" in merged and ws.cell(row=r, column=1).alignment.wrap_text
+        width = sum(ws.column_dimensions[get_column_letter(c)].width or 8.43 for c in range(1, right_col + 1))
+        lines = ws.row_dimensions[r].height / 12.0
+        assert lines * width * 1.1 >= len(ws.cell(row=r, column=1).value)
+    for k, (label, width) in enumerate(HEADERS[:-1]):  # every design column as wide as it asks
+        assert ws.column_dimensions[get_column_letter(cols[label] + 1)].width >= width
 
 
 def test_batch_until_matches_run_until(tmp_path):
@@ -253,3 +279,4 @@ def test_batch_until_matches_run_until(tmp_path):
     ref = service.run_until(load_case(case), 0.03, max_realizations=30)
     assert doc["realizations"] == ref.realizations.size and doc["until"]["achieved"] == ref.until.achieved
     assert doc["reactions"] == json.loads(json.dumps(run_to_dict(ref)["reactions"]))
+

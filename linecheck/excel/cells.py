@@ -8,6 +8,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from openpyxl.styles import Alignment, Font
+from openpyxl.utils import get_column_letter
 from openpyxl.worksheet.hyperlink import Hyperlink
 from openpyxl.worksheet.worksheet import Worksheet
 
@@ -165,6 +166,30 @@ def page_setup(ws: Worksheet, like: Worksheet | None, *, landscape: bool = True)
     ws.page_margins.header = ws.page_margins.footer = 0.3
     ws.oddFooter.left.text = "linecheck design sheet"
     ws.oddFooter.right.text = "page &P of &N"
+
+
+#: Characters of the 9 pt note font per unit of Excel column width (the width unit is one
+#: character of the 11 pt default font), rounded down so that an estimate never falls short.
+NOTE_CHARS_PER_WIDTH = 1.1
+NOTE_LINE_HEIGHT = 12.0  # [pt] one line of the 9 pt note font
+
+
+def wrap_notes(ws: Worksheet, first_row: int, last_row: int, right: int) -> None:
+    """Keep the notes inside columns A..``right`` (the print area): every note of rows
+    ``first_row``..``last_row`` (an ``lc_note`` cell in column A, the rest of its row empty) is
+    merged across them and wrapped, its row as tall as the lines it needs (Excel does not
+    fit a merged row's height itself)."""
+    widths = [ws.column_dimensions[get_column_letter(c)].width or 8.43 for c in range(1, right + 1)]
+    chars = max(20.0, sum(widths) * NOTE_CHARS_PER_WIDTH)
+    for r in range(first_row, last_row + 1):
+        cell = ws.cell(row=r, column=1)
+        if cell.style != "lc_note" or not isinstance(cell.value, str) or right < 2:
+            continue
+        if any(ws.cell(row=r, column=c).value not in (None, "") for c in range(2, right + 1)):
+            continue
+        ws.merge_cells(start_row=r, start_column=1, end_row=r, end_column=right)
+        align(cell, wrap_text=True, vertical="top")
+        ws.row_dimensions[r].height = NOTE_LINE_HEIGHT * max(1, math.ceil(len(cell.value) / chars))
 
 
 class Cursor:

@@ -1,7 +1,7 @@
 """The "Design values" block of the Summary sheet (issue 18): per case and reaction (R_x, R_y, R_z)
 the Gumbel design peak, the total (still air + wind) design reaction, GF_Dy / GF_QS / Cont_R with
-their 95 % intervals, the Cont_R flag state, and a "how to read" block where GF < 1 or a negative
-Cont_BG occurs.  Names, units and meanings come from the one statistics table
+their 95 % intervals (two number cells, low and high), the Cont_R flag state, and a "how to read"
+block where GF < 1 or a negative Cont_BG occurs.  Names, units and meanings come from the one statistics table
 (:data:`linecheck.io.document.STAT_TABLE`)."""
 
 from __future__ import annotations
@@ -9,6 +9,7 @@ from __future__ import annotations
 from typing import Any
 
 from openpyxl.styles import Font
+from openpyxl.utils import get_column_letter
 from openpyxl.worksheet.worksheet import Worksheet
 
 from ..io.display import flag_text, how_to_read
@@ -17,18 +18,22 @@ from . import template as tpl
 from .cells import KN, Cursor, align, excel_format, is_num, stat_cell
 
 REACTIONS_ALL = ("Rx", "Ry", "Rz")
+#: Header and column width (characters) of each column; a 95 % interval is two number cells
+#: (low, high) in the statistic's own format, so a spreadsheet can compute with them.
 HEADERS = (("Case", 16), ("Reaction", 8), ("still air\n(kN)", 9), ("design peak\nwind (kN)", 10),
-           ("design total\n(kN)", 10), ("ppcc", 7), ("GF_Dy", 8), ("GF_Dy\n95 % CI", 13), ("GF_QS", 8),
-           ("GF_QS\n95 % CI", 13), ("Cont_R\n(%)", 8), ("Cont_R\n95 % CI", 13), ("dynamic analysis", 30))
+           ("design total\n(kN)", 10), ("ppcc", 7),
+           ("GF_Dy", 8), ("GF_Dy 95 %\nCI low", 11), ("GF_Dy 95 %\nCI high", 11),
+           ("GF_QS", 8), ("GF_QS 95 %\nCI low", 11), ("GF_QS 95 %\nCI high", 11),
+           ("Cont_R\n(%)", 8), ("Cont_R 95 %\nCI low (%)", 12), ("Cont_R 95 %\nCI high (%)", 12),
+           ("dynamic analysis", 9))  # its text runs on into the empty cells to its right (inside the print area)
 
 
-def _ci(entry: StatValue, pct: bool = False) -> str:
+def _ci(entry: StatValue) -> tuple[float | None, float | None]:
+    """The 95 % interval (low, high) of a statistic as numbers, None where absent or null."""
     ci = entry.ci or (None, None)
     if not (is_num(ci[0]) and is_num(ci[1])):
-        return ""
-    if pct:
-        return f"[{100 * ci[0]:.1f}, {100 * ci[1]:.1f}] %"
-    return f"[{ci[0]:.3f}, {ci[1]:.3f}]"
+        return None, None
+    return float(ci[0]), float(ci[1])
 
 
 def write_design_block(ws: Worksheet, docs: list, top: int, left: int = 1) -> int:
@@ -43,8 +48,10 @@ def write_design_block(ws: Worksheet, docs: list, top: int, left: int = 1) -> in
                        "95 % confidence intervals of the mean over the realizations)", "lc_text")
     ws.cell(row=top, column=left).font = Font(name="Calibri", size=11, bold=True)
     cur.row = top + 1
-    for k, (label, _w) in enumerate(HEADERS):
+    for k, (label, width) in enumerate(HEADERS):
         cur.put(cur.row, left + k, label, "lc_header")
+        dim = ws.column_dimensions[get_column_letter(left + k)]
+        dim.width = max(width, dim.width or 0)  # wide enough for its header and numbers in print too
     ws.row_dimensions[cur.row].height = 30
     row = cur.row + 1
     notes: list[str] = []
@@ -65,11 +72,11 @@ def write_design_block(ws: Worksheet, docs: list, top: int, left: int = 1) -> in
             for key in ("GF_Dy", "GF_QS", "Cont_R"):
                 st = STAT_BY_NAME[key]
                 vals.append((stat_cell(st, e[key].mean), excel_format(st)))
-                vals.append((_ci(e[key], st.kind == "fraction"), None))
+                vals.extend((v, excel_format(st)) for v in _ci(e[key]))
             state = e.dynamic_analysis
             vals.append((flag_text(state), None))
             for k, (v, fmt) in enumerate(vals):
-                style = "lc_text" if k in (0, 1, 7, 9, 11, 12) else "lc_number"
+                style = "lc_text" if k in (0, 1, len(vals) - 1) else "lc_number"
                 cell = cur.put(row, left + k, v, style, fmt)
                 if k == 1:
                     align(cell, horizontal="center")

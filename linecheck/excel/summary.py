@@ -26,6 +26,7 @@ from .cells import (
     page_setup,
     stat_cell,
     wind_label,
+    wrap_notes,
 )
 from .charts import chart_title
 
@@ -144,12 +145,15 @@ def write_summary(ws: Worksheet, docs: list[RunDocument | FailedRun], names: lis
              "Ry transverse (wind), Rz vertical" + ("" if "Rz" in summary_reactions else
                                                     " (Rz on the case sheets: its wind-induced part is small beside "
                                                     "the conductor weight)") + ".")
+    from .design import HEADERS as DESIGN_HEADERS
     from .design import write_design_block  # issue 18: design values, intervals, flag states, how to read
 
     cur.row = write_design_block(ws, docs, cur.row + 1, left)
     ws.auto_filter.ref = f"{get_column_letter(left)}{top}:{get_column_letter(right)}{last}"
     ws.freeze_panes = ws.cell(row=top + 1, column=left + 1)
     ws.print_title_rows = f"{top}:{top}"
+    right = max(right, left + len(DESIGN_HEADERS) - 1)  # the print area holds the design block and the notes
+    wrap_notes(ws, last + 1, cur.row, right)
     ws.print_area = f"A1:{get_column_letter(right)}{cur.row}"
     ws.sheet_properties.pageSetUpPr.fitToPage = True
     ws.page_setup.fitToWidth = 1

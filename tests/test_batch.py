@@ -605,6 +605,25 @@ def test_summary_flags_cont_r_and_failed_sanity_check(short_cases):
     table = render(summary_table(report)).splitlines()
     row = next(ln for ln in table if "flagged" in ln)
     assert "25.0" in row and "Cont_R>10% Ry" in row and "t/f check" in row
+    # every reaction a Cont_R flag names has its value in the table (issue 34): Rx and Ry columns,
+    # Rz (no column) in the flag itself
+    header = next(ln for ln in table if "Cont_R Ry %" in ln)
+    assert "Cont_R Rx %" in header
+    d = flagged.doc.to_json()
+    d["reactions"]["Rx"]["Cont_R"]["mean"] = 0.097
+    d["reactions"]["Rx"]["dynamic_analysis"] = "inconclusive"
+    d["reactions"]["Rz"]["Cont_R"]["mean"] = 0.123
+    d["reactions"]["Rz"]["dynamic_analysis"] = "recommended"
+    both = copy.deepcopy(flagged)
+    both.name = "both"
+    both.doc = RunDocument.from_json(d)
+    lines = render(summary_table(BatchReport([both]))).splitlines()
+    header = next(ln for ln in lines if "Cont_R Ry %" in ln)
+    row = next(ln for ln in lines if "both" in ln)
+    cells = [c.strip() for c in row.split("│")]
+    names = [c.strip() for c in header.split("┃")]
+    assert cells[names.index("Cont_R Rx %")] == "9.7" and cells[names.index("Cont_R Ry %")] == "25.0"
+    assert "Cont_R>10% Ry Rz 12.3%" in row and "Cont_R~10% Rx" in row
     clean_row = next(ln for ln in table if clean.name in ln)
     assert "5.0" in clean_row and "Cont_R>10%" not in clean_row and "t/f" not in clean_row
     notes = summary_notes(report)

@@ -298,27 +298,36 @@ def _sanity_text(item: SanityItem) -> str:
 def summary_table(report: Any) -> Table:
     """One row per case: status, peak reactions, gust factors, Cont_R, flags, time, JSON or error.
 
-    Flags: ``Cont_R>10% <reactions>`` (dynamic analysis recommended) and ``t/f check`` (the
-    time- and frequency-domain r.m.s. of a synoptic case differ); :func:`summary_notes` explains them.
+    Flags: ``Cont_R>10% <reactions>`` (dynamic analysis recommended), ``Cont_R~10% <reactions>``
+    (inconclusive) and ``t/f check`` (the time- and frequency-domain r.m.s. of a synoptic case
+    differ); :func:`summary_notes` explains them.  Rx and Ry have their Cont_R columns,
+    highlighted as their flags; a flag on Rz (no column) carries its value, ``Rz 12.3%``.
     """
     t = Table(title="batch summary (tower of interest)", title_justify="left")
     for col, just in (("case", "left"), ("status", "left"), ("n", "right"), ("peak Rx kN", "right"),
-                      ("peak Ry kN", "right"), ("GF_Dy Rx", "right"), ("GF_Dy Ry", "right"), ("Cont_R Ry %", "right"),
-                      ("flags", "left"), ("time s", "right"), ("result / error", "left")):
+                      ("peak Ry kN", "right"), ("GF_Dy Rx", "right"), ("GF_Dy Ry", "right"), ("Cont_R Rx %", "right"),
+                      ("Cont_R Ry %", "right"), ("flags", "left"), ("time s", "right"), ("result / error", "left")):
         t.add_column(col, justify=just, overflow="fold")
     colours = {"done": "green", "skipped": "cyan", "failed": "red", "cancelled": "yellow", "pending": "yellow"}
     for o in report.outcomes:
         d = o.doc
         flagged = cont_r_flags(d)
-        cont_ry = _kn(d, "Ry", "Cont_R", "{:.1f}")
-        if "Ry" in flagged:
-            cont_ry = f"[bold yellow]{cont_ry}[/]"
+        unsure = cont_r_flags(d, "inconclusive")
+        cont = {}
+        for r in ("Rx", "Ry"):
+            cont[r] = _kn(d, r, "Cont_R", "{:.1f}")
+            if r in flagged:
+                cont[r] = f"[bold yellow]{cont[r]}[/]"
+            elif r in unsure:
+                cont[r] = f"[yellow]{cont[r]}[/]"
+        def named(rs: list[str]) -> str:
+            return " ".join(r if r in cont else f"{r} {_kn(d, r, 'Cont_R', '{:.1f}')}%" for r in rs)
+
         flags = []
         if flagged:
-            flags.append(f"[bold yellow]Cont_R>10% {' '.join(flagged)}[/]")
-        unsure = cont_r_flags(d, "inconclusive")
+            flags.append(f"[bold yellow]Cont_R>10% {named(flagged)}[/]")
         if unsure:
-            flags.append(f"[yellow]Cont_R~10% {' '.join(unsure)}[/]")
+            flags.append(f"[yellow]Cont_R~10% {named(unsure)}[/]")
         if sanity_failures(d):
             flags.append("[bold red]t/f check[/]")
         t.add_row(
@@ -326,7 +335,7 @@ def summary_table(report: Any) -> Table:
             str(d.realizations) if d else "",
             _kn(d, "Rx", "peak_dynamic"), _kn(d, "Ry", "peak_dynamic"),
             _kn(d, "Rx", "GF_Dy", "{:.3f}"), _kn(d, "Ry", "GF_Dy", "{:.3f}"),
-            cont_ry, " ".join(flags),
+            cont["Rx"], cont["Ry"], " ".join(flags),
             f"{o.elapsed:.1f}" if o.status == "done" else "",
             escape(o.error if o.error else (str(o.json_path) if o.json_path and o.ok else "")),
         )

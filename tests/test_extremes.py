@@ -195,3 +195,12 @@ def test_how_to_read_notes_only_when_they_apply():
     assert how_to_read(doc(1.1, 0.05)) == []
     assert how_to_read(doc(0.94, -0.04)) == [HOW_TO_READ_GF_BELOW_1, HOW_TO_READ_NEGATIVE_CONT_BG]
     assert how_to_read(doc(0.99, 0.01)) == [HOW_TO_READ_GF_BELOW_1]
+
+    # a negative Cont_R is explained too (issue 34): the dynamic peak below the quasi-static one
+    from linecheck.io.display import HOW_TO_READ_NEGATIVE_CONT_R
+
+    neg_r = SimpleNamespace(reactions={"Rx": means(GF_Dy=1.1, GF_QS=1.2, Cont_BG=0.1, Cont_R=-0.08)})
+    assert how_to_read(neg_r) == [HOW_TO_READ_NEGATIVE_CONT_R]
+    assert "GF_Dy < GF_QS" in HOW_TO_READ_NEGATIVE_CONT_R and "damping" in HOW_TO_READ_NEGATIVE_CONT_R
+    pos_r = SimpleNamespace(reactions={"Rx": means(GF_Dy=1.3, GF_QS=1.2, Cont_BG=0.1, Cont_R=0.08)})
+    assert how_to_read(pos_r) == []

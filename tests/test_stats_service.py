@@ -280,3 +280,23 @@ def test_batch_until_matches_run_until(tmp_path):
     assert doc["realizations"] == ref.realizations.size and doc["until"]["achieved"] == ref.until.achieved
     assert doc["reactions"] == json.loads(json.dumps(run_to_dict(ref)["reactions"]))
 
+
+def test_negative_cont_r_is_explained_in_excel_and_the_tui_figure(run9, tmp_path):
+    """A negative mean Cont_R (the dynamic peak below the quasi-static one) gets its "how to read"
+    note on the Summary sheet and on the TUI's contributions figure (issue 34, item 8)."""
+    from openpyxl import load_workbook
+
+    from linecheck.excel.writer import write_workbook
+    from linecheck.io.display import HOW_TO_READ_NEGATIVE_CONT_R
+    from linecheck.io.document import RunDocument
+    from linecheck.tui.figures import contributions
+
+    doc = json.loads(json.dumps(run_to_dict(run9)))
+    doc["reactions"]["Ry"]["Cont_R"]["mean"] = -0.05
+    texts = [c for r in load_workbook(write_workbook([doc], tmp_path / "r.xlsx"))["Summary"].iter_rows(values_only=True)
+             for c in r if isinstance(c, str)]
+    assert HOW_TO_READ_NEGATIVE_CONT_R in texts and "How to read" in texts
+    fig = contributions([("", RunDocument.from_json(doc))])
+    assert any(n.startswith("Cont_R < 0") for n in fig.notes)
+    doc["reactions"]["Ry"]["Cont_R"]["mean"] = 0.05
+    assert not any(n.startswith("Cont_R < 0") for n in contributions([("", RunDocument.from_json(doc))]).notes)

@@ -27,6 +27,11 @@ HOW_TO_READ_GF_BELOW_1 = (
 HOW_TO_READ_NEGATIVE_CONT_BG = (
     "Cont_BG < 0: the background lowered the peak below the largest mean (GF_QS < 1) in these "
     "realizations; it is sampling, not a relief the design can count on.")
+HOW_TO_READ_NEGATIVE_CONT_R = (
+    "Cont_R < 0: the dynamic peak max|M+B+R| is below the quasi-static one max|M+B| (GF_Dy < GF_QS): the "
+    "resonant part R is out of phase with B at the peak, inertia and damping lowering the response. Typical "
+    "of heavily damped (aerodynamic damping) or very flexible systems, whose frequencies lie below the "
+    "gusts; a small negative mean is also sampling. Design for the dynamic peak, not the quasi-static one.")
 
 #: The frame every tower's reactions are given in (docs/method.md, "Reactions in tower frames"):
 #: the console, the TUI, the JSON and the Excel sheets all use it and name it.
@@ -90,14 +95,17 @@ def flag_text(state: str | None) -> str:
 
 
 def how_to_read(doc: Any) -> list[str]:
-    """The "how to read" notes that apply to ``doc`` (a RunDocument: GF < 1, negative Cont_BG at
-    the tower of interest)."""
+    """The "how to read" notes that apply to ``doc`` (a RunDocument: GF < 1, negative Cont_BG,
+    negative Cont_R at the tower of interest)."""
     notes = []
-    means = [(k, blk[k].mean) for blk in doc.reactions.values() for k in ("GF_Dy", "GF_QS", "Cont_BG")]
-    if any(m is not None and m < 1.0 for k, m in means if k != "Cont_BG"):
+    means = [(k, blk[k].mean) for blk in doc.reactions.values() for k in ("GF_Dy", "GF_QS", "Cont_BG", "Cont_R")
+             if k in blk.stats]
+    if any(m is not None and m < 1.0 for k, m in means if k in ("GF_Dy", "GF_QS")):
         notes.append(HOW_TO_READ_GF_BELOW_1)
     if any(m is not None and m < 0.0 for k, m in means if k == "Cont_BG"):
         notes.append(HOW_TO_READ_NEGATIVE_CONT_BG)
+    if any(m is not None and m < 0.0 for k, m in means if k == "Cont_R"):
+        notes.append(HOW_TO_READ_NEGATIVE_CONT_R)
     return notes
 
 

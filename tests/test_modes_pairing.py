@@ -14,7 +14,6 @@ from linecheck.core.case import load_case
 from linecheck.core.model import build_model
 from linecheck.core.modes import natural_modes, pair_by_shape
 from linecheck.core.spectral import complex_modes
-from linecheck.core.system import LineSystem
 
 from .conftest import CASES
 

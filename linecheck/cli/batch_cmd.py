@@ -295,6 +295,11 @@ def _sanity_text(item: SanityItem) -> str:
             f"(allowed difference {kn(item.allowed_difference)})")
 
 
+def _flag_names(doc: RunDocument | None, reactions: list[str], columns: dict[str, str]) -> str:
+    """The reactions a Cont_R flag names; one without a Cont_R column carries its value (``Rz 12.3%``)."""
+    return " ".join(r if r in columns else f"{r} {_kn(doc, r, 'Cont_R', '{:.1f}')}%" for r in reactions)
+
+
 def summary_table(report: Any) -> Table:
     """One row per case: status, peak reactions, gust factors, Cont_R, flags, time, JSON or error.
 
@@ -320,14 +325,11 @@ def summary_table(report: Any) -> Table:
                 cont[r] = f"[bold yellow]{cont[r]}[/]"
             elif r in unsure:
                 cont[r] = f"[yellow]{cont[r]}[/]"
-        def named(rs: list[str]) -> str:
-            return " ".join(r if r in cont else f"{r} {_kn(d, r, 'Cont_R', '{:.1f}')}%" for r in rs)
-
         flags = []
         if flagged:
-            flags.append(f"[bold yellow]Cont_R>10% {named(flagged)}[/]")
+            flags.append(f"[bold yellow]Cont_R>10% {_flag_names(d, flagged, cont)}[/]")
         if unsure:
-            flags.append(f"[yellow]Cont_R~10% {named(unsure)}[/]")
+            flags.append(f"[yellow]Cont_R~10% {_flag_names(d, unsure, cont)}[/]")
         if sanity_failures(d):
             flags.append("[bold red]t/f check[/]")
         t.add_row(

@@ -150,8 +150,8 @@ def contributions(docs: list[tuple[str, RunDocument]]) -> Figure:
     notes = ("Cont_BG < 0: max|M+B| is below max|M| (B negative where M peaks)",) \
         if any(v < 0 for v in parts["Cont_BG"]) else ()
     if any(v < 0 for v in parts["Cont_R"]):
-        notes += ("Cont_R < 0: max|M+B+R| is below max|M+B| (R against B at the peak: inertia and damping "
-                  "lower the response)",)
+        notes += (("Cont_R < 0: max|M+B+R| is below max|M+B| (R against B at the peak: inertia and damping "
+                   "lower the response)"),)
     return Figure(
         title="contributions to the peak dynamic reaction, Cont_M / Cont_BG / Cont_R (%), mean over realizations",
         xlabel="", ylabel="%", notes=notes,

@@ -605,7 +605,7 @@ def test_summary_flags_cont_r_and_failed_sanity_check(short_cases):
     table = render(summary_table(report)).splitlines()
     row = next(ln for ln in table if "flagged" in ln)
     assert "25.0" in row and "Cont_R>10% Ry" in row and "t/f check" in row
-    # every reaction a Cont_R flag names has its value in the table (issue 34): Rx and Ry columns,
+    # every reaction a Cont_R flag names has its value in the table: Rx and Ry columns,
     # Rz (no column) in the flag itself
     header = next(ln for ln in table if "Cont_R Ry %" in ln)
     assert "Cont_R Rx %" in header

@@ -1,4 +1,4 @@
-"""Values the schema allows but that are probably mistyped (issue 34, item 8): a weight typed in
+"""Values the schema allows but that are probably mistyped: a weight typed in
 kg/m is warned about in one line by ``check``, ``static``, ``modes`` and ``run``."""
 
 from __future__ import annotations

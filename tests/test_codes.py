@@ -312,7 +312,7 @@ def test_excel_codes_sheet(short_run):
     asce = doc["codes"]["ASCE74"]["towers"][0]["Ry"]
     assert rows[0][1] == "ASCE74" and rows[0][4] == 1 and rows[0][5] == "Ry"
     assert rows[0][6] == pytest.approx(asce["code_load"] / 1e3) and rows[0][9] == asce["verdict"]
-    # the note says what the number is: the Gumbel design value, not the mean of the peak (issue 34)
+    # the note says what the number is: the Gumbel design value, not the mean of the peak
     notes = [c for row in ws.iter_rows(values_only=True) for c in row if isinstance(c, str) and "linecheck peak:" in c]
     assert len(notes) == 1 and C.CODES_PEAK in notes[0] and "mean over realizations of the wind" not in notes[0]
 

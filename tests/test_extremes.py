@@ -196,7 +196,7 @@ def test_how_to_read_notes_only_when_they_apply():
     assert how_to_read(doc(0.94, -0.04)) == [HOW_TO_READ_GF_BELOW_1, HOW_TO_READ_NEGATIVE_CONT_BG]
     assert how_to_read(doc(0.99, 0.01)) == [HOW_TO_READ_GF_BELOW_1]
 
-    # a negative Cont_R is explained too (issue 34): the dynamic peak below the quasi-static one
+    # a negative Cont_R is explained too: the dynamic peak below the quasi-static one
     from linecheck.io.display import HOW_TO_READ_NEGATIVE_CONT_R
 
     neg_r = SimpleNamespace(reactions={"Rx": means(GF_Dy=1.1, GF_QS=1.2, Cont_BG=0.1, Cont_R=-0.08)})

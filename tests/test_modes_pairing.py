@@ -1,5 +1,5 @@
 """``linecheck modes`` pairs each damped mode with its undamped counterpart by shape (MAC), not
-by rank (issue 34, item 8)."""
+by rank."""
 
 from __future__ import annotations
 

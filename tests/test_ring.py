@@ -187,7 +187,7 @@ def test_statics_every_mean_state_converges_and_balances():
     assert np.allclose(R_sum[:, 2], weight, rtol=1e-9)
 
 
-# --------------------------------------------------------------------------- issue 36 acceptance
+# --------------------------------------------------------------------------- the travelling downburst's acceptance
 PROBE_HEIGHTS = (5.0, 10.0, 20.0, 25.0, 40.0, 80.0, 150.0)  # m, D_j = 1000 m
 
 

@@ -179,7 +179,7 @@ def test_cli_scan_table_csv_and_dynamic(tmp_path):
     assert "full analysis at the critical configurations" in r.output
     assert "by the expected dynamic peak" in r.output and "same position" in r.output
     # one table says which number to design for: the full analysis at the case's V_ref at p,
-    # beside the scan's expected peak and the V_ref at p it was ranked at (issue 34)
+    # beside the scan's expected peak and the V_ref at p it was ranked at
     flat = " ".join(r.output.replace("│", " ").split())
     assert "design values: full analysis at the critical configurations at the case's V_ref = 40 m/s at point p" in flat
     assert 'design for the "design peak" columns' in flat and "a ranking, not a design value" in flat

@@ -235,7 +235,7 @@ def test_excel_summary_design_block(run9, tmp_path):
         assert body[r][cols["design total\n(kN)"]] == pytest.approx(e["peak_dynamic_total"]["gumbel"]["design"] / 1e3)
         assert body[r][cols["design peak\nwind (kN)"]] == pytest.approx(e["peak_dynamic"]["gumbel"]["design"] / 1e3)
         assert body[r][cols["still air\n(kN)"]] == pytest.approx(doc["still_air"]["reactions"][r] / 1e3)
-    # each 95 % interval is two numbers (low, high) in the statistic's own format (issue 34)
+    # each 95 % interval is two numbers (low, high) in the statistic's own format
     for key, mean, low, high in (("GF_Dy", "GF_Dy", "GF_Dy 95 %\nCI low", "GF_Dy 95 %\nCI high"),
                                  ("GF_QS", "GF_QS", "GF_QS 95 %\nCI low", "GF_QS 95 %\nCI high"),
                                  ("Cont_R", "Cont_R\n(%)", "Cont_R 95 %\nCI low (%)", "Cont_R 95 %\nCI high (%)")):
@@ -283,7 +283,7 @@ def test_batch_until_matches_run_until(tmp_path):
 
 def test_negative_cont_r_is_explained_in_excel_and_the_tui_figure(run9, tmp_path):
     """A negative mean Cont_R (the dynamic peak below the quasi-static one) gets its "how to read"
-    note on the Summary sheet and on the TUI's contributions figure (issue 34, item 8)."""
+    note on the Summary sheet and on the TUI's contributions figure."""
     from openpyxl import load_workbook
 
     from linecheck.excel.writer import write_workbook

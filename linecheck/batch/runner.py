@@ -373,7 +373,7 @@ def run_batch(
             st.done = o.realizations
             overall_done += o.realizations
 
-    # ---- the resource guard of every case to run, before any starts (issue 14): each task checks
+    # ---- the resource guard of every case to run, before any starts: each task checks
     # its own chunk, but the merged result keeps every realization's histories, so a case above
     # the memory limit fails here alone (its one-line estimate, a CaseError) and the others run
     for st in states:

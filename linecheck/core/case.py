@@ -686,7 +686,7 @@ class _TowerCtx(_Ctx):
 
 # A tower CSV's column names are quoted in a message only when they are short printable tokens
 # like these; anything else -- a file that is not a tower table (towers_file = "/etc/shadow") --
-# is refused without quoting its content (issue 35).
+# is refused without quoting its content.
 _COLUMN_TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_ .-]{0,31}")
 MAX_QUOTED_CELL = 40  # [characters] a longer cell is described by its length, not quoted
 

@@ -54,7 +54,7 @@ EN50341_TERRAINS = ("0", "I", "II", "III", "IV")
 
 #: What linecheck's peak beside a code load is (``linecheck_peak``, :func:`linecheck.service.design_peaks`):
 #: the one wording of the ``codes`` command, the TUI's Codes tab and the Excel Codes sheet.
-CODES_PEAK = ("design value of peak_dynamic (Gumbel fit at analysis.design_fractile, issue 18; the mean over "
+CODES_PEAK = ("design value of peak_dynamic (Gumbel fit at analysis.design_fractile; the mean over "
               "realizations when a single realization gives no fit) of the wind-induced peak |M + B + R| of the "
               "reaction, still air excluded: the same wind-induced quantity as the code's conductor wind load")
 

@@ -491,7 +491,7 @@ class DownburstField:
     t1: float = math.nan
     t_f: float = math.nan
     table: FieldTable | None = None
-    ring: ring_model.RingJet | None = None  # models "ring-jet", "ring-jet-inviscid" (issue 15)
+    ring: ring_model.RingJet | None = None  # models "ring-jet", "ring-jet-inviscid"
     point_xy: tuple[float, float] | None = None  # [m] plan position of p (section form; None: (point_p, 0))
 
     # -- model pieces

@@ -36,7 +36,7 @@ from .export_cmd import (
 )
 from .limits import MaxMemoryOpt, apply_max_memory
 from .scan_progress import ScanDisplay
-from .signals import sigterm_as_interrupt
+from .signals import sigterm_cancels
 from .stats_view import MaxRealOpt, UntilOpt, parse_until
 
 JobsOpt = Annotated[int | None, typer.Option(
@@ -365,7 +365,6 @@ def summary_notes(report: Any) -> list[str]:
 
 @app.command()
 @handle_errors
-@sigterm_as_interrupt()  # SIGTERM stops the batch like Ctrl-C: summary, results kept, exit 130
 def batch(
     cases: Annotated[list[Path], typer.Argument(help="Case files (TOML); shell globs like cases/paper/*.toml.",
                                                 show_default=False, parser=path_value)],
@@ -417,8 +416,8 @@ def batch(
     kernel_off = kernel_warning()  # compiled pieces off (Numba installed): one line, before the batch
     if kernel_off:
         limits_warn(kernel_off)
-    cancel = threading.Event()
-    with (make_executor(jobs, scheduler, connect_timeout) as executor,
+    cancel = threading.Event()  # set by SIGTERM too: the batch stops like Ctrl-C (summary, results kept, 130)
+    with (sigterm_cancels(cancel), make_executor(jobs, scheduler, connect_timeout) as executor,
           BatchDisplay(interval=progress_interval) as display):
         report = run_batch(paths, executor=executor, json_dir=out_dir, resume=resume, chunk_size=chunk,
                            progress=display, cancel=cancel,
@@ -560,8 +559,8 @@ def _scan_each_model(case_file: Path, case: Any, grid: Any, names: tuple[str | N
     from ..batch import make_executor, run_critical, run_scan, write_scan_csv
     from .limits import warn as limits_warn
 
-    cancel = threading.Event()
-    with make_executor(jobs, scheduler, connect_timeout) as executor:
+    cancel = threading.Event()  # set by SIGTERM too: the scan stops like Ctrl-C
+    with sigterm_cancels(cancel), make_executor(jobs, scheduler, connect_timeout) as executor:
         summary = []
         for k, model in enumerate(names):
             what = "scan" + (f" [{model}]" if model else "") + (" --dynamic" if dynamic else "")
@@ -608,7 +607,6 @@ def _scan_each_model(case_file: Path, case: Any, grid: Any, names: tuple[str | N
 
 @app.command()
 @handle_errors
-@sigterm_as_interrupt()  # SIGTERM stops the scan like Ctrl-C
 def scan(
     case_file: CaseArg,
     distance: Annotated[str | None, typer.Option(

@@ -287,11 +287,6 @@ def downdraft_scale(model: str | Closure = "ring-jet") -> float:
 
 
 # ---------------------------------------------------------------- outflow
-def _wood(eta):
-    # Wood, Kwok, Motteram & Fletcher (2001): f_z = 1.55 eta^(1/6) [1 - erf(0.70 eta)], eta = z/delta
-    return wood(eta)
-
-
 def radial_profile(rho, model: str | Closure = "ring-jet"):
     """f_r(rho) [-] of Holmes & Oliver (2000) Eq. 1-2 with the model's r_max and decay length."""
     c = closure(model)
@@ -302,7 +297,7 @@ def radial_profile(rho, model: str | Closure = "ring-jet"):
 def vertical_profile(zeta, model: str | Closure = "ring-jet"):
     """f_z(zeta) [-] of Wood et al. (2001), its maximum (1.00001) at zeta = z_max."""
     c = closure(model)
-    return _wood(np.asarray(zeta, dtype=float) * ETA_PEAK / c.z_max)
+    return wood(np.asarray(zeta, dtype=float) * ETA_PEAK / c.z_max)  # Wood et al. (2001) f_z
 
 
 def wall_jet(rho, zeta, model: str | Closure = "ring-jet"):

@@ -25,14 +25,12 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import lapack
 
 from . import kernel
+from .banded import ColumnSolver, factor as _factor, solve as _solve
 from .errors import Cancelled, NumericalError
 from .model import CSRArrays, LinearModel, band_blocks, band_to_csr_stack, rotate_band
 
-_dpbtrf = lapack.dpbtrf
-_dpbtrs = lapack.dpbtrs
 try:  # the kernel behind scipy's CSR @ dense product, called without the per-call dispatch
     from scipy.sparse._sparsetools import csr_matvecs as _csr_matvecs
 except ImportError:  # pragma: no cover - a scipy without it: the public product (same bits)
@@ -56,23 +54,6 @@ class Newmark:
     @property
     def a2(self) -> float:
         return 4.0 / self.dt  # 1/(beta dt)
-
-
-def _factor(K_band: np.ndarray, diag_add: np.ndarray, what: str, band_add: np.ndarray | None = None) -> np.ndarray:
-    """Banded Cholesky of K + band_add + diag(diag_add); NumericalError if not positive definite."""
-    ab = K_band.copy() if band_add is None else K_band + band_add
-    ab[-1] += diag_add
-    c, info = _dpbtrf(ab, lower=0, overwrite_ab=1)
-    if info != 0:
-        raise NumericalError(f"{what}: matrix is not positive definite (LAPACK dpbtrf info {info})")
-    return c
-
-
-def _solve(c: np.ndarray, b: np.ndarray) -> np.ndarray:
-    x, info = _dpbtrs(c, b, lower=0)
-    if info != 0:  # pragma: no cover - only for malformed input
-        raise NumericalError(f"banded solve failed (LAPACK dpbtrs info {info})")
-    return x
 
 
 #: values of the Newmark displacement history kept per block when the second-order tension
@@ -301,8 +282,7 @@ def integrate(
         if not compiled:
             U_new, V_new, A_new, tmp = (np.empty_like(U) for _ in range(4))
             rest_product = None if rest is None else _RestProduct(rest, a1, U.shape)
-            probe = np.zeros_like(U)
-            in_place = np.shares_memory(_dpbtrs(chat, probe.T, lower=0, overwrite_b=1)[0], probe)
+            solver = ColumnSolver(chat)  # each realization solved as if alone (banded.py)
         for b0 in range(int(s0), int(s1), block):
             b1 = min(b0 + block, int(s1))
             if compiled:  # the same arithmetic as the loop below, compiled (kernel.py)
@@ -323,11 +303,7 @@ def integrate(
                 U_new += Fb[k]
                 if rest_product is not None:
                     U_new += rest_product(U, V)  # C~_off (a1 u + v)
-                x, info = _dpbtrs(chat, U_new.T, lower=0, overwrite_b=1)  # solved in place
-                if info != 0:  # pragma: no cover - only for malformed input
-                    raise NumericalError(f"banded solve failed (LAPACK dpbtrs info {info})")
-                if not in_place:  # pragma: no cover - the LAPACK wrapper copies
-                    U_new[...] = x.T
+                solver.rows_in_place(U_new)
                 # trapezoidal relations of average acceleration: v' = 2/dt (u' - u) - v,
                 # a' = 2/dt (v' - v) - a  (= a0 (u' - u) - a2 v - a, Bathe Table 9.3)
                 np.subtract(U_new, U, out=V_new)
@@ -372,8 +348,9 @@ def integrate(
 def _rowdot(X: np.ndarray, BT: np.ndarray) -> np.ndarray:
     """X @ BT computed row by row in a fixed order (no BLAS): every realization's reactions
     are then bit-identical whichever other realizations share the call (batch chunking,
-    workers); a BLAS gemm rounds differently for different numbers of rows."""
-    return np.einsum("rd,dk->rk", X, BT, optimize=False)
+    workers); a BLAS gemm rounds differently for different numbers of rows.  X is made
+    C-contiguous first: einsum sums a contiguous row in another order than a strided one."""
+    return np.einsum("rd,dk->rk", np.ascontiguousarray(X), BT, optimize=False)
 
 
 def node_bases(model: LinearModel, c_band: np.ndarray) -> np.ndarray:

@@ -240,7 +240,7 @@ def build_model(system: LineSystem, state: StaticState) -> LinearModel:
         v = v_all[j]
         d = state.displacement[j]
         axis = np.array([d[0], d[1], d[2] - v]) / v  # from fixed point to attachment (points down)
-        axis /= np.linalg.norm(axis)
+        axis /= np.sqrt((axis[0] * axis[0] + axis[1] * axis[1]) + axis[2] * axis[2])  # as build_models
         P = np.outer(axis, axis)
         blk = k_ax * P + (state.insulator_force[j] / v) * (np.eye(3) - P)
         ins_blocks[j] = blk
@@ -331,9 +331,9 @@ def build_models(system: LineSystem, states: Sequence[StaticState]) -> list[Line
     k_ax = INSULATOR_AXIAL_FACTOR * ea_cable_el
     d = np.stack([s.displacement for s in states])[:, susp]  # (n_k, n_s, 3)
     axes = np.stack([d[..., 0], d[..., 1], d[..., 2] - v], axis=-1) / v[:, None]  # fixed point -> attachment
-    # |axis| by the dot product np.linalg.norm uses for one vector (bit-identical to build_model)
-    flat = axes.reshape(-1, 3)
-    axes /= np.sqrt(np.array([x.dot(x) for x in flat])).reshape(n_k, susp.size, 1)
+    # |axis| element-wise, as build_model (a BLAS dot of a 3-vector rounds by its alignment on
+    # OpenBLAS's SSE3 kernels, so a stacked state would not match one built alone)
+    axes /= np.sqrt((axes[..., 0] * axes[..., 0] + axes[..., 1] * axes[..., 1]) + axes[..., 2] * axes[..., 2])[..., None]
     P = axes[..., :, None] * axes[..., None, :]  # (n_k, n_s, 3, 3)
     fins = np.stack([s.insulator_force for s in states])[:, susp]  # (n_k, n_s)
     ins_blocks = k_ax * P + (fins / v)[..., None, None] * (np.eye(3) - P)
@@ -379,6 +379,24 @@ def build_models(system: LineSystem, states: Sequence[StaticState]) -> list[Line
     return [LinearModel(system, dm, ab[k], mass, trib, G[k], axes[k], axial_dof, K_axial[k]) for k in range(n_k)]
 
 
+def mul3(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """Stacked 3x3 matrix products A B, element by element (broadcast over leading axes).
+
+    Written as three multiply-adds in a fixed order instead of ``A @ B``: numpy's matmul
+    hands each 3x3 product to BLAS, and OpenBLAS's SSE3 (Prescott) kernels round such a
+    small product differently by the alignment of the matrix in memory, so a state's bits
+    depended on its position in a stack. Element-wise IEEE operations round the same
+    wherever the data lie, on every CPU.
+
+    Args:
+        A, B: shapes (..., 3, 3), broadcast against each other.
+    Returns:
+        shape (..., 3, 3).
+    """
+    return (A[..., :, 0, None] * B[..., None, 0, :] + A[..., :, 1, None] * B[..., None, 1, :]) \
+        + A[..., :, 2, None] * B[..., None, 2, :]
+
+
 def project_axial(model: LinearModel, ab: np.ndarray) -> np.ndarray:
     """P^T A P for a symmetric upper-band matrix A, P = I - a a^T at every suspension
     attachment node (identity elsewhere): removes the components along the insulator axes.
@@ -391,11 +409,11 @@ def project_axial(model: LinearModel, ab: np.ndarray) -> np.ndarray:
     D, E = band_blocks(ab)
     k = model.axial_dof // 3
     P = np.eye(3)[None] - model.axes[:, :, None] * model.axes[:, None, :]  # (n_s, 3, 3)
-    D[k] = P @ D[k] @ P
+    D[k] = mul3(mul3(P, D[k]), P)
     left = k > 0
-    E[k[left] - 1] = E[k[left] - 1] @ P[left]
+    E[k[left] - 1] = mul3(E[k[left] - 1], P[left])
     right = k < D.shape[0] - 1
-    E[k[right]] = P[right] @ E[k[right]]
+    E[k[right]] = mul3(P[right], E[k[right]])
     return blocks_to_band(D, E, ab.shape[0] - 1)
 
 
@@ -413,11 +431,11 @@ def project_axial_stack(axial_dof: np.ndarray, axes: np.ndarray, ab: np.ndarray)
     D, E = band_blocks(ab)
     k = axial_dof // 3
     P = np.eye(3) - axes[..., :, None] * axes[..., None, :]  # (n_k, n_s, 3, 3)
-    D[:, k] = P @ D[:, k] @ P
+    D[:, k] = mul3(mul3(P, D[:, k]), P)
     left = k > 0
-    E[:, k[left] - 1] = E[:, k[left] - 1] @ P[:, left]
+    E[:, k[left] - 1] = mul3(E[:, k[left] - 1], P[:, left])
     right = k < D.shape[1] - 1
-    E[:, k[right]] = P[:, right] @ E[:, k[right]]
+    E[:, k[right]] = mul3(P[:, right], E[:, k[right]])
     return blocks_to_band(D, E, ab.shape[-2] - 1)
 
 
@@ -585,11 +603,11 @@ def rotate_band(ab: np.ndarray, T: np.ndarray) -> np.ndarray:
         T: [-] per-node orthonormal bases (columns: local axes in global coordinates),
             shape (..., n_nodes, 3, 3).
 
-    Every 3x3 product is the same (BLAS) product whatever the leading axes, so a stack gives
-    bit for bit the matrices rotated one at a time (tests/test_build_models.py).
+    Every 3x3 product is element-wise (:func:`mul3`), so a stack gives bit for bit the
+    matrices rotated one at a time on any CPU (tests/test_build_models.py).
     """
     D, E = band_blocks(ab)
     Tt = np.swapaxes(T, -1, -2)
-    Dr = Tt @ D @ T
-    Er = Tt[..., :-1, :, :] @ E @ T[..., 1:, :, :]
+    Dr = mul3(mul3(Tt, D), T)
+    Er = mul3(mul3(Tt[..., :-1, :, :], E), T[..., 1:, :, :])
     return blocks_to_band(0.5 * (Dr + np.swapaxes(Dr, -1, -2)), Er, ab.shape[-2] - 1)

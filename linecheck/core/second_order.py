@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.linalg import lapack
 
+from . import banded
 from .errors import NumericalError
 from .model import LinearModel
 from .static import StaticState
@@ -349,9 +350,7 @@ def second_order_of_loads(op: SecondOrder, L: np.ndarray, c: np.ndarray, dirs: n
         Y[1::3] = L.T
     else:
         Y.reshape(-1, 3, L.shape[0])[...] = L.T[:, None, :] * Dc[:, :, None]
-    Y, info = lapack.dpbtrs(c, Y, lower=0, overwrite_b=1)  # column by column: a row's result is its own
-    if info != 0:  # pragma: no cover - c comes from a successful dpbtrf
-        raise NumericalError(f"banded solve failed (dpbtrs info {info})")
+    Y = banded.solve(c, Y)  # column by column, each as if alone: a row's result is its own
 
     def fill(u: np.ndarray, i0: int, r: int) -> None:
         for lo, hi, f0 in op.runs:

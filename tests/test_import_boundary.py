@@ -23,6 +23,7 @@ CORE_MODULES = [
     "linecheck.core.codes",
     "linecheck.core.kernel",
     "linecheck.core.second_order",
+    "linecheck.core.banded",
     "linecheck.core.catenary",
     "linecheck.core.wind.mean",
     "linecheck.core.wind.turbulence",

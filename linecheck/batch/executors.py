@@ -17,7 +17,8 @@ All three share one small interface used by the batch and scan runners:
 The sequential executor runs one task per ``wait`` call in the calling process and
 passes it the batch's ``cancel`` event and a progress callback (``in_process``).
 The process pool and Dask run tasks elsewhere; cancellation takes effect between
-tasks (pending ones are cancelled, running pool workers are terminated).
+tasks (pending ones are cancelled; running pool tasks are asked to stop through the pool's
+stop event and their workers terminated only if they do not).
 Dask is imported lazily: without the ``dask`` extra a :class:`CaseError` says how
 to install it.  Nothing here prints or imports a UI library.
 """
@@ -183,6 +184,11 @@ def _worker_environment() -> Iterator[None]:
             os.environ.pop(k, None)
 
 
+#: [s] how long an aborted batch waits for its running tasks to stop on their own before it
+#: terminates their workers (they check for cancellation every block of steps: milliseconds)
+ABORT_GRACE_S = 30.0
+
+
 class ProcessPool(Executor):
     """A local :class:`concurrent.futures.ProcessPoolExecutor` (``--jobs N``).
 
@@ -210,10 +216,11 @@ class ProcessPool(Executor):
     def _start(self) -> None:
         ctx = multiprocessing.get_context("spawn")
         self._queue = ctx.SimpleQueue()
+        self._stop = ctx.Event()  # set by abort: the workers' tasks end at their next cancellation check
         # PR_SET_PDEATHSIG follows the thread that starts a worker: only from the main thread
         pdeathsig = threading.current_thread() is threading.main_thread()
         self._pool = ProcessPoolExecutor(max_workers=self._jobs, mp_context=ctx, initializer=init_pool_worker,
-                                         initargs=(self._queue, os.getpid(), pdeathsig))
+                                         initargs=(self._queue, os.getpid(), pdeathsig, self._stop))
         with _worker_environment():  # each submit starts one worker while none is idle
             for _ in range(self._jobs):
                 self._pool.submit(noop)
@@ -268,11 +275,18 @@ class ProcessPool(Executor):
             f.cancel()
 
     def abort(self, handles: Sequence[Future]) -> None:
+        """Cancel the pending tasks and ask the running ones to stop (the pool's stop event:
+        they raise Cancelled at their next cancellation check, within a block of steps or a
+        scan point); a worker still busy after :data:`ABORT_GRACE_S` is terminated.  Workers
+        that stop on their own leave the pool's queues clean, so its shutdown cannot hang on
+        a message cut off by a kill."""
+        self._stop.set()
         self.cancel(handles)
+        futures_wait([f for f in handles if not f.done()], timeout=ABORT_GRACE_S)
         processes = dict(getattr(self._pool, "_processes", None) or {})
         self._pool.shutdown(wait=False, cancel_futures=True)
-        for p in processes.values():  # stop chunks that are running now (Python < 3.14 has no API)
-            if p.is_alive():
+        for p in processes.values():  # a task that did not stop in time (Python < 3.14 has no API)
+            if p.is_alive() and any(not f.done() for f in handles):
                 p.terminate()
         for p in processes.values():
             p.join(timeout=5)

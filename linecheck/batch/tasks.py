@@ -108,6 +108,8 @@ def run_chunk(
     """
     from ..service import run_case
 
+    if cancel is None:
+        cancel = _STOP  # in a pool worker: the pool's stop event
     if report_key is not None and _REPORTS is not None:
         _report("start", report_key, os.getpid())
         if os.environ.get(KILL_HOOK_ENV) == Path(case_path).stem:  # test hook (see KILL_HOOK_ENV)
@@ -235,6 +237,8 @@ def scan_chunk(
             case = apply_changes(case, model_changes(case, model))
     except LinecheckError as err:
         return Failure.of(err)
+    if cancel is None:
+        cancel = _STOP  # in a pool worker: the pool's stop event
     n = len(points)
     peak = np.full((n, 3), np.nan)
     time = np.full((n, 3), np.nan)
@@ -266,6 +270,7 @@ def ignore_sigint() -> None:
 # --------------------------------------------------------------------------- pool workers
 #: the coordinator's report queue in a pool worker (set by :func:`init_pool_worker`)
 _REPORTS: Any = None
+_STOP: Any = None  # the pool's stop event, in a worker (init_pool_worker)
 #: seconds between two progress reports of one task (at least one per realization is sent)
 REPORT_INTERVAL_S = 0.25
 #: seconds between two checks of the parent process by the worker's watchdog thread
@@ -306,17 +311,23 @@ def _exit_with_parent(parent_pid: int, pdeathsig: bool) -> None:
     threading.Thread(target=watch, name="linecheck-parent-watchdog", daemon=True).start()
 
 
-def init_pool_worker(reports: Any = None, parent_pid: int | None = None, pdeathsig: bool = False) -> None:
-    """Process-pool initializer: ignore Ctrl-C, exit with the parent, keep the report queue.
+def init_pool_worker(reports: Any = None, parent_pid: int | None = None, pdeathsig: bool = False,
+                     stop: Any = None) -> None:
+    """Process-pool initializer: ignore Ctrl-C, exit with the parent, keep the report queue
+    and the pool's stop event.
 
     ``reports``: a ``multiprocessing.SimpleQueue`` read by the coordinator; tasks
     submitted with a ``report_key`` put ``("start", key, pid)`` on it before they run
     (synchronously: the coordinator knows which worker holds which task even when the
     worker is killed right after) and ``("progress", key, done, total)`` while they run.
+    ``stop``: a ``multiprocessing.Event`` the coordinator sets to stop the batch; the
+    worker's tasks take it as their cancel event and end with :class:`Cancelled` at their
+    next cancellation check, so the pool stops without killing a worker mid-write.
     """
-    global _REPORTS
+    global _REPORTS, _STOP
     ignore_sigint()
     _REPORTS = reports
+    _STOP = stop
     if parent_pid is not None:
         _exit_with_parent(parent_pid, pdeathsig)
 

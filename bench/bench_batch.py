@@ -28,8 +28,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from linecheck.batch import ProcessPool, ScanGrid, SequentialExecutor, run_batch, run_scan  # noqa: E402
-from linecheck.core.case import load_case  # noqa: E402
+from linecheck.batch import ProcessPool, ScanGrid, SequentialExecutor, run_batch, run_scan
+from linecheck.core.case import load_case
 
 PAPER = ROOT / "cases" / "paper"
 SCAN_CASE = PAPER / "case01-single.toml"

@@ -62,7 +62,6 @@ def main() -> None:
     system, mean = st.system, st.mean
     states = [mean.state(k) for k in range(mean.time.size)]
     nm = dynamics.Newmark(case.analysis.time_step)
-    zs = case.analysis.structural_ratio
 
     # ---- the one-state-at-a-time code (before issue 20), from the per-state functions
     def models_before():
@@ -118,20 +117,20 @@ def main() -> None:
 
     base_run = None
     if args.baseline:
+        import atexit
         import importlib
         import io
+        import shutil
         import subprocess
         import tarfile
         import tempfile
-
-        import atexit
-        import shutil
 
         tmp = Path(tempfile.mkdtemp(prefix="lc-baseline-"))
         atexit.register(shutil.rmtree, tmp, True)
         tar = subprocess.run(["git", "-C", str(root), "archive", args.baseline, "linecheck"],
                              capture_output=True, check=True).stdout
-        tarfile.open(fileobj=io.BytesIO(tar)).extractall(tmp, filter="data")
+        with tarfile.open(fileobj=io.BytesIO(tar)) as archive:
+            archive.extractall(tmp, filter="data")
         (tmp / "linecheck").rename(tmp / "linecheck_baseline")  # its imports are relative
         sys.path.insert(0, str(tmp))
         base_service = importlib.import_module("linecheck_baseline.service")

@@ -33,11 +33,11 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from linecheck import service  # noqa: E402
-from linecheck.core.case import case_to_dict, load_case  # noqa: E402
-from linecheck.excel.writer import load_result_docs, write_workbook  # noqa: E402
-from linecheck.io.document import RunDocument  # noqa: E402
-from linecheck.io.jsonout import run_document, write_json  # noqa: E402
+from linecheck import service
+from linecheck.core.case import case_to_dict, load_case
+from linecheck.excel.writer import load_result_docs, write_workbook
+from linecheck.io.document import RunDocument
+from linecheck.io.jsonout import run_document, write_json
 
 PAPER = ROOT / "cases" / "paper"
 REPRESENTATIVE = ("case01-six", "case05-single", "case09-six", "case11-single")

@@ -25,10 +25,10 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from bench_core import case_with, line_with_spans  # noqa: E402
+from bench_core import case_with, line_with_spans
 
-from linecheck import service  # noqa: E402
-from linecheck.core import kernel  # noqa: E402
+from linecheck import service
+from linecheck.core import kernel
 
 
 def timed(case, reals, repeat):

@@ -31,9 +31,9 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from bench_core import case_with, line_with_spans  # noqa: E402
+from bench_core import case_with, line_with_spans
 
-from linecheck import service  # noqa: E402
+from linecheck import service
 
 MEMORY_SNIPPET = """
 import resource, sys, time

@@ -82,7 +82,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
 
-from opensees_reference import (  # noqa: E402
+from opensees_reference import (
     NonlinearLine,
     OpenSeesUnavailable,
     WindRecord,
@@ -90,8 +90,8 @@ from opensees_reference import (  # noqa: E402
     read_field,
 )
 
-from linecheck import service  # noqa: E402
-from linecheck.core.case import load_case  # noqa: E402
+from linecheck import service
+from linecheck.core.case import load_case
 
 CASES = ("case10-single", "case09-single", "case10-six", "case09-six", "case05-single", "case05-six")
 COMPONENTS = ("R_x", "R_y")

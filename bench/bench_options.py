@@ -39,9 +39,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from linecheck import service  # noqa: E402
-from linecheck.batch.executors import default_jobs  # noqa: E402
-from linecheck.core.case import load_case  # noqa: E402
+from linecheck import service
+from linecheck.batch.executors import default_jobs
+from linecheck.core.case import load_case
 
 COMBOS = (("linear", "linear"), ("quadratic", "linear"), ("linear", "second-order"), ("quadratic", "second-order"))
 TARGET = 1.15

@@ -39,8 +39,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from linecheck import service  # noqa: E402
-from linecheck.core.case import Tower, load_case, replace  # noqa: E402
+from linecheck import service
+from linecheck.core.case import Tower, load_case, replace
 
 
 def _settings(case, duration: float, n: int):

@@ -17,20 +17,20 @@ import os
 os.environ.setdefault("LINECHECK_UNIT_FIELD_MEMO", "0")  # time fresh turbulence
 os.environ.setdefault("LINECHECK_KERNEL", "numba")
 
-import argparse  # noqa: E402
-import sys  # noqa: E402
-import time  # noqa: E402
-from pathlib import Path  # noqa: E402
+import argparse
+import sys
+import time
+from pathlib import Path
 
-import numpy as np  # noqa: E402
+import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from bench_core import case_with, line_with_spans  # noqa: E402
+from bench_core import case_with, line_with_spans
 
-from linecheck import service  # noqa: E402
-from linecheck.batch.executors import default_jobs  # noqa: E402
+from linecheck import service
+from linecheck.batch.executors import default_jobs
 
 
 def timed(case, n: int, threads: int, check: bool = False):

@@ -109,7 +109,7 @@ def load_opensees():
                                   "(or pip install openseespy)") from None
     try:
         import openseespy.opensees as ops
-    except Exception as exc:  # noqa: BLE001 - the wheel wraps the loader error in a RuntimeError
+    except Exception as exc:
         detail = _root_cause(exc)
         if any(s in detail.lower() for s in SYSTEM_LIBS):
             raise OpenSeesUnavailable(f"{BLAS_HINT} [{detail}]") from None
@@ -126,7 +126,7 @@ def _root_cause(exc: BaseException) -> str:
     if "Failed to import openseespy" in msg:
         try:
             import openseespylinux.opensees  # noqa: F401
-        except Exception as inner:  # noqa: BLE001
+        except Exception as inner:
             return _root_cause(inner)
     return msg
 

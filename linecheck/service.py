@@ -22,8 +22,12 @@ from .analysis.guard import check_budget, check_case, warn_case  # noqa: F401 - 
 from .core import budget, kernel
 from .core.case import Case
 from .core.codes import CODES_PEAK  # what ``linecheck_peak`` is: one text for every front end
-from .core.damping import (aerodynamic_damping, aerodynamic_damping_stack, stiffness_proportional,
-                           stiffness_proportional_stack)
+from .core.damping import (
+    aerodynamic_damping,
+    aerodynamic_damping_stack,
+    stiffness_proportional,
+    stiffness_proportional_stack,
+)
 from .core.dynamics import DynamicResponse, integrate
 from .core.errors import Cancelled
 from .core.model import build_model, build_models
@@ -166,9 +170,9 @@ class RunResult:
     background: np.ndarray
     resonant: np.ndarray
     stats: Statistics
-    spectral: "SpectralResult | None" = None
-    burn_in: "BurnIn | None" = None
-    until: "UntilInfo | None" = None
+    spectral: SpectralResult | None = None
+    burn_in: BurnIn | None = None
+    until: UntilInfo | None = None
 
     @property
     def tower_index(self) -> int:
@@ -185,7 +189,7 @@ class RunResult:
         """Peak windows per realization (1 without ``analysis.peak_window``)."""
         return self.stats.n_samples // max(int(self.realizations.size), 1)
 
-    def summary(self) -> "ResultSummary":
+    def summary(self) -> ResultSummary:
         """Statistics summarised over realizations x windows (issue 18): moments, fractiles,
         Gumbel fits of the peaks, 95 % intervals, the Cont_R flag."""
         from .core.results import summarise_statistics
@@ -624,7 +628,7 @@ def _map_chunks(fn, n: int, threads: int, stop: _AnyEvent) -> list:
             return
         try:
             out[i] = fn(i)
-        except BaseException as exc:  # noqa: BLE001 - re-raised below in the calling thread
+        except BaseException as exc:
             errors.append((i, exc))
             stop.set()
 
@@ -1014,10 +1018,10 @@ class ModesResult:
     """
 
     case: Case
-    still_air: "Modes"
-    mean: "Modes"
+    still_air: Modes
+    mean: Modes
     mean_time: float
-    damped: "object" = None  # ComplexModes of the mean state with the case's damping
+    damped: object = None  # ComplexModes of the mean state with the case's damping
     #: per undamped mean-state mode, its damped counterpart (:func:`~linecheck.core.modes.pair_by_shape`):
     #: frequency [Hz], damping ratio [-] and MAC [-] of the paired complex mode (NaN where none)
     paired_hz: np.ndarray | None = None
@@ -1220,8 +1224,8 @@ class SpectralResult:
     """
 
     case: Case
-    exact: "SpectralEstimate"
-    davenport: "DavenportEstimate"
+    exact: SpectralEstimate
+    davenport: DavenportEstimate
     davenport_applicable: bool
     davenport_note: str
     window: CheckWindow | None = None

@@ -17,8 +17,8 @@ import numpy as np
 
 from . import service
 from .core.case import Line, load_case
-from .core.errors import CaseError
 from .core.dynamics import integrate
+from .core.errors import CaseError
 from .core.model import LinearModel, build_model, dof_map
 from .core.modes import natural_modes
 from .core.static import drag_intensity, solve_static, span_loads_uniform, still_air_state
@@ -178,7 +178,7 @@ def table5_rows(progress: Callable[[str, int, int], None] | None = None) -> list
         c = 0 if r["reaction"].startswith("Rx") else 1
 
         def stat(q: str, scale: float = 1.0) -> str:
-            m, s = res.stats.mean(q)[j, c], res.stats.std(q)[j, c]
+            m, s = res.stats.mean(q)[j, c], res.stats.std(q)[j, c]  # noqa: B023 - called at once, in this iteration
             return "**" if not np.isfinite(m) else f"{m * scale:.2f}±{s * scale:.2f}"
 
         ref = f"{r['GF_Dy'] or '**'} / {r['GF_QS'] or '**'} / {r['Cont_R_pct']}"

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import functools
 import json
 import logging
+import operator
 import re
 import subprocess
 import sys
@@ -95,7 +97,7 @@ def test_chunk_ranges_are_balanced_and_cover_all():
     assert chunk_ranges(3, 2) == [[0, 1], [2]]
     chunks = chunk_ranges(25, 10)
     assert [len(c) for c in chunks] == [8, 9, 8]
-    assert sum(chunks, []) == list(range(25))
+    assert functools.reduce(operator.iadd, chunks, []) == list(range(25))
     assert chunk_ranges(0, 4) == []
 
 
@@ -575,7 +577,6 @@ def test_summary_flags_cont_r_and_failed_sanity_check(short_cases):
 
     from linecheck.batch import BatchReport
     from linecheck.cli.batch_cmd import summary_notes, summary_table
-
     from linecheck.io.document import RunDocument
 
     clean = run_batch([short_cases[1]]).outcomes[0]  # synoptic: has the sanity check

@@ -98,8 +98,12 @@ def test_damping_and_steppers_stacked_bit_identical(which, damping, zeta, reques
     Newmark operators of all states at once equal those built state by state, bit for bit."""
     import dataclasses
 
-    from linecheck.core.damping import (aerodynamic_damping, aerodynamic_damping_stack, stiffness_proportional,
-                                        stiffness_proportional_stack)
+    from linecheck.core.damping import (
+        aerodynamic_damping,
+        aerodynamic_damping_stack,
+        stiffness_proportional,
+        stiffness_proportional_stack,
+    )
     from linecheck.core.dynamics import Newmark, _rotated_stack, _Stepper
 
     case, st, states = request.getfixturevalue(which)

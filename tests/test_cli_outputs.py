@@ -252,7 +252,7 @@ def test_summary_shows_the_sanity_check(doc, tmp_path):
     down.pop("spectral")
     path = write_workbook([ok, bad, down], tmp_path / "s.xlsx")
     wb = load_workbook(path)
-    ws, rows = _summary_rows(wb)
+    _ws, rows = _summary_rows(wb)
     by_case = {}
     for r in rows:
         by_case.setdefault(r["Case"], set()).add(r[SANITY_HEADER])

@@ -157,7 +157,7 @@ def test_summary_values_equal_json(docs, book):
 
 def test_summary_with_rz_rows(light, tmp_path):
     path = write_workbook(light, tmp_path / "rz.xlsx", reactions=("Rx", "Ry", "Rz"))
-    _, headers, rows = _summary_table(load_workbook(path))
+    _, _headers, rows = _summary_table(load_workbook(path))
     assert [r["Reaction"] for r in rows] == ["Rx", "Ry", "Rz"] * len(light)
     for row in rows:
         doc = next(d for d in light if d["case"] == row["Case"])
@@ -168,7 +168,7 @@ def test_summary_with_rz_rows(light, tmp_path):
 
 def test_summary_format_and_flags(book):
     wb = load_workbook(book)
-    ws, headers, rows = _summary_table(wb)
+    ws, headers, _rows = _summary_table(wb)
     top = ws[tpl.destination(wb, tpl.SUMMARY_ANCHOR)[1]].row
     assert ws.freeze_panes == f"B{top + 1}"
     col = headers.index("Cont_R\n(%)") + 1
@@ -301,7 +301,7 @@ def test_user_template_with_moved_cells_is_filled(light, tmp_path):
     assert "Summary" in wb.sheetnames and "Peaks" in wb.sheetnames
     ws = wb["Summary"]
     top = next(c.row for c in ws["A"] if c.value == "Case")
-    _, headers, rows = _table_at(ws, top, 1)
+    _, _headers, rows = _table_at(ws, top, 1)
     assert len(rows) == len(SUMMARY_REACTIONS) * len(light)
     assert rows[0]["peak Dy\n(kN)"] == same(light[0]["reactions"]["Rx"]["peak_dynamic"]["mean"] / 1000.0)
     for d in light:

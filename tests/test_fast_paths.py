@@ -16,7 +16,7 @@ import pytest
 from linecheck import service
 from linecheck.core import spectral
 from linecheck.core.case import load_case
-from linecheck.core.dynamics import _Stepper, Newmark, integrate, node_bases
+from linecheck.core.dynamics import Newmark, _Stepper, integrate, node_bases
 from linecheck.core.model import band_blocks, band_to_dense, blocks_to_band, rotate_band
 from linecheck.core.spectral import ModalTransfer, _banded_solve, dynamic_solve
 

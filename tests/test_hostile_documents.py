@@ -10,8 +10,8 @@ import dataclasses
 import json
 import re
 import warnings
-import zipfile
 import xml.etree.ElementTree as ET
+import zipfile
 from pathlib import Path
 
 import numpy as np

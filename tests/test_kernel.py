@@ -114,7 +114,7 @@ def test_structural_damping_remainder_by_diagonals_is_the_csr_product():
     same stepper's remainder (the numpy loop's ``csr_matvecs``), within RTOL_OP, for one vector and
     four lanes; and the diagonals hold exactly the CSR arrays' entries (zeros elsewhere)."""
     from linecheck.core import _loops
-    from linecheck.core.dynamics import _Stepper, Newmark
+    from linecheck.core.dynamics import Newmark, _Stepper
 
     case = _short(CASES / "paper" / "case09-six.toml", damping="quasi-steady")
     st = service._static_analysis(case)

@@ -20,11 +20,11 @@ pytest.importorskip("openseespy")
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "bench"))
 
-import opensees_reference as ref  # noqa: E402
+import opensees_reference as ref
 
-from linecheck.core.case import load_case  # noqa: E402
-from linecheck.core.static import still_air_state  # noqa: E402
-from linecheck.core.system import LineSystem  # noqa: E402
+from linecheck.core.case import load_case
+from linecheck.core.static import still_air_state
+from linecheck.core.system import LineSystem
 
 TOL = 0.005  # 0.5 %
 

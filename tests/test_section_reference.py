@@ -17,7 +17,7 @@ import json
 import math
 import re
 import shutil
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 
 import numpy as np
@@ -32,7 +32,7 @@ W, EA, H0 = 17.92, 0.7e-4 * 5.2e10, 20000.0  # conductor of the section cases [N
 N_EL = 100  # reference elements per span: discretisation error ~3e-5 of the reactions (test below)
 
 
-@lru_cache(maxsize=None)
+@cache
 def _ref(stem: str, n_el: int = N_EL) -> fe.Solution:
     """FE reference solution of tests/data/sections/<stem>.toml (cached per session)."""
     return fe.solve(DATA / f"{stem}.toml", n_el=n_el)

@@ -26,8 +26,14 @@ from linecheck.cli.app import app
 from linecheck.core.case import case_to_dict, load_case, with_values
 from linecheck.excel.writer import write_workbook
 from linecheck.io.jsonout import run_to_dict
-from linecheck.io.section import (insulators_known, line_from_parameters, line_summary, section_geometry,
-                                  section_summary, tower_rows)
+from linecheck.io.section import (
+    insulators_known,
+    line_from_parameters,
+    line_summary,
+    section_geometry,
+    section_summary,
+    tower_rows,
+)
 
 from .conftest import CASES
 

@@ -10,7 +10,7 @@ within 1 % on the paper's six-span system with only the three left spans loaded.
 
 from __future__ import annotations
 
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 import pytest
@@ -37,7 +37,7 @@ def _gy(system: LineSystem, per_span) -> np.ndarray:
     return np.repeat(np.asarray(per_span, dtype=float)[:, None], system.ne + 1, axis=1)
 
 
-@lru_cache(maxsize=None)
+@cache
 def _solved(L: float, V: float, spans: int):
     """(system, gy, linecheck state, FE reference) for the paper system; cached per module."""
     system = LineSystem(paper_line(L, spans=spans))

@@ -260,7 +260,7 @@ def test_excel_summary_design_block(run9, tmp_path):
         width = sum(ws.column_dimensions[get_column_letter(c)].width or 8.43 for c in range(1, right_col + 1))
         lines = ws.row_dimensions[r].height / 12.0
         assert lines * width * 1.1 >= len(ws.cell(row=r, column=1).value)
-    for k, (label, width) in enumerate(HEADERS[:-1]):  # every design column as wide as it asks
+    for _k, (label, width) in enumerate(HEADERS[:-1]):  # every design column as wide as it asks
         assert ws.column_dimensions[get_column_letter(cols[label] + 1)].width >= width
 
 

@@ -26,20 +26,20 @@ from linecheck.io.jsonout import run_to_dict
 
 textual = pytest.importorskip("textual")
 
-from textual.command import CommandList  # noqa: E402
-from textual.widgets import DataTable, Input, Static, TabbedContent  # noqa: E402
+from textual.command import CommandList
+from textual.widgets import DataTable, Input, Static, TabbedContent
 
-from linecheck.tui import files  # noqa: E402
-from linecheck.tui import messages as msg  # noqa: E402
-from linecheck.tui.app import LinecheckApp  # noqa: E402
-from linecheck.tui.commands import LinecheckCommands  # noqa: E402
-from linecheck.tui.formatting import tower_dicts  # noqa: E402
-from linecheck.tui.plotting import PlotView  # noqa: E402
-from linecheck.tui.widgets.browser import CaseBrowser  # noqa: E402
-from linecheck.tui.screens.confirm import ConfirmScreen  # noqa: E402
-from linecheck.tui.screens.error import ErrorScreen  # noqa: E402
-from linecheck.tui.screens.help import HelpScreen  # noqa: E402
-from linecheck.tui.screens.prompt import PathPrompt  # noqa: E402
+from linecheck.tui import files
+from linecheck.tui import messages as msg
+from linecheck.tui.app import LinecheckApp
+from linecheck.tui.commands import LinecheckCommands
+from linecheck.tui.formatting import tower_dicts
+from linecheck.tui.plotting import PlotView
+from linecheck.tui.screens.confirm import ConfirmScreen
+from linecheck.tui.screens.error import ErrorScreen
+from linecheck.tui.screens.help import HelpScreen
+from linecheck.tui.screens.prompt import PathPrompt
+from linecheck.tui.widgets.browser import CaseBrowser
 
 ROOT = Path(__file__).resolve().parents[1]
 SIZE = (120, 40)
@@ -318,7 +318,7 @@ async def test_six_span_run_never_blocks_and_cancels(tmp_path: Path, monkeypatch
         tabs = app.query_one("#main-tabs", TabbedContent)
         for key, tab in [("1", "cases"), ("3", "results"), ("2", "params"), ("4", "compare"), ("1", "cases")]:
             app.simulate_key(key)
-            await wait_for(pilot, lambda: tabs.active == tab, f"tab {tab}", messages)
+            await wait_for(pilot, lambda: tabs.active == tab, f"tab {tab}", messages)  # noqa: B023 - called at once, in this iteration
             assert app.running, "the run should still be in progress"
         app.simulate_key("question_mark")
         await wait_for(pilot, lambda: isinstance(app.screen, HelpScreen), "help", messages)
@@ -450,7 +450,7 @@ async def test_switching_case_with_unsaved_edits_asks(short_case: Path) -> None:
                 app.query_one(CaseBrowser).select_path(other)
                 await pilot.press("enter")
             else:
-                dict((c.name, c) for c in LinecheckCommands(app.screen)._commands())["case: open other"].callback()
+                {c.name: c for c in LinecheckCommands(app.screen)._commands()}["case: open other"].callback()
             await wait_for(pilot, asking, f"the question ({how})", messages)
             assert "wind.v_ref" in str(app.screen.query_one("#confirm-message", Static).render())
             await pilot.press("enter")  # the focus starts on "keep editing": enter alone keeps the edits
@@ -569,7 +569,7 @@ async def test_parameter_table_lists_the_wind_types_keys_uncut(short_case: Path,
         for path, shown, hidden in [(short_case, "wind.span_speeds", "wind.downburst.translation_direction"),
                                     (six, "wind.downburst.translation_direction", "wind.span_speeds")]:
             app.open_case(path, discard=True)
-            await wait_for(pilot, lambda: app.case is not None and app.case.source == path, "the case")
+            await wait_for(pilot, lambda: app.case is not None and app.case.source == path, "the case")  # noqa: B023 - called at once, in this iteration
             await pilot.pause()
             keys = [table.coordinate_to_cell_key((i, 0)).row_key.value for i in range(table.row_count)]
             assert shown in keys and hidden not in keys

@@ -389,7 +389,7 @@ def test_ensemble_psd_within_15_percent_in_every_octave_band(ensemble):
 
 @pytest.mark.parametrize("sep", [1, 2, 4])
 def test_co_coherence_within_0_05_at_three_separations(ensemble, sep):
-    case, X, f, n, dt = ensemble
+    case, X, f, _n, _dt = ensemble
     L, V, C = tb.length_scale(case), case.wind.v_ref, case.wind.coherence_decay
     dx = 30.0 * sep
     fc = math.log(2.0) * V / (C * dx)  # target coherence 0.5 here (most sensitive region)

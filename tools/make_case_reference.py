@@ -12,7 +12,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from linecheck.core.case import SCHEMA  # noqa: E402
+from linecheck.core.case import SCHEMA
 
 HEADER = """# Case files
 

@@ -15,9 +15,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from linecheck import service  # noqa: E402
-from linecheck.core.case import load_case  # noqa: E402
-from linecheck.core.wind.mean import downburst_field, event_window  # noqa: E402
+from linecheck import service
+from linecheck.core.case import load_case
+from linecheck.core.wind.mean import downburst_field, event_window
 
 RADII = (0.8, 1.2, 2.0)
 COLOURS = ("#1f77b4", "#d62728", "#2ca02c")

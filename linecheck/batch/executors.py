@@ -112,7 +112,7 @@ class Executor(ABC):
 
 # --------------------------------------------------------------------------- sequential
 class _Deferred:
-    __slots__ = ("fn", "args", "kwargs", "state", "value")
+    __slots__ = ("args", "fn", "kwargs", "state", "value")
 
     def __init__(self, fn: Callable[..., Any], args: tuple, kwargs: dict) -> None:
         self.fn, self.args, self.kwargs = fn, args, kwargs
@@ -369,7 +369,7 @@ def probe_scheduler(address: str, timeout: float = DEFAULT_CONNECT_TIMEOUT) -> N
     deadline = time.monotonic() + timeout
     try:
         sock = socket.create_connection((host, port), timeout=timeout)
-    except socket.timeout:
+    except TimeoutError:
         raise CaseError(f"{where}: no connection within {timeout:g} s (--connect-timeout)") from None
     except socket.gaierror as exc:
         raise CaseError(f"{where}: unknown host {host!r} ({exc.strerror})") from None
@@ -381,7 +381,7 @@ def probe_scheduler(address: str, timeout: float = DEFAULT_CONNECT_TIMEOUT) -> N
         while len(buf) < n:
             left = deadline - time.monotonic()
             if left <= 0:
-                raise socket.timeout
+                raise TimeoutError
             sock.settimeout(left)
             got = sock.recv(n - len(buf))
             if not got:
@@ -396,7 +396,7 @@ def probe_scheduler(address: str, timeout: float = DEFAULT_CONNECT_TIMEOUT) -> N
                 raise CaseError(f"{where}: the peer's answer is not a Dask handshake: is a Dask scheduler "
                                 "listening there?")
             read(n)
-    except socket.timeout:
+    except TimeoutError:
         raise CaseError(f"{where}: connected, but no Dask handshake within {timeout:g} s (--connect-timeout): "
                         "is a Dask scheduler listening there?") from None
     except OSError as exc:
@@ -425,7 +425,7 @@ def _open_client(distributed: Any, address: str, timeout: float) -> Any:
     def start() -> None:
         try:
             box["client"] = distributed.Client(address, timeout=timeout, set_as_default=False)
-        except BaseException as exc:  # noqa: BLE001 - reported below as one line
+        except BaseException as exc:
             box["error"] = exc
 
     with _quiet_unraisable():
@@ -529,7 +529,7 @@ class DaskExecutor(Executor):
             self._distributed.wait(list(handles), timeout=timeout, return_when="FIRST_COMPLETED")
         except TimeoutError:
             pass
-        except Exception:  # noqa: BLE001 - e.g. the scheduler went away: outcome() reports it
+        except Exception:
             pass
         return [i for i, f in enumerate(handles) if f.done()]
 
@@ -542,7 +542,7 @@ class DaskExecutor(Executor):
             return Failure("Cancelled", "cancelled", 130)
         try:
             return handle.result()
-        except Exception as exc:  # noqa: BLE001 - KilledWorker, lost scheduler, bugs
+        except Exception as exc:
             if self.lost():
                 return self._lost_failure()
             return Failure.of(exc)
@@ -552,7 +552,7 @@ class DaskExecutor(Executor):
             return
         try:
             self.client.cancel(list(handles))
-        except Exception:  # noqa: BLE001  # pragma: no cover
+        except Exception:  # pragma: no cover
             pass
 
     def abort(self, handles: Sequence[Any]) -> None:

@@ -4,6 +4,7 @@ case with the typed ``models`` block and the envelope (:func:`linecheck.io.jsono
 from __future__ import annotations
 
 from pathlib import Path
+
 from ..core.case import load_case
 from ..io.document import FailedRun, RunDocument
 from ..service import model_changes, parse_models

@@ -28,6 +28,7 @@ import numpy as np
 from ..core.case import Case, case_hash, load_case, with_values
 from ..core.errors import Cancelled, CaseError, LinecheckError
 
+
 @dataclass(frozen=True)
 class Failure:
     """A task that ended with a user-facing error.

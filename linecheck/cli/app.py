@@ -26,6 +26,7 @@ from rich.console import Console
 from ..core.case import Case, load_case
 from ..core.errors import LinecheckError, printable
 
+
 def usage_line(err: UsageError) -> str:
     """One line for a command-line usage error: what is wrong, the usage, where the help is."""
     ctx = err.ctx

@@ -8,8 +8,8 @@ import typer
 from rich.table import Table
 
 from ..io.atomic import check_target
-from ..io.outputs import case_inputs, check_outputs
 from ..io.document import CodeCheck
+from ..io.outputs import case_inputs, check_outputs
 from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .progress import progress_bar
 

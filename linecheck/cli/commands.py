@@ -107,12 +107,14 @@ def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     if json_out is not None:
         write_json(json_out, doc)
         console.print(f"wrote {json_out}")
-from . import run_cmd  # noqa: E402,F401
-from . import spectral_cmd  # noqa: E402,F401
-from . import wind_cmd  # noqa: E402,F401
-from . import tui_cmd  # noqa: E402,F401
-from . import export_cmd  # noqa: E402,F401
-from . import batch_cmd  # noqa: E402,F401
-from . import validate_cmd  # noqa: E402,F401
-from . import codes_cmd  # noqa: E402,F401
-from . import info_cmd  # noqa: E402,F401
+from . import (  # noqa: E402 - registers the commands on the app defined above
+    batch_cmd,  # noqa: F401
+    codes_cmd,  # noqa: F401
+    export_cmd,  # noqa: F401
+    info_cmd,  # noqa: F401
+    run_cmd,  # noqa: F401
+    spectral_cmd,  # noqa: F401
+    tui_cmd,  # noqa: F401
+    validate_cmd,  # noqa: F401
+    wind_cmd,  # noqa: F401
+)

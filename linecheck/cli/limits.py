@@ -11,6 +11,7 @@ import os
 from typing import Annotated
 
 import typer
+
 from ..core.budget import ENV_MAX_MEMORY, parse_size
 from .app import error_line
 

@@ -416,9 +416,8 @@ def _find_line(text: str | None, section: str, key: str | None) -> int | None:
             if key is None and current == section:
                 return n
             continue
-        if key is not None and current == section:
-            if re.match(rf"^\s*\"?{re.escape(key)}\"?\s*=", raw):
-                return n
+        if key is not None and current == section and re.match(rf"^\s*\"?{re.escape(key)}\"?\s*=", raw):
+            return n
     return None
 
 

@@ -27,7 +27,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import kernel
-from .banded import ColumnSolver, factor as _factor, solve as _solve
+from .banded import ColumnSolver
+from .banded import factor as _factor
+from .banded import solve as _solve
 from .errors import Cancelled, NumericalError
 from .model import CSRArrays, LinearModel, band_blocks, band_to_csr_stack, rotate_band
 
@@ -428,7 +430,7 @@ class _StackedBases:
         self.chunk = max(1, min(len(self.order), 4_000_000 // max(30 * n_dof, 1)))  # ~32 MB of blocks
         self.held: dict[int, _Stepper] = {}
 
-    def get(self, k: int) -> "_Stepper":
+    def get(self, k: int) -> _Stepper:
         """The operator of mean state k."""
         if k not in self.held:
             ks = self.order[self.pos[k]:self.pos[k] + self.chunk]
@@ -463,20 +465,20 @@ class _Stepper:
     cols: np.ndarray  # per row of GT the column range [c0, c1) of its non-zeros (its tower), (n_nz, 2)
 
     @staticmethod
-    def build(model: LinearModel, c_band: np.ndarray, nm: Newmark, load_dirs: np.ndarray | None = None) -> "_Stepper":
+    def build(model: LinearModel, c_band: np.ndarray, nm: Newmark, load_dirs: np.ndarray | None = None) -> _Stepper:
         T = node_bases(model, c_band)
         return _Stepper.from_bases(model, T, rotate_band(model.K_band, T), rotate_band(c_band, T), nm, load_dirs)
 
     @staticmethod
     def from_bases(model: LinearModel, T: np.ndarray, Kr: np.ndarray, Cr: np.ndarray, nm: Newmark,
-                   load_dirs: np.ndarray | None = None) -> "_Stepper":
+                   load_dirs: np.ndarray | None = None) -> _Stepper:
         """The operator from the node bases T (n_nodes, 3, 3) and the rotated stiffness and
         damping bands K~ = T^T K T, C~ = T^T C T (:meth:`stack` of one state)."""
         return _Stepper.stack([model], T[None], Kr[None], Cr[None], nm, load_dirs)[0]
 
     @staticmethod
     def stack(models: list[LinearModel], T: np.ndarray, Kr: np.ndarray, Cr: np.ndarray, nm: Newmark,
-              load_dirs: np.ndarray | None = None) -> list["_Stepper"]:
+              load_dirs: np.ndarray | None = None) -> list[_Stepper]:
         """The operators of many mean states of one system from their node bases T and rotated
         bands K~, C~ (:func:`_rotated_stack`, each with a leading axis of n_k), in vectorised passes
         over the states (issue 20: ≈ 0.7 ms per state built one by one, 250 states in a downburst

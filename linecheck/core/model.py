@@ -24,8 +24,8 @@ directly at pinned nodes: R = G u + D f_pinned.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from collections.abc import Sequence
+from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np

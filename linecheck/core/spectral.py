@@ -88,7 +88,7 @@ class ComplexModes:
     left: np.ndarray | None = None
     S: np.ndarray | None = None
     mass: np.ndarray | None = None
-    expansion: "StateEigen | None" = None
+    expansion: StateEigen | None = None
     norm: np.ndarray | None = None
 
 

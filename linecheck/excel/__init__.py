@@ -8,4 +8,4 @@
 
 from .writer import check_excel_target, load_result_docs, write_workbook
 
-__all__ = ["write_workbook", "check_excel_target", "load_result_docs"]
+__all__ = ["check_excel_target", "load_result_docs", "write_workbook"]

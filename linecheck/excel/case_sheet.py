@@ -13,8 +13,14 @@ from openpyxl.worksheet.worksheet import Worksheet
 from ..core.case import SCHEMA, Line
 from ..io.display import flag_state, flag_text
 from ..io.document import STAT_BY_NAME, STAT_TABLE, RunDocument
-from ..io.section import (COLUMN_UNITS, insulators_known, line_from_parameters, section_geometry, section_summary,
-                          tower_rows)
+from ..io.section import (
+    COLUMN_UNITS,
+    insulators_known,
+    line_from_parameters,
+    section_geometry,
+    section_summary,
+    tower_rows,
+)
 from . import template as tpl
 from .cells import (
     FLAG_NOTE,

@@ -10,7 +10,6 @@ from openpyxl.worksheet.worksheet import Worksheet
 
 from ..core.codes import CODES_PEAK
 from ..io.document import RunDocument
-
 from .cells import KN3, RATIO, Cursor, kn, page_setup
 
 COLUMNS = (("Case", 18), ("Code", 11), ("Edition", 30), ("Verified", 9), ("Tower", 6), ("Reaction", 9),

@@ -11,9 +11,9 @@ from openpyxl.styles import Font, PatternFill
 from openpyxl.utils import get_column_letter
 from openpyxl.worksheet.worksheet import Worksheet
 
-from . import template as tpl
 from ..io.display import flag_state
 from ..io.document import STAT_BY_NAME, FailedRun, RunDocument
+from . import template as tpl
 from .cells import (
     FLAG_NOTE,
     GF_UNDEFINED,
@@ -78,7 +78,7 @@ def write_summary(ws: Worksheet, docs: list[RunDocument | FailedRun], names: lis
                     link(cell, names[n_doc])
                 c += 1
             note = ""
-            for label, spec, _ in cols[len(SUMMARY_IDS):-2]:
+            for _label, spec, _ in cols[len(SUMMARY_IDS):-2]:
                 stat, which = spec
                 if failed:
                     cur.put(row, left + c, None)

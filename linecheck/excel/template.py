@@ -187,7 +187,7 @@ def _destination(wb: Workbook, name: str) -> tuple[Worksheet, str] | None:
         return None
     try:
         dests = list(dn.destinations)
-    except Exception:  # noqa: BLE001 - a formula name, not a cell reference
+    except Exception:
         return None
     if not dests:
         return None

@@ -222,6 +222,17 @@ def build_workbook(wb: Workbook, docs: list[RunDocument | FailedRun], title: dic
     wb.active = wb.sheetnames.index(summary.title)
 
 
-__all__ = ["write_workbook", "check_excel_target", "load_result_docs", "validate_doc", "build_workbook",
-           "stat_cell", "chart_indices", "sheet_name", "FLAG_NOTE", "GF_UNDEFINED", "SUMMARY_REACTIONS",
-           "CHART_POINTS"]
+__all__ = [
+    "CHART_POINTS",
+    "FLAG_NOTE",
+    "GF_UNDEFINED",
+    "SUMMARY_REACTIONS",
+    "build_workbook",
+    "chart_indices",
+    "check_excel_target",
+    "load_result_docs",
+    "sheet_name",
+    "stat_cell",
+    "validate_doc",
+    "write_workbook",
+]

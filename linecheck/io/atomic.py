@@ -29,7 +29,6 @@ from pathlib import Path
 
 from ..core.errors import CaseError
 
-
 # Temporary files of a killed writer (SIGKILL, power loss) stay behind as ".NAME.XXXX.tmp";
 # the next write of NAME removes those older than this process (a live writer in another
 # process that started earlier is racing for the same file anyway).
@@ -49,7 +48,7 @@ def clean_stale_temporaries(path: str | Path) -> list[Path]:
         with contextlib.suppress(OSError):
             st = tmp.lstat()
             if (stat.S_ISREG(st.st_mode) and st.st_mtime < _PROCESS_START
-                    and getattr(os, "getuid", lambda: st.st_uid)() == st.st_uid):
+                    and getattr(os, "getuid", lambda: st.st_uid)() == st.st_uid):  # noqa: B023 - called at once, in this iteration
                 tmp.unlink()
                 removed.append(tmp)
     return removed

@@ -164,7 +164,7 @@ def blas_libraries() -> tuple[Blas, Blas | None]:
     """
     import numpy
     import scipy
-    import scipy.linalg  # noqa: F401 - loads scipy's BLAS, so that it is listed
+    import scipy.linalg
 
     try:
         from threadpoolctl import threadpool_info

@@ -191,9 +191,9 @@ def _schema(value: Any, schema: dict[str, Any], root: dict[str, Any], path: str)
         return bad()
     if isinstance(value, HugeInteger) and ("minimum" in schema or "maximum" in schema):
         return bad()
-    if isinstance(value, (int, float)) and not isinstance(value, bool):
-        if ("minimum" in schema and value < schema["minimum"]) or ("maximum" in schema and value > schema["maximum"]):
-            return bad()
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and (
+            ("minimum" in schema and value < schema["minimum"]) or ("maximum" in schema and value > schema["maximum"])):
+        return bad()
     if isinstance(value, dict):
         props = schema.get("properties", {})
         for k in schema.get("required", ()):

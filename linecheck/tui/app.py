@@ -23,11 +23,20 @@ from ..core.case import Case, load_case
 from ..core.errors import Cancelled, LinecheckError
 from ..io.document import RunDocument
 from . import files, runner
-from .formatting import case_differences
 from .catalog import discover
 from .commands import LinecheckCommands
-from .messages import (CaseOpened, Exported, OpenCaseRequested, ParameterChanged, RunCancelled, RunFailed,
-                       RunFinished, RunProgress, RunStarted)
+from .formatting import case_differences
+from .messages import (
+    CaseOpened,
+    Exported,
+    OpenCaseRequested,
+    ParameterChanged,
+    RunCancelled,
+    RunFailed,
+    RunFinished,
+    RunProgress,
+    RunStarted,
+)
 from .screens.confirm import ConfirmScreen
 from .screens.error import ErrorScreen
 from .screens.help import HelpScreen

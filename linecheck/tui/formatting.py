@@ -14,9 +14,6 @@ import tomllib
 from typing import Any
 
 from ..core.case import SCHEMA, Case, FieldSpec
-from ..core.extremes import (
-    CONT_R_THRESHOLD as CONT_R_FLAG,  # Cont_R flag, paper Sect. 5 (one definition)
-)
 from ..io.display import (  # noqa: F401  (shared with the CLI)
     STAT_ROWS,
     SUMMARY_STATS,

@@ -512,7 +512,7 @@ def _modes_of(m: _Model, U: np.ndarray, n_modes: int) -> Modes:
 def still_air_modes(source: Section | str | Path, *, n_el: int = 200, n_modes: int = 12,
                     insulator_stiffness: float = 1e3, tol: float = 1e-5) -> Modes:
     """Still-air natural modes on a mesh of ``n_el`` elements per span."""
-    sec, geo, m = _build(source, n_el, insulator_stiffness)
+    _sec, geo, m = _build(source, n_el, insulator_stiffness)
     U, _, _ = _still(m, tol, 50, 0.1 * float(np.min(geo.length)))
     return _modes_of(m, U, n_modes)
 

@@ -42,7 +42,6 @@ import zipfile
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -51,8 +50,10 @@ from ..case import Case, Downburst, cell_text, read_regular_file, reads_as_heade
 from ..errors import CaseError
 from ..system import LineSystem
 from . import ring as ring_model
+
 # Wood et al. (2001) f_z and z/delta of its maximum: one source, shared with the ring-jet models
-from .profiles import ETA_PEAK, wood as _wood
+from .profiles import ETA_PEAK
+from .profiles import wood as _wood
 
 if TYPE_CHECKING:
     from scipy.interpolate import RegularGridInterpolator

@@ -22,8 +22,7 @@ import numpy as np
 from ..case import Case
 from ..errors import CaseError
 from ..system import LineSystem
-from .mean import (downburst_field, event_window, mean_components_at_nodes, mean_velocity_at, nearest_node_to_p,
-                   point_p)
+from .mean import downburst_field, event_window, mean_components_at_nodes, mean_velocity_at, nearest_node_to_p, point_p
 from .turbulence import length_scale, unit_field
 
 

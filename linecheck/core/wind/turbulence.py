@@ -62,15 +62,15 @@ from ..system import LineSystem
 from .mean import mean_normal_at_nodes, mean_speed_at_nodes
 
 __all__ = [
-    "SpectralGrid",
     "VON_KARMAN_A",
+    "SpectralGrid",
     "davenport_coherence",
-    "fluctuating_velocity",
-    "general_apply",
-    "kms_apply",
     "fft_input",
+    "fluctuating_velocity",
     "gap_coherence",
     "gap_rows",
+    "general_apply",
+    "kms_apply",
     "length_scale",
     "markov_apply",
     "markov_quadratic_form",
@@ -418,7 +418,7 @@ def unit_field(case: Case, system: LineSystem, n_steps: int, dt: float, realizat
                       case.wind.coherence_decay, v)
 
 
-_phase_memo: "dict[tuple, UnitPhases]" = {}
+_phase_memo: dict[tuple, UnitPhases] = {}
 
 
 def unit_phases(seed: int, realization: int, n_nodes: int, n_freq: int) -> UnitPhases:
@@ -494,7 +494,7 @@ def fluctuating_velocity(case: Case, system: LineSystem, time: np.ndarray, reali
 #: [bytes] unit fields kept per process for reuse (issue 20: scans); the environment variable
 #: LINECHECK_UNIT_FIELD_MEMO overrides it (0: off; the bench scripts time fresh runs with it)
 UNIT_FIELD_MEMO_BYTES = float(os.environ.get("LINECHECK_UNIT_FIELD_MEMO", "256e6"))
-_memo: "dict[tuple, np.ndarray]" = {}
+_memo: dict[tuple, np.ndarray] = {}
 _memo_lock = threading.Lock()
 
 

@@ -18,7 +18,7 @@ class TickBox(Checkbox):
     """A checkbox that shows ``X`` only when ticked (Textual's shows it always, only recoloured)."""
 
     @property
-    def _button(self):  # noqa: ANN202 - Textual's Content
+    def _button(self):
         self.BUTTON_INNER = "X" if self.value else " "
         return super()._button
 

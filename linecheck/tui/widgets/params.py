@@ -26,8 +26,17 @@ from ...core.case import Case, FieldSpec, field_spec, with_value, with_values
 from ...core.errors import CaseError
 from ...io.section import COLUMN_UNITS, section_summary, tower_rows
 from ..catalog import shown_path
-from ..formatting import (TOWER_KEYS, case_differences, fields_for, get_value, iter_fields, parse_value, tower_dicts,
-                          tower_key, value_text)
+from ..formatting import (
+    TOWER_KEYS,
+    case_differences,
+    fields_for,
+    get_value,
+    iter_fields,
+    parse_value,
+    tower_dicts,
+    tower_key,
+    value_text,
+)
 from ..messages import ParameterChanged, ParameterRejected
 
 COLUMNS = ("", "parameter", "value", "unit", "description")

@@ -9,11 +9,19 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.widgets import DataTable, RadioButton, RadioSet, Static, TabbedContent, TabPane
 
-from .. import figures
-from ..formatting import (REACTIONS, cont_r_flags, davenport_lines, how_to_read, sanity_rows, spectral_compare_rows,
-                          summary_rows, summary_title)
 from ...io.display import STAT_ROWS, doc_frame_caption, number_text
 from ...io.document import RunDocument
+from .. import figures
+from ..formatting import (
+    REACTIONS,
+    cont_r_flags,
+    davenport_lines,
+    how_to_read,
+    sanity_rows,
+    spectral_compare_rows,
+    summary_rows,
+    summary_title,
+)
 from ..plotting import PlotView
 from ..runner import RunOutput
 
@@ -65,12 +73,11 @@ class ResultsView(Vertical):
                 yield PlotView(NO_RUN, id="plot-wind")
             with TabPane("Contributions", id="res-contrib"):
                 yield PlotView(NO_RUN, id="plot-contrib")
-            with TabPane("Spectral check", id="res-spectral"):
-                with VerticalScroll(id="spectral-box"):
-                    yield Static(NO_RUN, id="spectral-notes")
-                    yield DataTable(id="spectral-table", cursor_type="row", zebra_stripes=True)
-                    yield Static("", id="spectral-davenport")
-                    yield DataTable(id="sanity-table", cursor_type="row", zebra_stripes=True)
+            with TabPane("Spectral check", id="res-spectral"), VerticalScroll(id="spectral-box"):
+                yield Static(NO_RUN, id="spectral-notes")
+                yield DataTable(id="spectral-table", cursor_type="row", zebra_stripes=True)
+                yield Static("", id="spectral-davenport")
+                yield DataTable(id="sanity-table", cursor_type="row", zebra_stripes=True)
             with TabPane("Frequencies", id="res-freq"):
                 yield Static(NO_RUN, id="freq-notes")
                 yield DataTable(id="freq-table", cursor_type="row", zebra_stripes=True)

@@ -25,7 +25,7 @@ from ..core.extremes import (
 )
 from ..io.display import STAT_ROWS
 from ..io.document import RunDocument, SanityItem
-from .app import CaseArg, app, console, err_console, error_line, handle_errors, path_value, read_case
+from .common import CaseArg, app, console, err_console, error_line, handle_errors, path_value, read_case
 from .export_cmd import (
     EngineerOpt,
     LineOpt,

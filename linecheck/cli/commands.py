@@ -9,7 +9,7 @@ from rich.table import Table
 from ..core.errors import CaseError
 from ..io.atomic import check_target
 from ..io.outputs import case_inputs, check_outputs
-from .app import CaseArg, CasesArg, JsonOpt, app, console, error_line, handle_errors, read_case
+from .common import CaseArg, CasesArg, JsonOpt, app, console, error_line, handle_errors, read_case
 from .limits import warn as limits_warn
 from .progress import progress_bar
 
@@ -107,14 +107,3 @@ def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     if json_out is not None:
         write_json(json_out, doc)
         console.print(f"wrote {json_out}")
-from . import (  # noqa: E402 - registers the commands on the app defined above
-    batch_cmd,  # noqa: F401
-    codes_cmd,  # noqa: F401
-    export_cmd,  # noqa: F401
-    info_cmd,  # noqa: F401
-    run_cmd,  # noqa: F401
-    spectral_cmd,  # noqa: F401
-    tui_cmd,  # noqa: F401
-    validate_cmd,  # noqa: F401
-    wind_cmd,  # noqa: F401
-)

@@ -14,7 +14,7 @@ import typer
 
 from ..core.errors import CaseError
 from ..core.extremes import CONT_R_THRESHOLD
-from .app import app, console, handle_errors, path_value
+from .common import app, console, handle_errors, path_value
 
 ExcelOpt = Annotated[Path | None, typer.Option(
     "--excel", help="Also write the Excel design sheet (.xlsx) to this file.", show_default=False, parser=path_value)]

@@ -9,7 +9,7 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from .app import app, console, handle_errors
+from .common import app, console, handle_errors
 
 
 def info_table(prov) -> Table:

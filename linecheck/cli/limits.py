@@ -13,7 +13,7 @@ from typing import Annotated
 import typer
 
 from ..core.budget import ENV_MAX_MEMORY, parse_size
-from .app import error_line
+from .common import error_line
 
 MaxMemoryOpt = Annotated[str | None, typer.Option(
     "--max-memory", help="Refuse jobs estimated to need more memory than this (e.g. 8GB, 512MB; "

@@ -7,7 +7,7 @@ from collections.abc import Iterator
 
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-from .app import err_console
+from .common import err_console
 
 
 @contextlib.contextmanager

@@ -15,7 +15,7 @@ from ..io.atomic import check_target
 from ..io.display import STAT_ROWS, SUMMARY_STATS, number_text, stat_text
 from ..io.document import RunDocument, StatDef
 from ..io.outputs import case_inputs, check_outputs
-from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
+from .common import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .export_cmd import (
     EngineerOpt,
     ExcelOpt,
@@ -266,7 +266,7 @@ def modes(
 ) -> None:
     """Natural frequencies (and mode shapes) of the still-air and mean states."""
     from .. import service
-    from ..io.jsonout import _num, with_provenance, write_json
+    from ..io.jsonout import modes_to_dict, write_json
 
     case = read_case(case_file)
     check_outputs([("--json", json_out)], case_inputs(case))
@@ -282,23 +282,7 @@ def modes(
     if case.wind.type == "downburst":
         console.print(f"[dim]mean state at t = {res.mean_time:.1f} s (largest mean reaction at the tower of interest)[/]")
     if json_out is not None:
-        dirs = "xyz"
-        ds, dm = res.still_air.dominant_direction(), res.mean.dominant_direction()
-        doc = {"case": case.name, "units": "SI",
-               "still_air": {"frequencies_hz": _num(res.still_air.frequencies_hz),
-                             "direction": [dirs[i] for i in ds]},
-               "mean": {"frequencies_hz": _num(res.mean.frequencies_hz), "direction": [dirs[i] for i in dm],
-                        "time": res.mean_time,
-                        "damped_frequencies_hz": _num(res.damped.frequencies_hz),
-                        "damping_ratios": _num(res.damped.damping_ratio),
-                        "paired_damped": {"frequencies_hz": _num(res.paired_hz),
-                                          "damping_ratios": _num(res.paired_ratio),
-                                          "mac": _num(res.paired_mac)}},
-               "damping": case.analysis.damping}
-        if shapes:
-            doc["still_air"]["shapes"] = _num(res.still_air.shapes)
-            doc["mean"]["shapes"] = _num(res.mean.shapes)
-        write_json(json_out, with_provenance(doc))
+        write_json(json_out, modes_to_dict(case, res, shapes=shapes))
         console.print(f"wrote {json_out}")
 
 

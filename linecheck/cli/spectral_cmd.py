@@ -8,7 +8,7 @@ from rich.table import Table
 
 from ..io.atomic import check_target
 from ..io.outputs import case_inputs, check_outputs
-from .app import CaseArg, JsonOpt, app, console, handle_errors, read_case
+from .common import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .limits import warn as limits_warn
 
 

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from .app import app, error_line, path_value
+from .common import app, error_line, path_value
 
 PathsArg = Annotated[
     list[Path] | None,

@@ -11,7 +11,7 @@ from rich.table import Table
 
 from ..io.atomic import check_target, write_text_atomic
 from ..io.outputs import check_outputs
-from .app import JsonOpt, app, console, handle_errors, path_value
+from .common import JsonOpt, app, console, handle_errors, path_value
 from .progress import progress_bar
 
 

@@ -14,7 +14,7 @@ from rich.table import Table
 from ..core.case import Case
 from ..io.atomic import check_target, write_atomic, write_text_atomic
 from ..io.outputs import case_inputs, check_outputs
-from .app import CaseArg, JsonOpt, app, console, handle_errors, path_value, read_case
+from .common import CaseArg, JsonOpt, app, console, handle_errors, path_value, read_case
 
 if TYPE_CHECKING:  # annotations only: the wind modules are imported where they are used (start-up time)
     from ..core.wind.point import PointSeries

@@ -119,6 +119,28 @@ def static_to_dict(res: StaticResult) -> dict[str, Any]:
     return with_provenance(doc)
 
 
+def modes_to_dict(case: Any, res: Any, *, shapes: bool = False) -> dict[str, Any]:
+    """JSON of ``linecheck modes`` (a :class:`~linecheck.service.ModesResult`): the still-air and
+    mean-state frequencies [Hz] and dominant directions, the damped modes and those paired with
+    the mean-state ones by shape, the mode shapes if ``shapes``, and ``"provenance"``."""
+    dirs = "xyz"
+    ds, dm = res.still_air.dominant_direction(), res.mean.dominant_direction()
+    doc: dict[str, Any] = {
+        "case": case.name, "units": "SI",
+        "still_air": {"frequencies_hz": _num(res.still_air.frequencies_hz), "direction": [dirs[i] for i in ds]},
+        "mean": {"frequencies_hz": _num(res.mean.frequencies_hz), "direction": [dirs[i] for i in dm],
+                 "time": res.mean_time,
+                 "damped_frequencies_hz": _num(res.damped.frequencies_hz),
+                 "damping_ratios": _num(res.damped.damping_ratio),
+                 "paired_damped": {"frequencies_hz": _num(res.paired_hz), "damping_ratios": _num(res.paired_ratio),
+                                   "mac": _num(res.paired_mac)}},
+        "damping": case.analysis.damping}
+    if shapes:
+        doc["still_air"]["shapes"] = _num(res.still_air.shapes)
+        doc["mean"]["shapes"] = _num(res.mean.shapes)
+    return with_provenance(doc)
+
+
 def write_json(path: str | Path, doc: Any, *, force: bool = True) -> Path:
     """Write a JSON document (a dict, or a typed document by its ``to_json()``) atomically."""
     if hasattr(doc, "to_json"):

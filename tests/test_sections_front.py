@@ -320,10 +320,10 @@ def test_spectral_line_without_a_closed_form():
 
 def test_tui_codes_rows_name_the_section_towers():
     """The TUI's Codes table labels a section's towers "index name" (issue 17)."""
-    from linecheck.io.document import CodeCheck, CodeTower, CodeVerdict
+    from linecheck.io.document import CodeCheckRecord, CodeTower, CodeVerdict
     from linecheck.tui.widgets.codes import codes_rows
 
-    block = CodeCheck(edition="2010", verified=True, provision="synoptic", inputs={}, note="", load_per_length=10.0,
+    block = CodeCheckRecord(edition="2010", verified=True, provision="synoptic", inputs={}, note="", load_per_length=10.0,
                       towers=(CodeTower(7, {"Ry": CodeVerdict(4000.0, 5000.0, 1.25, "code exceeded by 25 %")}),))
     assert codes_rows({"ASCE74": block}, {7: "T7"})[0][2] == "7 T7"
     assert codes_rows({"ASCE74": block})[0][2] == "7"  # the equal-span form: numbers only

@@ -24,7 +24,7 @@ from ..core.extremes import (
     CONT_R_THRESHOLD as CONT_R_FLAG,  # Cont_R flag, paper Sect. 5 (one definition)
 )
 from ..io.display import STAT_ROWS
-from ..io.document import RunDocument, SanityItem
+from ..io.document import RunDocument, SanityCheckRow
 from .common import CaseArg, app, console, err_console, error_line, handle_errors, path_value, read_case
 from .export_cmd import (
     EngineerOpt,
@@ -279,14 +279,14 @@ def cont_r_flags(doc: RunDocument | None, state: str = "recommended") -> list[st
     return [r for r in REACTION_NAMES if doc.reactions[r].dynamic_analysis == state]
 
 
-def sanity_failures(doc: RunDocument | None) -> list[SanityItem]:
+def sanity_failures(doc: RunDocument | None) -> list[SanityCheckRow]:
     """The failed items of the time- vs frequency-domain sanity check of a synoptic result."""
     if doc is None or doc.spectral is None:
         return []
     return [i for i in doc.spectral.sanity_check or () if not i.ok]
 
 
-def _sanity_text(item: SanityItem) -> str:
+def _sanity_text(item: SanityCheckRow) -> str:
     def kn(v: Any) -> str:
         return "?" if v is None else f"{v / 1e3:.3f}"
 

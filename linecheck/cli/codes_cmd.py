@@ -8,13 +8,13 @@ import typer
 from rich.table import Table
 
 from ..io.atomic import check_target
-from ..io.document import CodeCheck
+from ..io.document import CodeCheckRecord
 from ..io.outputs import case_inputs, check_outputs
 from .common import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .progress import progress_bar
 
 
-def codes_table(codes: dict[str, CodeCheck], title: str) -> Table:
+def codes_table(codes: dict[str, CodeCheckRecord], title: str) -> Table:
     """Rich table of a typed ``codes`` block (kN at display)."""
     t = Table(title=title, title_justify="left")
     for col in ("code", "verified", "tower", "code load kN", "linecheck peak kN", "ratio", "verdict"):
@@ -32,7 +32,7 @@ def codes_table(codes: dict[str, CodeCheck], title: str) -> Table:
     return t
 
 
-def print_codes_notes(codes: dict[str, CodeCheck]) -> None:
+def print_codes_notes(codes: dict[str, CodeCheckRecord]) -> None:
     for name, block in codes.items():
         console.print(f"[dim]{name} ({block.edition}): {block.note}[/]", highlight=False)
 

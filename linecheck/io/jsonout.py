@@ -193,7 +193,7 @@ def run_document(res: Any, *, full_histories: bool = False, max_points: int = 20
     extremes unless ``full_histories``.
     """
     from ..core.results import REACTIONS
-    from .document import BurnIn, SanityItem, StaticSeries, StillAir, TimeHistories, document_of
+    from .document import BurnInRecord, SanityCheckRow, StaticSeries, StillAir, TimeHistories, document_of
     from .provenance import provenance
 
     case = res.case
@@ -214,7 +214,7 @@ def run_document(res: Any, *, full_histories: bool = False, max_points: int = 20
     }
     if res.burn_in is not None:
         b = res.burn_in
-        blocks["burn_in"] = BurnIn(_num(b.seconds), _num(b.required), _num(b.mode_hz), _num(b.zeta), b.sufficient,
+        blocks["burn_in"] = BurnInRecord(_num(b.seconds), _num(b.required), _num(b.mode_hz), _num(b.zeta), b.sufficient,
                                    b.source)
     if res.spectral is not None:
         from dataclasses import replace
@@ -222,7 +222,7 @@ def run_document(res: Any, *, full_histories: bool = False, max_points: int = 20
         from ..service import sanity_check
 
         blocks["spectral"] = replace(spectral_document(res.spectral), sanity_check=tuple(
-            SanityItem(it.reaction, it.quantity, _num(it.time_domain), _num(it.time_domain_std),
+            SanityCheckRow(it.reaction, it.quantity, _num(it.time_domain), _num(it.time_domain_std),
                        _num(it.frequency_domain), _num(it.allowed), it.ok)
             for it in sanity_check(res)))
     blocks["codes"] = codes_block(res)
@@ -260,7 +260,7 @@ def codes_to_dict(cr: Any) -> dict[str, Any]:
 
 def codes_block(res: Any) -> dict[str, Any]:
     """The typed ``codes`` block of a run document (per code a
-    :class:`~linecheck.io.document.CodeCheck`): the design codes beside the run's peaks; a code
+    :class:`~linecheck.io.document.CodeCheckRecord`): the design codes beside the run's peaks; a code
     outside its validity is reported, not raised (``linecheck codes`` raises instead)."""
     from ..service import codes_analysis
 
@@ -268,10 +268,10 @@ def codes_block(res: Any) -> dict[str, Any]:
 
 
 def codes_document(cr: Any) -> dict[str, Any]:
-    """The typed form of :func:`codes_to_dict`: per code a :class:`~linecheck.io.document.CodeCheck`."""
-    from .document import CodeCheck
+    """The typed form of :func:`codes_to_dict`: per code a :class:`~linecheck.io.document.CodeCheckRecord`."""
+    from .document import CodeCheckRecord
 
-    return {k: CodeCheck.from_json(v) for k, v in codes_to_dict(cr).items()}
+    return {k: CodeCheckRecord.from_json(v) for k, v in codes_to_dict(cr).items()}
 
 
 def with_models(doc: Any, model: str, reactions: dict[str, Any], failed: dict[str, str] | None = None) -> Any:

@@ -186,7 +186,7 @@ def blas_libraries() -> tuple[Blas, Blas | None]:
 def kernel_state() -> Kernel:
     """Every piece of the compiled kernel (:func:`linecheck.core.kernel.status`: loads the kernel
     first unless ``LINECHECK_KERNEL=numpy``; ≈ 0.5 s once per process with Numba's cache warm)."""
-    from ..core import kernel
+    from ..core.pieces import kernel  # with every piece's load check registered
 
     pieces = tuple(Piece(p.name, bool(p.on), p.reason, p.description) for p in kernel.status())
     return Kernel(kernel.installed(), kernel.mode(), pieces)

@@ -12,14 +12,14 @@ from textual.containers import Vertical
 from textual.widgets import DataTable, Static
 
 from ...core.codes import CODES_PEAK
-from ...io.document import CodeCheck, RunDocument
+from ...io.document import CodeCheckRecord, RunDocument
 
 HELP = "No result yet. Run a case (r): the four design codes' conductor wind loads appear here beside its peaks."
 PEAK_NOTE = (f"linecheck peak: {CODES_PEAK}; ratio = peak / code load. "
              "Unverified codes are shown, not judged (docs/codes.md).")
 
 
-def codes_rows(codes: dict[str, CodeCheck], names: dict[int, str] | None = None) -> list[tuple[str, ...]]:
+def codes_rows(codes: dict[str, CodeCheckRecord], names: dict[int, str] | None = None) -> list[tuple[str, ...]]:
     """Table rows (text, kN) of a typed ``codes`` block; ``names``: tower labels by 1-based index
     (a section's ``towers[].name``, issue 17), shown as "7 T7"."""
     def kn(x):

@@ -21,7 +21,7 @@ import pytest
 from typer.testing import CliRunner
 
 from linecheck.cli.app import app
-from linecheck.core import case as case_module
+from linecheck.core import case_geometry, case_load, case_towers, case_validate
 from linecheck.core.case import case_hash, load_case
 from linecheck.core.errors import CaseError
 
@@ -135,15 +135,17 @@ def _synoptic_with_span_speeds(tmp_path: Path, values: list[str]) -> Path:
 
 @pytest.fixture
 def fmt_calls(monkeypatch):
-    """Counts the calls of the message formatting (``case._fmt``) while a case is checked."""
+    """Counts the calls of the message formatting (``case_validate.fmt_value``, wherever the case
+    modules call it) while a case is checked."""
     calls = [0]
-    real = case_module._fmt
+    real = case_validate.fmt_value
 
     def counting(value):
         calls[0] += 1
         return real(value)
 
-    monkeypatch.setattr(case_module, "_fmt", counting)
+    for module in (case_validate, case_load, case_geometry, case_towers):
+        monkeypatch.setattr(module, "fmt_value", counting)
     return calls
 
 
@@ -153,14 +155,14 @@ def test_checking_a_long_list_formats_a_bounded_number_of_items(tmp_path, fmt_ca
     and the message (a wrong count for this 1-span line) shows a few items and the length."""
     n = 10_000
     checked = [0]
-    real_ok = case_module._number_ok
+    real_ok = case_validate._number_ok
 
     def counting_ok(spec, v):
         checked[0] += 1
         return real_ok(spec, v)
 
     path = _synoptic_with_span_speeds(tmp_path, ["30.0"] * n)
-    monkeypatch.setattr(case_module, "_number_ok", counting_ok)
+    monkeypatch.setattr(case_validate, "_number_ok", counting_ok)
     with pytest.raises(CaseError) as info:
         load_case(path)
     msg = str(info.value)

@@ -9,6 +9,13 @@ import pytest
 
 CORE_MODULES = [
     "linecheck.core.case",
+    "linecheck.core.case_schema",
+    "linecheck.core.case_model",
+    "linecheck.core.case_validate",
+    "linecheck.core.case_files",
+    "linecheck.core.case_towers",
+    "linecheck.core.case_geometry",
+    "linecheck.core.case_load",
     "linecheck.core.errors",
     "linecheck.core.system",
     "linecheck.core.static",

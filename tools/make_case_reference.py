@@ -12,12 +12,12 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from linecheck.core.case import SCHEMA
+from linecheck.core.case_schema import SCHEMA
 
 HEADER = """# Case files
 
 A case file is TOML. Its key layout is a public contract: the names below do not change.
-This page is generated from the schema in `linecheck/core/case.py`
+This page is generated from the schema in `linecheck/core/case_schema.py`
 (`python tools/make_case_reference.py`).
 
 Every key is checked for type and range; an unknown key is rejected with the closest valid
@@ -128,7 +128,7 @@ drag = "linear"
 tension = "linear"
 ```
 
-## Sections: towers, angles and terrain (issue 17)
+## Sections: towers, angles and terrain
 
 A real section is described by its towers instead of the equal-span keys: `[line] tension` (H0,
 the still-air horizontal tension at clipping-in) and either one `[[line.towers]]` table per
@@ -167,7 +167,7 @@ characters is described by its length. `[wind] direction`,
 `profile_exponent` and `reference_height` apply to both forms (equal-span form: every node at
 `height`).
 
-`drag` and `tension` (issue 16) choose how much of the non-linearity the method keeps. The
+`drag` and `tension` choose how much of the non-linearity the method keeps. The
 paper's method is `drag = "linear"` (Eq. 5: the drag's v² term dropped) and `tension =
 "linear"` (reactions linear in the motion); the paper cases pin both and reproduce the paper's
 method bit for bit. A case that omits them gets `drag = "quadratic"` (the v² term kept: its

@@ -19,9 +19,9 @@ import pytest
 from scipy.linalg import lapack
 
 from linecheck import service
-from linecheck.core import kernel
 from linecheck.core.case import load_case
 from linecheck.core.model import BANDWIDTH
+from linecheck.core.pieces import kernel  # with every piece's load check registered
 
 from .conftest import CASES
 from .tolerance import RTOL_OP, RTOL_RUN, RTOL_SOLVE, assert_close
@@ -154,7 +154,8 @@ def test_downburst_field_agrees(monkeypatch, name):
     st = service._static_analysis(case)
     x = np.unique(np.concatenate([wm.span_node_x(st.system).ravel(), st.system.node_x0]))
     t = service.record_time(case)
-    got = kernel.field_velocity(field, x, t)
+    got = kernel.field_velocity(field, x, t, float(wm.vertical_profile(field.height, field.delta)),
+                                wm.intensity(t, field.t1, field.t_f))
     ref = field.velocity_numpy(x, t)
     assert got is not None
     for a, b in zip(got, ref):
@@ -333,7 +334,7 @@ def test_a_piece_that_fails_its_check_falls_back_alone(monkeypatch):
     the measured difference as the reason; the other pieces stay on and a run still agrees."""
     monkeypatch.setenv("LINECHECK_KERNEL", "auto")
     monkeypatch.setattr(kernel, "_pieces", {})
-    monkeypatch.setattr(kernel, "_newmark_check", lambda fns: 6e-10)
+    monkeypatch.setitem(kernel._checks, "newmark", lambda fns: 6e-10)  # the check dynamics registered
     states = {p.name: p for p in kernel.status()}
     assert not states["newmark"].on
     assert states["newmark"].reason == "load check: differs from numpy by 6.0e-10 of the largest value (allowed 1e-12)"
@@ -367,13 +368,13 @@ def test_change_of_node_bases_agrees():
 
 @needs_kernel
 def test_static_transfer_rows_agree():
-    """kernel.rowdot (step 3's static transfer, compiled where verified at load) against _rowdot."""
-    from linecheck.core.dynamics import _rowdot
+    """kernel.rowdot (step 3's static transfer, compiled where verified at load) against rowdot_numpy."""
+    from linecheck.core.dynamics import rowdot_numpy
 
     rng = np.random.default_rng(6)
     X, BT = rng.standard_normal((250, 59)), rng.standard_normal((59, 21))
     got = kernel.rowdot(X, BT)
-    assert_close(got, _rowdot(X, BT), RTOL_OP, "rowdot")
+    assert_close(got, rowdot_numpy(X, BT), RTOL_OP, "rowdot")
     np.testing.assert_allclose(got, X @ BT, rtol=1e-12, atol=1e-12 * np.abs(X @ BT).max())
 
 
@@ -427,7 +428,7 @@ def test_a_numba_that_fails_falls_back_to_numpy(monkeypatch):
 _CACHE_PROBE = r'''
 import dataclasses, os
 from linecheck import service
-from linecheck.core import kernel
+from linecheck.core.pieces import kernel  # with every piece's load check registered
 from linecheck.core.case import load_case
 case = load_case(os.environ["PROBE_CASE"])
 case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, duration=4.0, burn_in=1.0))
@@ -516,8 +517,8 @@ def test_step1_span_tension_agrees(monkeypatch, name):
     state; sections solve their spans by :mod:`linecheck.core.catenary` instead)."""
     case = load_case(CASES / f"{name}.toml")
     calls = []
-    fn = kernel._span  # the compiled form's call
-    monkeypatch.setattr(kernel, "_span", lambda *a, **k: calls.append(1) or fn(*a, **k))
+    fn = kernel.span_compiled  # the compiled form's call
+    monkeypatch.setattr(kernel, "span_compiled", lambda *a, **k: calls.append(1) or fn(*a, **k))
     monkeypatch.setenv("LINECHECK_KERNEL", "numba")
     fast = service.static_analysis(case).mean
     n_fast = len(calls)

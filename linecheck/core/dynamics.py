@@ -25,13 +25,14 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.linalg import lapack
 
 from . import kernel
 from .banded import ColumnSolver
 from .banded import factor as _factor
 from .banded import solve as _solve
 from .errors import Cancelled, NumericalError
-from .model import CSRArrays, LinearModel, band_blocks, band_to_csr_stack, rotate_band
+from .model import BANDWIDTH, CSRArrays, LinearModel, band_blocks, band_to_csr, band_to_csr_stack, rotate_band
 
 try:  # the kernel behind scipy's CSR @ dense product, called without the per-call dispatch
     from scipy.sparse._sparsetools import csr_matvecs as _csr_matvecs
@@ -223,7 +224,7 @@ def integrate(
             m, _ = model_of(n)
             c = _factor(m.K_band, np.zeros(n_dof), f"stiffness at step {n}")
             UB = _solve(c, loads_full(loads[n]).T).T
-            R_B[n] = _rowdot(UB, m.G.T)
+            R_B[n] = rowdot_numpy(UB, m.G.T)
             if second_order is not None and n >= second_order_start:
                 R_B[n] += so(n, UB)
 
@@ -233,7 +234,7 @@ def integrate(
     chol = _factor(m0.K_band, np.zeros(n_dof), "stiffness at t = 0")
     U = _solve(chol, loads_full(loads[0]).T).T  # quasi-static start, (n_real, n_dof), global
     R_F = np.empty((n_steps, n_real, n_r))
-    R_F[0] = _rowdot(U, m0.G.T)
+    R_F[0] = rowdot_numpy(U, m0.G.T)
     if second_order is not None and second_order_start == 0:
         R_F[0] += so(0, U)
     block = max(1, min(512, 2_000_000 // max(n_real * n_dof, 1)))  # steps per block
@@ -347,7 +348,7 @@ def integrate(
     )
 
 
-def _rowdot(X: np.ndarray, BT: np.ndarray) -> np.ndarray:
+def rowdot_numpy(X: np.ndarray, BT: np.ndarray) -> np.ndarray:
     """X @ BT computed row by row in a fixed order (no BLAS): every realization's reactions
     are then bit-identical whichever other realizations share the call (batch chunking,
     workers); a BLAS gemm rounds differently for different numbers of rows.  X is made
@@ -595,3 +596,83 @@ def st_rotate(X: np.ndarray, old: _Stepper | None, new: _Stepper) -> np.ndarray:
     if old is not None:
         Xn = np.einsum("rnj,naj->rna", Xn, old.T)  # u = T u~
     return np.ascontiguousarray(np.einsum("rna,naj->rnj", Xn, new.T).reshape(shape))  # u~ = T^T u
+
+
+# ---- the compiled kernel's pieces ``newmark``, ``rotate`` and ``rowdot`` (linecheck.core.kernel):
+# their load checks and numpy forms
+
+def _band_check_system(rng, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """A random diagonally dominant banded SPD matrix (upper band storage, (BANDWIDTH + 1, n);
+    condition ≲ 10) and its Cholesky factor (LAPACK ``dpbtrf``)."""
+    kd = BANDWIDTH
+    ab = np.zeros((kd + 1, n))
+    for off in range(kd + 1):
+        ab[kd - off, off:] = rng.uniform(-1.0, 1.0, max(n - off, 0))
+    ab[kd] = 4.0 * (kd + 1) + rng.uniform(0.0, 1.0, n)
+    c, info = lapack.dpbtrf(ab, lower=0)
+    if info != 0:  # pragma: no cover - diagonally dominant by construction
+        raise NumericalError("load check: test matrix not positive definite")
+    return ab, c
+
+
+def _newmark_check(fns) -> float:
+    """The compiled banded solves (four lanes, one vector, a short system) against LAPACK
+    ``dpbtrs``, the structural-damping remainder by diagonals against scipy's CSR product; the
+    largest relative difference."""
+    rng = np.random.default_rng(20)
+    pairs = []
+    for n in (60, 4):
+        ab, c = _band_check_system(rng, n)
+        B = rng.standard_normal((4, n))
+        ref = lapack.dpbtrs(c, np.asfortranarray(B.T), lower=0)[0]
+        X = np.ascontiguousarray(B.T)[None]  # one group of four lanes
+        fns.band_solve(c, X)
+        pairs.append((ref, X[0]))
+        for q in range(4):
+            x = B[q].copy()
+            fns.band_solve_1(c, x)
+            pairs.append((ref[:, q], x))
+        cols = np.array(B.T)
+        fns.solve_columns(c, cols)
+        pairs.append((ref, cols))
+        ab[BANDWIDTH] = 0.0  # an off-diagonal remainder, with some exact zeros
+        ab[rng.random(ab.shape) < 0.2] = 0.0
+        rest = band_to_csr(ab)
+        W = rng.standard_normal((4, n))
+        t = np.empty((4, n))
+        fns.rest_product(rest.band, np.pad(W, ((0, 0), (BANDWIDTH, BANDWIDTH))), t)
+        pairs.append(((rest.tocsr() @ W.T).T, t))
+    return kernel.worst_difference(pairs)
+
+
+def _rotate_check(fns) -> float:
+    """The compiled change of node bases (``fns.rotate``) against :func:`st_rotate`."""
+    from types import SimpleNamespace
+
+    rng = np.random.default_rng(21)
+    To, Tn = (np.linalg.qr(rng.standard_normal((20, 3, 3)))[0] for _ in range(2))
+    X = rng.standard_normal((5, 60))
+    pairs = []
+    for old in (None, SimpleNamespace(T=To)):
+        Y = X.copy()
+        fns.rotate(Y, To, Tn, old is not None)
+        pairs.append((st_rotate(X, old, SimpleNamespace(T=Tn)), Y))
+    return kernel.worst_difference(pairs)
+
+
+def _rowdot_check(fns) -> float:
+    """The compiled X @ BT (``fns.rowdot``) against :func:`rowdot_numpy` on the shapes the core
+    uses (many rows, tens of columns)."""
+    rng = np.random.default_rng(22)
+    pairs = []
+    for m, n, q in ((480, 59, 21), (7, 177, 9), (33, 3, 40), (482, 55, 3), (6, 10, 2)):
+        X, BT = rng.standard_normal((m, n)), rng.standard_normal((n, q))
+        out = np.empty((m, q))
+        fns.rowdot(X, BT, out)
+        pairs.append((rowdot_numpy(X, BT), out))
+    return kernel.worst_difference(pairs)
+
+
+kernel.register_check("newmark", _newmark_check)
+kernel.register_check("rotate", _rotate_check, numpy=st_rotate)
+kernel.register_check("rowdot", _rowdot_check, numpy=rowdot_numpy)

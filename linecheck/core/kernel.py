@@ -45,6 +45,7 @@ from __future__ import annotations
 import importlib.util
 import os
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -82,11 +83,32 @@ class PieceState:
     description: str
 
 
-_lock = threading.Lock()
+_lock = threading.RLock()  # re-entrant: a piece's check may ask for the piece it requires
 _fns = None  # the compiled module (linecheck.core._loops) once loaded
-_pieces: dict[str, PieceState] = {}  # filled by _load
+_pieces: dict[str, PieceState] = {}  # filled per piece by its load check (_state)
+_checks: dict[str, Callable[[object], float]] = {}  # piece -> load check (register_check)
+_numpy_forms: dict[str, Callable] = {}  # piece -> numpy form an entry point falls back to
 _dgemm_address: int | None = None  # scipy's dgemm for the compiled second-order loop
 _NO_BAND = np.zeros((1, 1))  # the remainder argument of a stepper without one
+
+#: a piece that runs only when another one is on
+_REQUIRES = {"second_order_loop": "second_order"}
+
+
+def register_check(piece: str, check: Callable[[object], float], numpy: Callable | None = None) -> None:
+    """Register ``piece``'s load check: ``check(fns)`` runs the compiled functions ``fns`` (the
+    module :mod:`linecheck.core._loops`) on test data beside the numpy form and returns the
+    largest relative difference (:func:`worst_difference`); it runs the first time the piece is
+    asked for (:func:`use`, :func:`status`).  ``numpy``: the numpy form the piece's entry point
+    falls back to when the piece is off (entry points that return None instead need none).
+
+    The core module that owns a piece's numpy form registers it when imported;
+    :mod:`linecheck.core.pieces` imports all of them (for a full :func:`status`)."""
+    if piece not in PIECES:
+        raise ValueError(f"unknown kernel piece {piece!r}")
+    _checks[piece] = check
+    if numpy is not None:
+        _numpy_forms[piece] = numpy
 
 
 def mode() -> str:
@@ -111,7 +133,7 @@ def _one_line(e: BaseException) -> str:
     return text if len(text) <= 160 else text[:157] + "..."
 
 
-def _rel(ref, got) -> float:
+def relative_difference(ref, got) -> float:
     """Largest |got - ref| over the largest |ref| of one array (inf on a shape or finiteness mismatch)."""
     ref, got = np.asarray(ref), np.asarray(got)
     if ref.shape != got.shape or not np.array_equal(np.isfinite(ref), np.isfinite(got)):
@@ -124,13 +146,13 @@ def _rel(ref, got) -> float:
     return diff / scale if scale > 0 else (0.0 if diff == 0 else np.inf)
 
 
-def _worst(pairs) -> float:
-    """The largest :func:`_rel` over (ref, got) pairs."""
-    return max((_rel(r, g) for r, g in pairs), default=0.0)
+def worst_difference(pairs) -> float:
+    """The largest :func:`relative_difference` over (ref, got) pairs (what a load check returns)."""
+    return max((relative_difference(r, g) for r, g in pairs), default=0.0)
 
 
 def _load() -> None:
-    """Import Numba and the compiled loops, then check every piece against its numpy form."""
+    """Import Numba and the compiled loops; when that fails, every piece is off with the reason."""
     global _fns, _dgemm_address
     if not installed():
         _pieces.update({k: PieceState(k, False, "Numba not installed (linecheck[fast])", d) for k, d in PIECES.items()})
@@ -146,31 +168,22 @@ def _load() -> None:
         _dgemm_address = _loops.scipy_dgemm()
     except Exception:  # pragma: no cover - a scipy without cython_blas
         _dgemm_address = None
-    checks = {
-        "newmark": lambda: _newmark_check(_loops), "rotate": lambda: _rotate_check(_loops.rotate),
-        "rowdot": lambda: _rowdot_check(_loops.rowdot), "spectrum": lambda: _spectrum_check(_loops),
-        "loads": lambda: _loads_check(_loops.drag_loads), "span": lambda: _span_check(_loops.span_terms),
-        "reductions": lambda: _reductions_check(_loops.history_reductions),
-        "field": lambda: _field_check(_loops), "quad": lambda: _quad_check(_loops.quad_kms),
-        "second_order": lambda: _second_order_check(_loops),
-    }
-    for name, check in checks.items():
-        _pieces[name] = _checked(name, check)
-    if not _pieces["second_order"].on:
-        why = "needs the piece second_order"
-        _pieces["second_order_loop"] = PieceState("second_order_loop", False, why, PIECES["second_order_loop"])
-    elif _dgemm_address is None:  # pragma: no cover - scipy without an LP64 cython_blas dgemm
-        _pieces["second_order_loop"] = PieceState("second_order_loop", False, "scipy's cython_blas dgemm not found",
-                                                  PIECES["second_order_loop"])
-    else:
-        _pieces["second_order_loop"] = _checked("second_order_loop", lambda: _second_order_check(_loops, _dgemm_address))
 
 
-def _checked(name: str, check) -> PieceState:
-    """Run one piece's load check: on when its difference from numpy is within :data:`RTOL`."""
+def _checked(name: str) -> PieceState | None:
+    """Run one piece's load check: on when its difference from numpy is within :data:`RTOL`;
+    None when no module has registered it yet (not remembered: asked again later)."""
     desc = PIECES[name]
+    check = _checks.get(name)
+    if check is None:
+        return None
+    need = _REQUIRES.get(name)
+    if need is not None and not _state(need).on:
+        return PieceState(name, False, f"needs the piece {need}", desc) if need in _pieces else None
+    if name == "second_order_loop" and _dgemm_address is None:  # pragma: no cover - no LP64 dgemm
+        return PieceState(name, False, "scipy's cython_blas dgemm not found", desc)
     try:
-        d = check()
+        d = check(_fns)
     except Exception as e:  # compilation or the compiled call failed: this piece only
         return PieceState(name, False, f"load check failed: {_one_line(e)}", desc)
     if not d <= RTOL:
@@ -179,30 +192,48 @@ def _checked(name: str, check) -> PieceState:
     return PieceState(name, True, "", desc)
 
 
+def _state(piece: str) -> PieceState:
+    """``piece``'s state: loads the kernel on the first call, then runs the piece's check once."""
+    s = _pieces.get(piece)
+    if s is not None:
+        return s
+    with _lock:
+        if not _pieces:
+            _load()
+        s = _pieces.get(piece)
+        if s is None:
+            s = _checked(piece)
+            if s is None:
+                return PieceState(piece, False, "no load check registered (linecheck.core.pieces not imported)",
+                                  PIECES[piece])
+            _pieces[piece] = s
+        return s
+
+
 def status() -> tuple[PieceState, ...]:
-    """Every piece's state (loads the kernel first unless ``LINECHECK_KERNEL=numpy``)."""
+    """Every piece's state (loads the kernel and runs every registered check first unless
+    ``LINECHECK_KERNEL=numpy``; import :mod:`linecheck.core.pieces` for all of them)."""
     if mode() == "numpy":
         return tuple(PieceState(k, False, "LINECHECK_KERNEL=numpy", d) for k, d in PIECES.items())
-    _ensure()
-    return tuple(_pieces[k] for k in PIECES)
+    return tuple(_state(k) for k in PIECES)
 
 
 def _ensure() -> None:
-    if not _pieces:
+    """Load the compiled module (for entry points whose caller checked :func:`use`)."""
+    if _fns is None:
         with _lock:
-            if not _pieces:
+            if _fns is None:
                 _load()
 
 
 def use(piece: str) -> bool:
-    """Whether ``piece`` runs compiled in this process (loads the kernel on the first call).  The
-    answer depends only on the installation, ``LINECHECK_KERNEL`` and the piece's load check, so
-    every run of a case on one machine takes the same path."""
+    """Whether ``piece`` runs compiled in this process (loads the kernel and checks the piece on
+    the first call).  The answer depends only on the installation, ``LINECHECK_KERNEL`` and the
+    piece's load check, so every run of a case on one machine takes the same path."""
     if os.environ.get("LINECHECK_KERNEL") is not None and mode() == "numpy":  # asked per call: cheap
         return False
-    if not _pieces:
-        _ensure()
-    return _pieces[piece].on
+    s = _pieces.get(piece)
+    return s.on if s is not None else _state(piece).on
 
 
 def available() -> bool:
@@ -210,111 +241,19 @@ def available() -> bool:
     return mode() != "numpy" and any(p.on for p in status())
 
 
+def drag_loads_numpy(pv, pq, s2, v, sel, loads) -> None:
+    """The numpy form of :func:`drag_loads`; ``sel`` the free nodes, a slice or an index array."""
+    for i in range(v.shape[0]):
+        vi = v[i][:, sel]
+        np.multiply(pv, vi, out=loads[:, i, :])
+        if pq is not None:  # the quadratic drag's (v^2 - s2) pq
+            q = vi * vi
+            q -= s2
+            q *= pq
+            loads[:, i, :] += q
 
 
-# ---- load checks: each runs one piece on test data beside its numpy form and returns the
-# largest relative difference (:func:`_rel`)
-
-def _newmark_check(fns) -> float:
-    """The compiled banded solves (four lanes, one vector, a short system) against LAPACK
-    ``dpbtrs``, the structural-damping remainder by diagonals against scipy's CSR product, and a
-    block of compiled Newmark steps against the numpy loop's recurrence on the same system."""
-    from scipy.linalg import lapack
-
-    from .model import BANDWIDTH, band_to_csr
-
-    rng = np.random.default_rng(20)
-    pairs = []
-    for n in (60, 4):
-        kd = BANDWIDTH
-        ab = np.zeros((kd + 1, n))
-        for off in range(kd + 1):
-            ab[kd - off, off:] = rng.uniform(-1.0, 1.0, max(n - off, 0))
-        ab[kd] = 4.0 * (kd + 1) + rng.uniform(0.0, 1.0, n)  # diagonally dominant: condition ≲ 10
-        c, info = lapack.dpbtrf(ab, lower=0)
-        if info != 0:  # pragma: no cover - diagonally dominant by construction
-            return np.inf
-        B = rng.standard_normal((4, n))
-        ref, info = lapack.dpbtrs(c, np.asfortranarray(B.T), lower=0)
-        X = np.ascontiguousarray(B.T)[None]  # one group of four lanes
-        fns.band_solve(c, X)
-        pairs.append((ref, X[0]))
-        for q in range(4):
-            x = B[q].copy()
-            fns.band_solve_1(c, x)
-            pairs.append((ref[:, q], x))
-        cols = np.array(B.T)
-        fns.solve_columns(c, cols)
-        pairs.append((ref, cols))
-        ab[kd] = 0.0  # an off-diagonal remainder, with some exact zeros
-        ab[rng.random(ab.shape) < 0.2] = 0.0
-        rest = band_to_csr(ab)
-        W = rng.standard_normal((4, n))
-        t = np.empty((4, n))
-        fns.rest_product(rest.band, np.pad(W, ((0, 0), (kd, kd))), t)
-        pairs.append(((rest.tocsr() @ W.T).T, t))
-    return _worst(pairs)
-
-
-def _rotate_check(rotate) -> float:
-    """The compiled change of node bases against :func:`~linecheck.core.dynamics.st_rotate`."""
-    from types import SimpleNamespace
-
-    from .dynamics import st_rotate
-
-    rng = np.random.default_rng(21)
-    To, Tn = (np.linalg.qr(rng.standard_normal((20, 3, 3)))[0] for _ in range(2))
-    X = rng.standard_normal((5, 60))
-    pairs = []
-    for old in (None, SimpleNamespace(T=To)):
-        Y = X.copy()
-        rotate(Y, To, Tn, old is not None)
-        pairs.append((st_rotate(X, old, SimpleNamespace(T=Tn)), Y))
-    return _worst(pairs)
-
-
-def _rowdot_check(rowdot) -> float:
-    """The compiled X @ BT against :func:`~linecheck.core.dynamics._rowdot` on the shapes the
-    core uses (many rows, tens of columns)."""
-    from .dynamics import _rowdot
-
-    rng = np.random.default_rng(22)
-    pairs = []
-    for m, n, q in ((480, 59, 21), (7, 177, 9), (33, 3, 40), (482, 55, 3), (6, 10, 2)):
-        X, BT = rng.standard_normal((m, n)), rng.standard_normal((n, q))
-        out = np.empty((m, q))
-        rowdot(X, BT, out)
-        pairs.append((_rowdot(X, BT), out))
-    return _worst(pairs)
-
-
-def _spectrum_check(fns) -> float:
-    """The compiled synthesis spectrum against the numpy forms: equal gaps (the KMS recursion)
-    and unequal ones (the Markov recursion, a coefficient row per gap)."""
-    from .wind.turbulence import fft_input, gap_rows, kms_apply, markov_apply
-
-    rng = np.random.default_rng(23)
-    n_nodes, n_freq = 9, 301
-    phases = rng.random((n_nodes, n_freq)) * (2.0 * np.pi)
-    freq = np.arange(1, n_freq + 1) * 0.01
-    amp = rng.random(n_freq)
-    m = 2 * n_freq + 2
-    x = np.cumsum(np.r_[0.0, rng.choice([30.0, 12.5], n_nodes - 1)])
-    rows, gap = gap_rows(x, freq, 10.0, 40.0)
-    cases = [(markov_apply(x, freq, np.exp(1j * phases), 10.0, 40.0), rows, gap),
-             (kms_apply(rows[0], np.exp(1j * phases)), rows[:1], np.zeros(n_nodes - 1, dtype=np.int64))]
-    pairs = []
-    for y, r, g in cases:
-        ref = fft_input(y, amp, m)
-        got = np.zeros_like(ref)
-        xr, xi = np.empty_like(phases), np.empty_like(phases)
-        fns.phasors(phases, xr, xi)
-        fns.coherent_spectrum(xr, xi, r, np.sqrt(np.maximum(1.0 - r * r, 0.0)), g, amp, 0.5 * m, got)
-        pairs.append((ref.view(float), got.view(float)))
-    return _worst(pairs)
-
-
-def _loads_check(fn) -> float:
+def _loads_check(fns) -> float:
     """The compiled drag loads against :func:`drag_loads_numpy` (linear and quadratic drag)."""
     rng = np.random.default_rng(24)
     v = rng.standard_normal((3, 40, 9))
@@ -323,119 +262,12 @@ def _loads_check(fn) -> float:
     for quad in (False, True):
         ref, got = np.empty((40, 3, 7)), np.empty((40, 3, 7))
         drag_loads_numpy(pv, pq if quad else None, s2, v, slice(1, 8), ref)
-        fn(pv, pq, s2, v, 1, quad, got)
+        fns.drag_loads(pv, pq, s2, v, 1, quad, got)
         pairs.append((ref, got))
-    return _worst(pairs)
+    return worst_difference(pairs)
 
 
-def _field_check(fns) -> float:
-    """The compiled analytic downburst field against :meth:`DownburstField.velocity_numpy`
-    (points inside and outside r_max, at the centre, before and after the peak of Pi(t))."""
-    from .wind.mean import DownburstField
-
-    field = DownburstField(jet_diameter=600.0, height=15.0, centre=(450.0, -700.0), t_ref=300.0,
-                           translation=(3.0, 8.0), v_max=41.3, point_p=450.0, window=(0.0, 600.0),
-                           r_max=780.0, radial_decay=430.0, z_max=50.0, delta=272.0, t1=300.0, t_f=1200.0)
-    x = np.concatenate([np.linspace(0.0, 1800.0, 37), [712.5]])
-    t = np.concatenate([np.linspace(0.0, 900.0, 41), [387.5]])  # the centre crosses the line at x = 712.5
-    return _worst(zip(field.velocity_numpy(x, t), _field(fns, field, x, t)))
-
-
-def _quad_check(fn) -> float:
-    """The compiled coherence quadrature against :func:`~linecheck.core.spectral._quad_kms_nodes`
-    (one coherence for all gaps and one per gap)."""
-    from .spectral import _quad_kms_nodes
-
-    rng = np.random.default_rng(27)
-    w = rng.standard_normal((9, 13, 37)) + 1j * rng.standard_normal((9, 13, 37))
-    w[:, 3] = 0.0  # a node without load
-    pairs = []
-    for rho in (rng.random(37), rng.random((12, 37))):
-        ref = _quad_kms_nodes(w, rho, compiled=False)
-        got = np.empty(ref.shape)
-        fn(w, np.ascontiguousarray(np.atleast_2d(rho)), rho.ndim == 2, got)
-        pairs.append((ref, got))
-    return _worst(pairs)
-
-
-def _span_check(fn) -> float:
-    """The compiled span-tension integrands against :func:`~linecheck.core.static.span_terms`
-    (one and several states, with and without e)."""
-    from .static import span_terms as ref_terms
-
-    rng = np.random.default_rng(25)
-    pairs = []
-    for lead in ((), (3,)):
-        by = rng.standard_normal(lead + (4, 9)) * 1e4  # per state (step 1's loads), as static passes it
-        bz = rng.standard_normal((4, 9)) * 1e4
-        ay, az = (rng.standard_normal(lead + (4, 1)) * 0.05 for _ in range(2))
-        H = rng.uniform(1e4, 5e4, lead + (4,))
-        l = rng.uniform(300.0, 500.0, lead + (4,))
-        for ll in (None, l):
-            ref = ref_terms(ay, az, by, bz, H, 3.2e7, ll)
-            got = _span(fn, ay, az, by, bz, H, 3.2e7, ll)
-            if len(ref) != len(got):  # pragma: no cover - a compiled form that lost an output
-                return np.inf
-            pairs += list(zip(ref, got))
-    return _worst(pairs)
-
-
-def _reductions_check(fn) -> float:
-    """The compiled reductions over time against :func:`~linecheck.core.results.history_reductions`
-    (the mean held, and one per sample as with peak windows)."""
-    from .results import history_reductions as ref_fn
-
-    rng = np.random.default_rng(26)
-    B, R = rng.standard_normal((2, 3, 257, 2, 3)) * 1e3
-    sa = rng.standard_normal((2, 3)) * 1e4
-    pairs = []
-    for m in (1, 3):
-        M = rng.standard_normal((m, 257, 2, 3)) * 1e4
-        pairs += list(zip(ref_fn(M, B, R, sa), _reductions(fn, M, B, R, sa)))
-    return _worst(pairs)
-
-
-def _second_order_check(fns, dgemm: int | None = None) -> float:
-    """The compiled second-order passes (``dgemm`` None) or the whole compiled block loop with
-    scipy's ``dgemm`` (its address) against the numpy form, through
-    :func:`~linecheck.core.second_order.second_order_reactions` (in node bases and global, the
-    history row- and dof-major) and ``second_order_of_loads``, on an operator of random numbers
-    with two runs of free nodes, insulators, rows of zeros and a padded last block."""
-    from scipy.linalg import lapack
-
-    from .second_order import SecondOrder, second_order_of_loads, second_order_reactions
-
-    rng = np.random.default_rng(28)
-    n_nodes, n_s, n_r = 21, 3, 7
-    free = np.r_[1:10, 11:20]  # nodes 0, 10 and 20 pinned
-    n_el = n_nodes - 1
-    e = rng.standard_normal((n_el + n_s, 3))
-    op = SecondOrder(
-        e=(e / np.linalg.norm(e, axis=1)[:, None]).ravel(), c=np.ones(n_el + n_s), n_nodes=n_nodes,
-        pinned=np.array([0, 10, 20]), runs=((1, 10, 0), (11, 20, 9)), ins_free=np.array([4, 10, 15]),
-        A=np.zeros((3 * (n_el + n_s), n_r)), W=rng.standard_normal((3 * n_el + 3 * n_s, n_r)) * 1e3,
-        ins_nodes=np.array([5, 12, 17]), ins_frame=np.linalg.qr(rng.standard_normal((n_s, 3, 3)))[0])
-    T = np.linalg.qr(rng.standard_normal((free.size, 3, 3)))[0]
-    U = rng.standard_normal((300, 3 * free.size)) * 0.2
-    U[[0, 7, 150]] = 0.0
-    L = rng.standard_normal((150, free.size))
-    L[[3, 90]] = 0.0
-    kd, n = 5, 3 * free.size  # a banded stiffness's factor (dpbtrf, upper)
-    ab = rng.uniform(-1.0, 1.0, (kd + 1, n)) * 1e3
-    ab[kd] = 1e4 * (kd + 1) * (1.0 + rng.uniform(0.0, 1.0, n))
-    c = lapack.dpbtrf(ab, lower=0)[0]
-    dirs = rng.standard_normal((free.size, 3))
-    dirs /= np.linalg.norm(dirs, axis=1)[:, None]
-    Ut = np.ascontiguousarray(U.T)  # the compiled Newmark loop's dof-major history
-    pairs = []
-    for t in (T, None):
-        ref = second_order_reactions(op, U, t, passes=None, dgemm=None)
-        pairs.append((ref, second_order_reactions(op, U, t, passes=fns, dgemm=dgemm)))
-        pairs.append((ref, second_order_reactions(op, Ut, t, transposed=True, passes=fns, dgemm=dgemm)))
-    for d in (None, dirs):
-        ref = second_order_of_loads(op, L, c, d, passes=None, dgemm=None)
-        pairs.append((ref, second_order_of_loads(op, L, c, d, passes=fns, dgemm=dgemm)))
-    return _worst(pairs)
+register_check("loads", _loads_check)  # its numpy form is here (the other pieces': linecheck.core.pieces)
 
 
 # ---- the pieces' entry points: each runs compiled when its piece is on, else returns None (the
@@ -475,18 +307,6 @@ def coherent_spectrum(phases, rho_rows: np.ndarray, row_of_gap: np.ndarray, amp:
     return spec
 
 
-def drag_loads_numpy(pv, pq, s2, v, sel, loads) -> None:
-    """The numpy form of :func:`drag_loads`; ``sel`` the free nodes, a slice or an index array."""
-    for i in range(v.shape[0]):
-        vi = v[i][:, sel]
-        np.multiply(pv, vi, out=loads[:, i, :])
-        if pq is not None:  # the quadratic drag's (v^2 - s2) pq
-            q = vi * vi
-            q -= s2
-            q *= pq
-            loads[:, i, :] += q
-
-
 def drag_loads(pv: np.ndarray, pq: np.ndarray | None, s2: np.ndarray | None, v: np.ndarray, sel,
                loads: np.ndarray) -> bool:
     """Fill loads (n_steps, n_real, n_free) [N] = pv v (+ (v² − s2) pq with the quadratic drag,
@@ -501,9 +321,9 @@ def drag_loads(pv: np.ndarray, pq: np.ndarray | None, s2: np.ndarray | None, v: 
     return False
 
 
-def _field(fns, field, x: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    from .wind.mean import intensity, vertical_profile
-
+def field_compiled(fns, field, x: np.ndarray, t: np.ndarray, fz: float, pi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`field_velocity` by the compiled functions ``fns`` (also for the piece's load check):
+    fz [-] the height factor f_z at the field's height, pi [-] Pi(t) at every t (n_t,)."""
     x = np.ascontiguousarray(x, dtype=float)
     t = np.ascontiguousarray(t, dtype=float)
     cx, cy = (np.ascontiguousarray(np.broadcast_to(c, t.shape), dtype=float) for c in field.centre_at(t))
@@ -511,23 +331,23 @@ def _field(fns, field, x: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.nda
     z = np.empty_like(r)
     fns.field_radius(x, cx, cy, float(field.r_max), float(field.radial_decay), r, z)
     e = np.exp(z, out=z)
-    fz = float(vertical_profile(field.height, field.delta))
-    pi = np.ascontiguousarray(intensity(t, field.t1, field.t_f), dtype=float)
+    pi = np.ascontiguousarray(pi, dtype=float)
     vx, vy = np.empty_like(r), np.empty_like(r)
-    fns.field_velocity(x, cx, cy, r, e, float(field.r_max), fz, pi, float(field.v_max),
+    fns.field_velocity(x, cx, cy, r, e, float(field.r_max), float(fz), pi, float(field.v_max),
                        float(field.translation[0]), float(field.translation[1]), vx, vy)
     return vx, vy
 
 
-def field_velocity(field, x: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+def field_velocity(field, x: np.ndarray, t: np.ndarray, fz: float,
+                   pi: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     """:meth:`~linecheck.core.wind.mean.DownburstField.velocity` of the analytic field (Holmes &
-    Oliver 2000 radial profile, Wood et al. 2001 height factor, Chay et al. 2006 Pi(t)) in two
-    compiled passes: r and the Gaussian's exponent, numpy's exp on the whole array, then the
-    profile, the speed and the vector sum with the translation.  None when the piece ``field``
-    is off.  x [m] (n_x,), t [s] (n_t,) -> (v_x, v_y) [m/s], each (n_t, n_x)."""
+    Oliver 2000 radial profile, Wood et al. 2001 height factor fz [-], Chay et al. 2006 Pi(t)
+    given as pi [-] (n_t,)) in two compiled passes: r and the Gaussian's exponent, numpy's exp on
+    the whole array, then the profile, the speed and the vector sum with the translation.  None
+    when the piece ``field`` is off.  x [m] (n_x,), t [s] (n_t,) -> (v_x, v_y) [m/s], each (n_t, n_x)."""
     if not use("field"):
         return None
-    return _field(_fns, field, x, t)
+    return field_compiled(_fns, field, x, t, fz, pi)
 
 
 def quad_kms(w: np.ndarray, rho: np.ndarray) -> np.ndarray | None:
@@ -541,7 +361,8 @@ def quad_kms(w: np.ndarray, rho: np.ndarray) -> np.ndarray | None:
     return out
 
 
-def _span(fn, ay, az, by, bz, H, EA, l):
+def span_compiled(fn, ay, az, by, bz, H, EA, l):
+    """:func:`span_terms` by the compiled ``fn`` (``_loops.span_terms``; also for the load check)."""
     n_spans, n_gp = by.shape[-2:]
     H2 = np.ascontiguousarray(H, dtype=float).reshape(-1, n_spans)
 
@@ -566,13 +387,12 @@ def span_terms(ay: np.ndarray, az: np.ndarray, by: np.ndarray, bz: np.ndarray, H
     compiled pass when the piece ``span`` is on, else the numpy form.
     Shapes: ay, az (..., n_spans, 1); by, bz (..., n_spans, n_gp); H, l (..., n_spans)."""
     if not use("span"):
-        from .static import span_terms as ref_terms
-
-        return ref_terms(ay, az, by, bz, H, EA, l)
-    return _span(_fns.span_terms, ay, az, by, bz, H, EA, l)
+        return _numpy_forms["span"](ay, az, by, bz, H, EA, l)
+    return span_compiled(_fns.span_terms, ay, az, by, bz, H, EA, l)
 
 
-def _reductions(fn, M, background, resonant, still_air):
+def reductions_compiled(fn, M, background, resonant, still_air):
+    """:func:`history_reductions` by the compiled ``fn`` (also for the load check)."""
     B = np.ascontiguousarray(background, dtype=float)
     out = np.empty((7, B.shape[0]) + B.shape[2:])
     fn(np.ascontiguousarray(M, dtype=float), B, np.ascontiguousarray(resonant, dtype=float),
@@ -581,14 +401,12 @@ def _reductions(fn, M, background, resonant, still_air):
 
 
 def history_reductions(M: np.ndarray, background: np.ndarray, resonant: np.ndarray,
-                       still_air: np.ndarray) -> tuple[np.ndarray, ...]:
+                       still_air: np.ndarray) -> tuple[np.ndarray, ...] | None:
     """:func:`~linecheck.core.results.history_reductions` (the statistics' r.m.s. values and peaks
-    over time) in one compiled pass when the piece ``reductions`` is on, else the numpy form."""
+    over time) in one compiled pass, or None when the piece ``reductions`` is off."""
     if not use("reductions"):
-        from .results import history_reductions as ref_fn
-
-        return ref_fn(M, background, resonant, still_air)
-    return _reductions(_fns.history_reductions, M, background, resonant, still_air)
+        return None
+    return reductions_compiled(_fns.history_reductions, M, background, resonant, still_air)
 
 
 def second_order_dgemm() -> int | None:
@@ -607,11 +425,9 @@ def second_order_passes():
 
 def rowdot(X: np.ndarray, BT: np.ndarray) -> np.ndarray:
     """X (m, n) @ BT (n, q), row by row (a row's result does not depend on the other rows):
-    compiled when the piece ``rowdot`` is on, else :func:`~linecheck.core.dynamics._rowdot`."""
+    compiled when the piece ``rowdot`` is on, else :func:`~linecheck.core.dynamics.rowdot_numpy`."""
     if not use("rowdot"):
-        from .dynamics import _rowdot
-
-        return _rowdot(X, BT)
+        return _numpy_forms["rowdot"](X, BT)
     out = np.empty((X.shape[0], BT.shape[1]))
     _fns.rowdot(np.ascontiguousarray(X), np.ascontiguousarray(BT), out)
     return out
@@ -621,9 +437,7 @@ def rotate(X: np.ndarray, old, new) -> np.ndarray:
     """Vectors (n_real, n_dof) from ``old``'s node bases (global if None) to ``new``'s: compiled
     when the piece ``rotate`` is on, else :func:`~linecheck.core.dynamics.st_rotate`."""
     if not use("rotate"):
-        from .dynamics import st_rotate
-
-        return st_rotate(X, old, new)
+        return _numpy_forms["rotate"](X, old, new)
     Y = np.array(X, dtype=float, order="C")
     _fns.rotate(Y, new.T if old is None else old.T, new.T, old is not None)
     return Y

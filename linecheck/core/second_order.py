@@ -425,3 +425,64 @@ def _reactions(op: SecondOrder, m: int, fill, fns=None) -> np.ndarray:
             np.matmul(P[:, j0:j0 + chunk].T, W, out=tmp)
             out[i0 + j0:min(i0 + j0 + chunk, i1)] = tmp[:min(chunk, r - j0)]
     return out
+
+
+# ---- the compiled kernel's pieces ``second_order`` and ``second_order_loop``
+# (linecheck.core.kernel): their load checks
+
+def _check_operator(rng) -> tuple[SecondOrder, np.ndarray]:
+    """A second-order operator of random numbers for the load checks: 21 nodes, two runs of free
+    nodes (nodes 0, 10 and 20 pinned), three insulators.  Returns it and the free node bases
+    T (n_free, 3, 3)."""
+    n_nodes, n_s, n_r = 21, 3, 7
+    n_el = n_nodes - 1
+    e = rng.standard_normal((n_el + n_s, 3))
+    op = SecondOrder(
+        e=(e / np.linalg.norm(e, axis=1)[:, None]).ravel(), c=np.ones(n_el + n_s), n_nodes=n_nodes,
+        pinned=np.array([0, 10, 20]), runs=((1, 10, 0), (11, 20, 9)), ins_free=np.array([4, 10, 15]),
+        A=np.zeros((3 * (n_el + n_s), n_r)), W=rng.standard_normal((3 * n_el + 3 * n_s, n_r)) * 1e3,
+        ins_nodes=np.array([5, 12, 17]), ins_frame=np.linalg.qr(rng.standard_normal((n_s, 3, 3)))[0])
+    return op, np.linalg.qr(rng.standard_normal((n_nodes - 3, 3, 3)))[0]
+
+
+def _second_order_check(fns, dgemm: int | None = None) -> float:
+    """The compiled second-order passes (``dgemm`` None) or the whole compiled block loop with
+    scipy's ``dgemm`` (its address) against the numpy form, through
+    :func:`second_order_reactions` (in node bases and global, the history row- and dof-major)
+    and :func:`second_order_of_loads`, on an operator of random numbers with rows of zeros and a
+    padded last block; the largest relative difference."""
+    from . import kernel
+
+    rng = np.random.default_rng(28)
+    op, T = _check_operator(rng)
+    n_free = T.shape[0]
+    U = rng.standard_normal((300, 3 * n_free)) * 0.2
+    U[[0, 7, 150]] = 0.0
+    L = rng.standard_normal((150, n_free))
+    L[[3, 90]] = 0.0
+    kd, n = 5, 3 * n_free  # a banded stiffness's factor (dpbtrf, upper)
+    ab = rng.uniform(-1.0, 1.0, (kd + 1, n)) * 1e3
+    ab[kd] = 1e4 * (kd + 1) * (1.0 + rng.uniform(0.0, 1.0, n))
+    c = lapack.dpbtrf(ab, lower=0)[0]
+    dirs = rng.standard_normal((n_free, 3))
+    dirs /= np.linalg.norm(dirs, axis=1)[:, None]
+    Ut = np.ascontiguousarray(U.T)  # the compiled Newmark loop's dof-major history
+    pairs = []
+    for t in (T, None):
+        ref = second_order_reactions(op, U, t, passes=None, dgemm=None)
+        pairs.append((ref, second_order_reactions(op, U, t, passes=fns, dgemm=dgemm)))
+        pairs.append((ref, second_order_reactions(op, Ut, t, transposed=True, passes=fns, dgemm=dgemm)))
+    for d in (None, dirs):
+        ref = second_order_of_loads(op, L, c, d, passes=None, dgemm=None)
+        pairs.append((ref, second_order_of_loads(op, L, c, d, passes=fns, dgemm=dgemm)))
+    return kernel.worst_difference(pairs)
+
+
+def _register_kernel_checks() -> None:
+    from . import kernel
+
+    kernel.register_check("second_order", _second_order_check)
+    kernel.register_check("second_order_loop", lambda fns: _second_order_check(fns, fns.scipy_dgemm()))
+
+
+_register_kernel_checks()

@@ -808,3 +808,31 @@ def modal_contributions(
     SB = von_karman(fb, sigma, length_scale, v_mean)[:, None] * _quad_kms(wb, rhob)
     rms_b = np.sqrt(np.trapezoid(SB, fb, axis=0))
     return ModalContribution(f, rate / np.abs(lam), rate, rms, rms_b)
+
+
+# ---- the compiled kernel's piece ``quad`` (linecheck.core.kernel): its load check
+
+def _quad_check(fns) -> float:
+    """The compiled coherence quadrature (``fns.quad_kms``) against :func:`_quad_kms_nodes` (one
+    coherence for all gaps and one per gap); the largest relative difference."""
+    from . import kernel
+
+    rng = np.random.default_rng(27)
+    w = rng.standard_normal((9, 13, 37)) + 1j * rng.standard_normal((9, 13, 37))
+    w[:, 3] = 0.0  # a node without load
+    pairs = []
+    for rho in (rng.random(37), rng.random((12, 37))):
+        ref = _quad_kms_nodes(w, rho, compiled=False)
+        got = np.empty(ref.shape)
+        fns.quad_kms(w, np.ascontiguousarray(np.atleast_2d(rho)), rho.ndim == 2, got)
+        pairs.append((ref, got))
+    return kernel.worst_difference(pairs)
+
+
+def _register_kernel_check() -> None:
+    from . import kernel
+
+    kernel.register_check("quad", _quad_check)
+
+
+_register_kernel_check()

@@ -653,3 +653,28 @@ def solve_mean_states(
         gy=np.asarray(gy, dtype=float),
         still_air=still,
     )
+
+
+# ---- the compiled kernel's piece ``span`` (linecheck.core.kernel): its load check and numpy form
+
+def _span_check(fns) -> float:
+    """The compiled span-tension integrands (``fns.span_terms``) against :func:`span_terms` (one
+    and several states, with and without the chords l); the largest relative difference."""
+    rng = np.random.default_rng(25)
+    pairs = []
+    for lead in ((), (3,)):
+        by = rng.standard_normal(lead + (4, 9)) * 1e4  # per state (step 1's loads), as the Newton passes it
+        bz = rng.standard_normal((4, 9)) * 1e4
+        ay, az = (rng.standard_normal(lead + (4, 1)) * 0.05 for _ in range(2))
+        H = rng.uniform(1e4, 5e4, lead + (4,))
+        l = rng.uniform(300.0, 500.0, lead + (4,))
+        for ll in (None, l):
+            ref = span_terms(ay, az, by, bz, H, 3.2e7, ll)
+            got = kernel.span_compiled(fns.span_terms, ay, az, by, bz, H, 3.2e7, ll)
+            if len(ref) != len(got):  # pragma: no cover - a compiled form that lost an output
+                return np.inf
+            pairs += list(zip(ref, got))
+    return kernel.worst_difference(pairs)
+
+
+kernel.register_check("span", _span_check, numpy=span_terms)

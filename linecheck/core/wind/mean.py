@@ -567,7 +567,8 @@ class DownburstField:
         if self.ring is None and self.table is None:  # the analytic field compiled (kernel piece ``field``)
             from .. import kernel
 
-            fast = kernel.field_velocity(self, np.asarray(x, dtype=float).ravel(), np.asarray(t, dtype=float).ravel())
+            tt = np.asarray(t, dtype=float).ravel()
+            fast = kernel.field_velocity(self, np.asarray(x, dtype=float).ravel(), tt, *_field_factors(self, tt))
             if fast is not None:
                 return fast
         return self.velocity_numpy(x, t)
@@ -1149,3 +1150,35 @@ def mean_speed_at_nodes(case: Case, system: LineSystem, time: np.ndarray) -> np.
     else:
         vx, vy = _downburst_nodes(case, system, downburst_field(case), time)
     return np.hypot(vx, vy)
+
+
+# ---- the compiled kernel's piece ``field`` (linecheck.core.kernel): its load check
+
+def _field_check(fns) -> float:
+    """The compiled analytic downburst field against :meth:`DownburstField.velocity_numpy`
+    (points inside and outside r_max, at the centre, before and after the peak of Pi(t)); the
+    largest relative difference."""
+    from .. import kernel
+
+    field = DownburstField(jet_diameter=600.0, height=15.0, centre=(450.0, -700.0), t_ref=300.0,
+                           translation=(3.0, 8.0), v_max=41.3, point_p=450.0, window=(0.0, 600.0),
+                           r_max=780.0, radial_decay=430.0, z_max=50.0, delta=272.0, t1=300.0, t_f=1200.0)
+    x = np.concatenate([np.linspace(0.0, 1800.0, 37), [712.5]])
+    t = np.concatenate([np.linspace(0.0, 900.0, 41), [387.5]])  # the centre crosses the line at x = 712.5
+    got = kernel.field_compiled(fns, field, x, t, *_field_factors(field, t))
+    return kernel.worst_difference(zip(field.velocity_numpy(x, t), got))
+
+
+def _field_factors(field: DownburstField, t: np.ndarray) -> tuple[float, np.ndarray]:
+    """The compiled field's height factor f_z [-] (Wood et al. 2001) and Pi(t) [-] (Chay et al.
+    2006) at the instants t [s] (n_t,)."""
+    return float(vertical_profile(field.height, field.delta)), intensity(t, field.t1, field.t_f)
+
+
+def _register_kernel_check() -> None:
+    from .. import kernel
+
+    kernel.register_check("field", _field_check)
+
+
+_register_kernel_check()

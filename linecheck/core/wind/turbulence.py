@@ -533,3 +533,33 @@ def _memo_put(memo: dict, key: tuple, value, nbytes: Callable, limit: float) -> 
         memo[key] = value
         while sum(nbytes(v) for v in memo.values()) > limit:
             memo.pop(next(iter(memo)))
+
+
+# ---- the compiled kernel's piece ``spectrum`` (linecheck.core.kernel): its load check
+
+def _spectrum_check(fns) -> float:
+    """The compiled synthesis spectrum (``fns.phasors``, ``fns.coherent_spectrum``) against the
+    numpy forms: equal gaps (the KMS recursion, :func:`kms_apply`) and unequal ones (the Markov
+    recursion, :func:`markov_apply`, a coefficient row per gap); the largest relative difference."""
+    rng = np.random.default_rng(23)
+    n_nodes, n_freq = 9, 301
+    phases = rng.random((n_nodes, n_freq)) * (2.0 * np.pi)
+    freq = np.arange(1, n_freq + 1) * 0.01
+    amp = rng.random(n_freq)
+    m = 2 * n_freq + 2
+    x = np.cumsum(np.r_[0.0, rng.choice([30.0, 12.5], n_nodes - 1)])
+    rows, gap = gap_rows(x, freq, 10.0, 40.0)
+    cases = [(markov_apply(x, freq, np.exp(1j * phases), 10.0, 40.0), rows, gap),
+             (kms_apply(rows[0], np.exp(1j * phases)), rows[:1], np.zeros(n_nodes - 1, dtype=np.int64))]
+    pairs = []
+    for y, r, g in cases:
+        ref = fft_input(y, amp, m)
+        got = np.zeros_like(ref)
+        xr, xi = np.empty_like(phases), np.empty_like(phases)
+        fns.phasors(phases, xr, xi)
+        fns.coherent_spectrum(xr, xi, r, np.sqrt(np.maximum(1.0 - r * r, 0.0)), g, amp, 0.5 * m, got)
+        pairs.append((ref.view(float), got.view(float)))
+    return kernel.worst_difference(pairs)
+
+
+kernel.register_check("spectrum", _spectrum_check)

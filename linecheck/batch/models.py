@@ -8,7 +8,7 @@ from pathlib import Path
 from ..core.case import load_case
 from ..io.document import FailedRun, RunDocument
 from ..service import model_changes, parse_models
-from .runner import BatchReport, RunJob
+from .report import BatchReport, RunJob
 
 
 def model_jobs(paths: list[Path], models: str) -> tuple[list[RunJob], dict[Path, list[tuple[str, int]]]]:

@@ -43,7 +43,8 @@ from ..core.case import Case, case_hash, load_case
 from ..core.errors import Cancelled, CaseError, LinecheckError
 from ..core.results import REACTIONS
 from .executors import Executor, SequentialExecutor
-from .runner import BatchProgress, BatchReport, RunJob, run_batch
+from .report import BatchProgress, BatchReport, RunJob
+from .runner import run_batch
 from .tasks import Failure, ScanChunk, scan_changes, scan_chunk
 
 MAX_POINTS = 1_000_000

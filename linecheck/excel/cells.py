@@ -31,8 +31,6 @@ SEC = "0.0"
 #: table (:data:`linecheck.io.document.STAT_TABLE`), whose labels, units and formats they use.
 SUMMARY_STATS: tuple[str, ...] = ("mean_max", "peak_quasi_static", "peak_dynamic", "GF_Dy", "GF_QS", "Cont_M",
                                   "Cont_BG", "Cont_R", "peak_normalised")
-SUMMARY_IDS = (("Case", 16), ("Wind", 14), ("Spans", 6), ("L_x\n(m)", 7), ("V_ref\n(m/s)", 7),
-               ("Tower", 6), ("n", 5), ("Reaction", 8))
 
 
 def excel_format(stat: StatDef, *, summary: bool = False) -> str:

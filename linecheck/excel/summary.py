@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 from openpyxl.chart import BarChart, Reference
@@ -12,12 +13,11 @@ from openpyxl.utils import get_column_letter
 from openpyxl.worksheet.worksheet import Worksheet
 
 from ..io.display import flag_state
-from ..io.document import STAT_BY_NAME, FailedRun, RunDocument
+from ..io.document import STAT_BY_NAME, FailedRun, RunDocument, StatDef
 from . import template as tpl
 from .cells import (
     FLAG_NOTE,
     GF_UNDEFINED,
-    SUMMARY_IDS,
     SUMMARY_STATS,
     Cursor,
     align,
@@ -34,100 +34,153 @@ INCONCLUSIVE_NOTE = "inconclusive: run more realizations"
 
 
 # --------------------------------------------------------------------------- Summary
-def write_summary(ws: Worksheet, docs: list[RunDocument | FailedRun], names: list[str | None], threshold: float,
-                  top: int, left: int, summary_reactions: Sequence[str]) -> None:
-    """The Table 5 table from (top, left): one row per case and reaction, flags, notes, print setup."""
+@dataclass(frozen=True)
+class Column:
+    """A Summary column: header, width [characters] and what it holds, by ``name``: an
+    identification value (a key of :func:`id_values`), ``"stat"`` (``stat``'s realization
+    ``which``, "mean" or "std"), ``"sanity"`` (the time-vs-frequency check) or ``"note"``.
+    An identification column is a text or a number, maybe centred, maybe with a number format."""
+
+    header: str
+    width: int
+    name: str
+    stat: StatDef | None = None
+    which: str = "mean"
+    text: bool = False
+    center: bool = False
+    fmt: str | None = None
+
+
+#: The identification columns, left of the statistics (paper Table 5).
+ID_COLUMNS: tuple[Column, ...] = (
+    Column("Case", 16, "case", text=True),
+    Column("Wind", 14, "wind", text=True),
+    Column("Spans", 6, "spans", center=True),
+    Column("L_x\n(m)", 7, "span_length", fmt="0.#"),
+    Column("V_ref\n(m/s)", 7, "v_ref", fmt="0.#"),
+    Column("Tower", 6, "tower", center=True),
+    Column("n", 5, "realizations", center=True),
+    Column("Reaction", 8, "reaction", text=True, center=True),
+)
+
+
+def id_values(doc: RunDocument | FailedRun, reaction: str) -> dict[str, Any]:
+    """The identification values of a Summary row by column name (a failed case: its name only)."""
+    if isinstance(doc, FailedRun):
+        return {"case": doc.case, "wind": ""}
+    return {"case": doc.case, "wind": wind_label(doc), "spans": doc.spans, "span_length": doc.span_length,
+            "v_ref": doc.v_ref, "tower": doc.tower_of_interest, "realizations": doc.realizations,
+            "reaction": reaction}
+
+
+def summary_columns(docs: list[RunDocument | FailedRun]) -> list[Column]:
+    """Every Summary column in order: identification, statistics (each with a ``±`` column when a
+    case has several realizations and the statistic varies between them), sanity check, note."""
     with_std = any(d.realizations > 1 for d in docs if isinstance(d, RunDocument))
-    cols: list[tuple[str, Any, int]] = []  # (header, (statistic, "mean" | "std"), width)
-    for label, width in SUMMARY_IDS:
-        cols.append((label, None, width))
+    cols = list(ID_COLUMNS)
     for name in SUMMARY_STATS:
         stat = STAT_BY_NAME[name]
-        cols.append((stat.header(), (stat, "mean"), 9))
+        cols.append(Column(stat.header(), 9, "stat", stat))
         if with_std and stat.varies:
-            cols.append(("±", (stat, "std"), 7))
-    cols.append((SANITY_HEADER, None, 14))
-    cols.append(("Note", None, 44))
-    cur = Cursor(ws, top)
-    for k, (label, _, width) in enumerate(cols):
-        cur.put(top, left + k, label, "lc_header")
+            cols.append(Column("±", 7, "stat", stat, "std"))
+    cols += [Column(SANITY_HEADER, 14, "sanity"), Column("Note", 44, "note")]
+    return cols
+
+
+def _headers(ws: Worksheet, cur: Cursor, cols: list[Column], top: int, left: int) -> None:
+    """The header row and the column widths (a width set before, other than the default, may widen one)."""
+    for k, col in enumerate(cols):
+        cur.put(top, left + k, col.header, "lc_header")
         letter = get_column_letter(left + k)
         current = ws.column_dimensions[letter].width
-        ws.column_dimensions[letter].width = max(width, current if current and current != 13 else 0)
+        ws.column_dimensions[letter].width = max(col.width, current if current and current != 13 else 0)
     ws.row_dimensions[top].height = 30
-    row = top + 1
-    cont_r_col = None
-    band = PatternFill("solid", fgColor=tpl.BAND_FILL)
-    for n_doc, doc in enumerate(docs):
-        failed = isinstance(doc, FailedRun)
-        reactions = ("—",) if failed else summary_reactions
-        for r in reactions:
-            if isinstance(doc, FailedRun):
-                idvals = [doc.case, "", None, None, None, None, None, None]
-            else:
-                idvals = [doc.case, wind_label(doc), doc.spans, doc.span_length, doc.v_ref,
-                          doc.tower_of_interest, doc.realizations, r]
-            c = 0
-            for k, v in enumerate(idvals):
-                cell = cur.put(row, left + c, v, "lc_text" if k in (0, 1, 7) else "lc_number")
-                if k == 3 or k == 4:
-                    cell.number_format = "0.#"
-                if k in (2, 5, 6, 7):
-                    align(cell, horizontal="center")
-                if k == 0 and not failed:
-                    link(cell, names[n_doc])
-                c += 1
-            note = ""
-            for _label, spec, _ in cols[len(SUMMARY_IDS):-2]:
-                stat, which = spec
-                if failed:
-                    cur.put(row, left + c, None)
-                else:
-                    entry = doc.reactions[r][stat.name]
-                    if which == "std":
-                        value = stat_cell(stat, entry.std) if doc.realizations > 1 and entry.std is not None else None
-                    else:
-                        value = stat_cell(stat, entry.mean)
-                    cur.put(row, left + c, value, "lc_number", excel_format(stat, summary=True))
-                    if stat.name == "Cont_R" and which == "mean":
-                        cont_r_col = left + c
-                        state = flag_state(doc, r, threshold)  # issue 18: on the 95 % interval
-                        if state == "recommended":
-                            note = FLAG_NOTE
-                        elif state == "inconclusive":
-                            note = INCONCLUSIVE_NOTE
-                c += 1
-            check, check_bad = ("", False) if failed else sanity_text(doc)
-            ccell = cur.put(row, left + c, check, "lc_text")
-            align(ccell, horizontal="center", wrap_text=True)
-            if check_bad:
-                ccell.font = Font(name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT)
-                ccell.fill = PatternFill("solid", fgColor=tpl.FLAG_FILL)
-            c += 1
-            if isinstance(doc, FailedRun):
-                note = f"FAILED: {doc.error}"
-            ncell = cur.put(row, left + c, note, "lc_text")
-            align(ncell, indent=1)
-            if failed:
-                ncell.font = Font(name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT)
-                align(ncell, wrap_text=True)
-            elif note:
-                ncell.font = Font(name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT)
-            if n_doc % 2 == 1:
-                for k in range(len(cols)):
-                    if not (k == len(cols) - 2 and check_bad):
-                        ws.cell(row=row, column=left + k).fill = band
-            row += 1
-    last = row - 1
-    right = left + len(cols) - 1
-    if cont_r_col is not None and last > top:
-        letter = get_column_letter(cont_r_col)
-        ws.conditional_formatting.add(
-            f"{letter}{top + 1}:{letter}{last}",
-            CellIsRule(operator="greaterThan", formula=[repr(float(threshold))],
-                       fill=PatternFill("solid", fgColor=tpl.FLAG_FILL, bgColor=tpl.FLAG_FILL),
-                       font=Font(bold=True, color=tpl.FLAG_FONT)))
-    cur.row = last + 2
+
+
+def _put_id(cur: Cursor, row: int, at: int, col: Column, value: Any, link_to: str | None) -> None:
+    cell = cur.put(row, at, value, "lc_text" if col.text else "lc_number")
+    if col.fmt is not None:
+        cell.number_format = col.fmt
+    if col.center:
+        align(cell, horizontal="center")
+    if col.name == "case" and link_to is not None:
+        link(cell, link_to)
+
+
+def _put_stat(cur: Cursor, row: int, at: int, col: Column, doc: RunDocument | FailedRun, reaction: str) -> None:
+    """A statistic's cell [kN, -, or fraction shown in %]; empty for a failed case."""
+    stat = col.stat
+    assert stat is not None
+    if isinstance(doc, FailedRun):
+        cur.put(row, at, None)
+        return
+    entry = doc.reactions[reaction][stat.name]
+    if col.which == "std":
+        value = stat_cell(stat, entry.std) if doc.realizations > 1 and entry.std is not None else None
+    else:
+        value = stat_cell(stat, entry.mean)
+    cur.put(row, at, value, "lc_number", excel_format(stat, summary=True))
+
+
+def _put_sanity(cur: Cursor, row: int, at: int, doc: RunDocument | FailedRun) -> bool:
+    """The sanity-check cell; whether it is a FLAG (then marked)."""
+    check, check_bad = ("", False) if isinstance(doc, FailedRun) else sanity_text(doc)
+    cell = cur.put(row, at, check, "lc_text")
+    align(cell, horizontal="center", wrap_text=True)
+    if check_bad:
+        cell.font = Font(name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT)
+        cell.fill = PatternFill("solid", fgColor=tpl.FLAG_FILL)
+    return check_bad
+
+
+def row_note(doc: RunDocument | FailedRun, reaction: str, threshold: float) -> str:
+    """The Note of a row: a failed case's error, else the Cont_R flag state (on its 95 % interval)."""
+    if isinstance(doc, FailedRun):
+        return f"FAILED: {doc.error}"
+    state = flag_state(doc, reaction, threshold)
+    return FLAG_NOTE if state == "recommended" else INCONCLUSIVE_NOTE if state == "inconclusive" else ""
+
+
+def _put_note(cur: Cursor, row: int, at: int, note: str, failed: bool) -> None:
+    cell = cur.put(row, at, note, "lc_text")
+    align(cell, indent=1)
+    if failed:
+        cell.font = Font(name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT)
+        align(cell, wrap_text=True)
+    elif note:
+        cell.font = Font(name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT)
+
+
+def _write_row(cur: Cursor, row: int, left: int, cols: list[Column], doc: RunDocument | FailedRun, reaction: str,
+               link_to: str | None, threshold: float) -> int | None:
+    """One Summary row (a case and a reaction); the column of a FLAG sanity cell, if any."""
+    failed = isinstance(doc, FailedRun)
+    ids = id_values(doc, reaction)
+    flagged = None
+    for k, col in enumerate(cols):
+        if col.name == "stat":
+            _put_stat(cur, row, left + k, col, doc, reaction)
+        elif col.name == "sanity":
+            flagged = k if _put_sanity(cur, row, left + k, doc) else None
+        elif col.name == "note":
+            _put_note(cur, row, left + k, row_note(doc, reaction, threshold), failed)
+        else:
+            _put_id(cur, row, left + k, col, ids.get(col.name), None if failed else link_to)
+    return flagged
+
+
+def _flag_cont_r(ws: Worksheet, cols: list[Column], top: int, last: int, left: int, threshold: float) -> None:
+    """Colour the Cont_R means above ``threshold`` [-] (conditional format)."""
+    at = next(k for k, c in enumerate(cols) if c.stat is not None and c.stat.name == "Cont_R" and c.which == "mean")
+    letter = get_column_letter(left + at)
+    ws.conditional_formatting.add(
+        f"{letter}{top + 1}:{letter}{last}",
+        CellIsRule(operator="greaterThan", formula=[repr(float(threshold))],
+                   fill=PatternFill("solid", fgColor=tpl.FLAG_FILL, bgColor=tpl.FLAG_FILL),
+                   font=Font(bold=True, color=tpl.FLAG_FONT)))
+
+
+def _summary_notes(cur: Cursor, threshold: float, summary_reactions: Sequence[str]) -> None:
     cur.note(f"Note: '{FLAG_NOTE}' where the 95 % interval of Cont_R lies above {threshold:.0%}, "
              f"'{INCONCLUSIVE_NOTE}' where it straddles {threshold:.0%} (none where GF is ** or the reaction is below "
              "5 % of the still-air load); the colour marks a mean Cont_R above it.")
@@ -145,21 +198,51 @@ def write_summary(ws: Worksheet, docs: list[RunDocument | FailedRun], names: lis
              "Ry transverse (wind), Rz vertical" + ("" if "Rz" in summary_reactions else
                                                     " (Rz on the case sheets: its wind-induced part is small beside "
                                                     "the conductor weight)") + ".")
-    from .design import HEADERS as DESIGN_HEADERS
-    from .design import write_design_block  # issue 18: design values, intervals, flag states, how to read
 
-    cur.row = write_design_block(ws, docs, cur.row + 1, left)
+
+def _print_setup(ws: Worksheet, top: int, left: int, last: int, right: int, bottom: int) -> None:
+    """Filter, frozen panes, print titles and area (the design block and notes included), fit to width."""
+    from .design import HEADERS as DESIGN_HEADERS
+
     ws.auto_filter.ref = f"{get_column_letter(left)}{top}:{get_column_letter(right)}{last}"
     ws.freeze_panes = ws.cell(row=top + 1, column=left + 1)
     ws.print_title_rows = f"{top}:{top}"
     right = max(right, left + len(DESIGN_HEADERS) - 1)  # the print area holds the design block and the notes
-    wrap_notes(ws, last + 1, cur.row, right)
-    ws.print_area = f"A1:{get_column_letter(right)}{cur.row}"
+    wrap_notes(ws, last + 1, bottom, right)
+    ws.print_area = f"A1:{get_column_letter(right)}{bottom}"
     ws.sheet_properties.pageSetUpPr.fitToPage = True
     ws.page_setup.fitToWidth = 1
     ws.page_setup.fitToHeight = 0
     if not ws.page_setup.orientation:
         ws.page_setup.orientation = "landscape"
+
+
+def write_summary(ws: Worksheet, docs: list[RunDocument | FailedRun], names: list[str | None], threshold: float,
+                  top: int, left: int, summary_reactions: Sequence[str]) -> None:
+    """The Table 5 table from (top, left): one row per case and reaction, flags, notes, the design
+    block (design values, intervals, flag states, how to read them), print setup."""
+    from .design import write_design_block
+
+    cols = summary_columns(docs)
+    cur = Cursor(ws, top)
+    _headers(ws, cur, cols, top, left)
+    row = top + 1
+    band = PatternFill("solid", fgColor=tpl.BAND_FILL)
+    for n_doc, doc in enumerate(docs):
+        for r in ("—",) if isinstance(doc, FailedRun) else summary_reactions:
+            flagged = _write_row(cur, row, left, cols, doc, r, names[n_doc], threshold)
+            if n_doc % 2 == 1:
+                for k in range(len(cols)):
+                    if k != flagged:
+                        ws.cell(row=row, column=left + k).fill = band
+            row += 1
+    last = row - 1
+    if any(isinstance(d, RunDocument) for d in docs):
+        _flag_cont_r(ws, cols, top, last, left, threshold)
+    cur.row = last + 2
+    _summary_notes(cur, threshold, summary_reactions)
+    cur.row = write_design_block(ws, docs, cur.row + 1, left)
+    _print_setup(ws, top, left, last, left + len(cols) - 1, cur.row)
 
 
 #: Summary column of the time-vs-frequency sanity check of a synoptic case.

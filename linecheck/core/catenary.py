@@ -1,4 +1,4 @@
-"""Exact elastic-cable span element and the step-1 equilibrium of a line section (issue 17).
+"""Exact elastic-cable span element and the step-1 equilibrium of a line section (section form).
 
 The paper's Appendix A describes every span by the shallow-cable (parabolic) theory with the
 loads spread along the horizontal chord and the line straight and level.  A real section has
@@ -239,24 +239,80 @@ def conductor_forces(sol: SpanSolution, n_towers: int) -> np.ndarray:
     return f
 
 
-def equilibrium(
-    clamps: np.ndarray,
-    tops: np.ndarray,
-    v: np.ndarray,
-    suspension: np.ndarray,
-    along: np.ndarray,
-    p: np.ndarray,
-    Lu: np.ndarray,
-    EA: float,
-    p_start: np.ndarray,
-    N0_start: np.ndarray,
-    *,
-    labels: list[str],
-    tol: float,
-    max_iter: int,
-    progress: Callable[[int, int], None] | None = None,
-    cancel: threading.Event | None = None,
-) -> SectionEquilibrium:
+def _check_finite(f: np.ndarray, labels: list[str], it: int) -> None:
+    """Raise :class:`ConvergenceError` naming the first state whose clamp forces f (n_s, n_towers, 3)
+    are not all finite after ``it`` iterations."""
+    if not np.all(np.isfinite(f)):
+        j = int(np.flatnonzero(~np.all(np.isfinite(f.reshape(f.shape[0], -1)), axis=1))[0])
+        raise ConvergenceError(f"{labels[j]}: non-finite values after {it} iterations")
+
+
+def _tangent_system(sol: SpanSolution, f: np.ndarray, pos: np.ndarray, tops: np.ndarray, along: np.ndarray,
+                    idx: np.ndarray, vs: np.ndarray, adjacent: np.ndarray, labels: list[str]):
+    """Newton system of the suspension clamps on their insulator spheres (module docstring).
+
+    Args: sol: spans at the current clamps; f [N] conductor forces (n_s, n_towers, 3); pos [m]
+        clamps (n_s, n_towers, 3); tops [m] (n_towers, 3); along (n_towers, 3); idx: suspension
+        towers (k,); vs [m] their insulator lengths (k,); adjacent: bool (k-1,) consecutive towers.
+    Returns: B tangent bases (n_s, k, 3, 2); r [N] tangential forces (n_s, k, 2); D [N/m]
+        diagonal blocks (n_s, k, 2, 2) and E [N/m] off-diagonal blocks (n_s, k-1, 2, 2) of
+        A = B^T (K_left + K_right) B + (f . u / v) I.
+    """
+    n_s, nt, k = pos.shape[0], pos.shape[1], idx.size
+    u = (pos[:, idx] - tops[idx]) / vs[:, None]
+    B = _tangent_bases(u, along[idx])  # (n_s, k, 3, 2)
+    fk = f[:, idx]
+    fu = (fk * u).sum(axis=-1)  # insulator tension
+    if np.any(fu <= 0.0):
+        j = int(np.flatnonzero(np.any(fu <= 0.0, axis=1))[0])
+        raise ConvergenceError(f"{labels[j]}: a suspension insulator is in compression (uplift at tower "
+                               f"{int(idx[np.argmin(fu[j])]) + 1}); no admissible equilibrium with rigid insulators")
+    r = np.einsum("skab,ska->skb", B, fk)  # tangential force components [N]
+    Bt = np.swapaxes(B, -1, -2)
+    Kl = np.zeros((n_s, k, 3, 3))
+    has_left = idx > 0
+    Kl[:, has_left] = sol.K[:, idx[has_left] - 1]
+    Kr = np.zeros((n_s, k, 3, 3))
+    has_right = idx < nt - 1
+    Kr[:, has_right] = sol.K[:, idx[has_right]]
+    D = Bt @ (Kl + Kr) @ B + (fu / vs)[..., None, None] * np.eye(2)
+    E = np.zeros((n_s, max(k - 1, 0), 2, 2))
+    if k > 1:
+        E[:, adjacent] = -(Bt[:, :-1] @ sol.K[:, idx[:-1]] @ B[:, 1:])[:, adjacent]
+    return B, r, D, E
+
+
+def _move_clamps(pos: np.ndarray, tops: np.ndarray, idx: np.ndarray, vs: np.ndarray, B: np.ndarray,
+                 dq: np.ndarray, active: np.ndarray) -> np.ndarray:
+    """Move the active states' suspension clamps by dq on their spheres (in place).
+
+    The step is capped at 0.3 v per clamp, then the moved point is projected back on the sphere
+    of radius v about the insulator top (rigid link).  dq [m] (n_s, k, 2) in the bases B;
+    active: bool (n_s,).  Returns the largest clamp step per state [m] (n_s,).
+    """
+    size = np.linalg.norm(dq, axis=-1)
+    cap = 0.3 * vs
+    dq = np.where((size > cap)[..., None], dq * (cap / np.maximum(size, 1e-300))[..., None], dq)
+    dq[~active] = 0.0
+    moved = pos[:, idx] + np.einsum("skab,skb->ska", B, dq) - tops[idx]
+    pos[:, idx] = tops[idx] + vs[:, None] * moved / np.linalg.norm(moved, axis=-1, keepdims=True)
+    return np.max(np.linalg.norm(dq, axis=-1), axis=1)
+
+
+def _tangential_residual(f: np.ndarray, pos: np.ndarray, tops: np.ndarray, idx: np.ndarray,
+                         vs: np.ndarray) -> np.ndarray:
+    """Largest force [N] on a suspension clamp normal to its insulator, per state (n_s,)."""
+    if not idx.size:
+        return np.zeros(pos.shape[0])
+    u = (pos[:, idx] - tops[idx]) / vs[:, None]
+    fk = f[:, idx]
+    return np.max(np.linalg.norm(fk - (fk * u).sum(axis=-1, keepdims=True) * u, axis=-1), axis=1)
+
+
+def equilibrium(clamps: np.ndarray, tops: np.ndarray, v: np.ndarray, suspension: np.ndarray, along: np.ndarray,
+                p: np.ndarray, Lu: np.ndarray, EA: float, p_start: np.ndarray, N0_start: np.ndarray, *,
+                labels: list[str], tol: float, max_iter: int, progress: Callable[[int, int], None] | None = None,
+                cancel: threading.Event | None = None) -> SectionEquilibrium:
     """Step-1 equilibrium of a section under ``n_s`` load cases (Newton over the suspension clamps).
 
     Args:
@@ -278,53 +334,25 @@ def equilibrium(
     tol_d = tol * max(float(v[idx].max()) if k else 1.0, 1.0)
     adjacent = np.diff(idx) == 1 if k else np.zeros(0, dtype=bool)
     vs = v[idx]
+    what = labels[0] if n_s == 1 else "mean states"
     done_at = np.zeros(n_s, dtype=int)
     last = np.full(n_s, np.inf)
     for it in range(1, max_iter + 1):
         if cancel is not None and cancel.is_set():
             raise Cancelled("step 1 cancelled")
-        sol = solve_spans(np.diff(pos, axis=1), p, Lu, EA, N0, what=labels[0] if n_s == 1 else "mean states")
+        sol = solve_spans(np.diff(pos, axis=1), p, Lu, EA, N0, what=what)
         N0 = sol.N0
         f = conductor_forces(sol, nt)
-        if not np.all(np.isfinite(f)):
-            j = int(np.flatnonzero(~np.all(np.isfinite(f.reshape(n_s, -1)), axis=1))[0])
-            raise ConvergenceError(f"{labels[j]}: non-finite values after {it} iterations")
+        _check_finite(f, labels, it)
         if k == 0:
             done_at[:] = it
             last[:] = 0.0
             break
-        u = (pos[:, idx] - tops[idx]) / vs[:, None]
-        B = _tangent_bases(u, along[idx])  # (n_s, k, 3, 2)
-        fk = f[:, idx]
-        fu = (fk * u).sum(axis=-1)  # insulator tension
-        if np.any(fu <= 0.0):
-            j = int(np.flatnonzero(np.any(fu <= 0.0, axis=1))[0])
-            raise ConvergenceError(f"{labels[j]}: a suspension insulator is in compression (uplift at tower "
-                                   f"{int(idx[np.argmin(fu[j])]) + 1}); no admissible equilibrium with rigid insulators")
-        r = np.einsum("skab,ska->skb", B, fk)  # tangential force components [N]
-        Bt = np.swapaxes(B, -1, -2)
-        Kl = np.zeros((n_s, k, 3, 3))
-        has_left = idx > 0
-        Kl[:, has_left] = sol.K[:, idx[has_left] - 1]
-        Kr = np.zeros((n_s, k, 3, 3))
-        has_right = idx < nt - 1
-        Kr[:, has_right] = sol.K[:, idx[has_right]]
-        D = Bt @ (Kl + Kr) @ B + (fu / vs)[..., None, None] * np.eye(2)
-        E = np.zeros((n_s, max(k - 1, 0), 2, 2))
-        if k > 1:
-            E[:, adjacent] = -(Bt[:, :-1] @ sol.K[:, idx[:-1]] @ B[:, 1:])[:, adjacent]
-        dq = _block_tridiag_solve(D, E, r)
-        size = np.linalg.norm(dq, axis=-1)
-        cap = 0.3 * vs
-        dq = np.where((size > cap)[..., None], dq * (cap / np.maximum(size, 1e-300))[..., None], dq)
+        B, r, D, E = _tangent_system(sol, f, pos, tops, along, idx, vs, adjacent, labels)
         active = done_at == 0
-        dq[~active] = 0.0
-        moved = pos[:, idx] + np.einsum("skab,skb->ska", B, dq) - tops[idx]
-        pos[:, idx] = tops[idx] + vs[:, None] * moved / np.linalg.norm(moved, axis=-1, keepdims=True)
-        change = np.max(np.linalg.norm(dq, axis=-1), axis=1)
+        change = _move_clamps(pos, tops, idx, vs, B, _block_tridiag_solve(D, E, r), active)
         last = np.where(active, change, last)
-        newly = active & (change <= tol_d)
-        done_at[newly] = it
+        done_at[active & (change <= tol_d)] = it
         if progress is not None:
             progress(int((done_at > 0).sum()), n_s)
         if np.all(done_at > 0):
@@ -333,11 +361,6 @@ def equilibrium(
         j = int(np.flatnonzero(done_at == 0)[0])
         raise ConvergenceError(f"{labels[j]}: step-1 section solver did not converge in {max_iter} iterations "
                                f"(last clamp motion {last[j]:.3g} m)")
-    sol = solve_spans(np.diff(pos, axis=1), p, Lu, EA, N0, what=labels[0] if n_s == 1 else "mean states")
+    sol = solve_spans(np.diff(pos, axis=1), p, Lu, EA, N0, what=what)
     f = conductor_forces(sol, nt)
-    resid = np.zeros(n_s)
-    if k:
-        u = (pos[:, idx] - tops[idx]) / vs[:, None]
-        fk = f[:, idx]
-        resid = np.max(np.linalg.norm(fk - (fk * u).sum(axis=-1, keepdims=True) * u, axis=-1), axis=1)
-    return SectionEquilibrium(pos, sol, f, done_at, resid)
+    return SectionEquilibrium(pos, sol, f, done_at, _tangential_residual(f, pos, tops, idx, vs))

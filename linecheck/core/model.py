@@ -5,7 +5,7 @@ the nodes at strain towers removed (pinned).  Element matrices:
 
 - cable element (paper Eq. 7): in local axes diag(EA, T, T)/L_e, i.e. in global axes
   k = (EA/L_e) e e^T + (T/L_e) (I - e e^T), e the unit chord of the deformed element;
-- insulator (issue 4): from the fixed point to the attachment node, axially stiff
+- insulator: from the fixed point to the attachment node, axially stiff
   (penalty EA_ins/v, see :data:`INSULATOR_AXIAL_FACTOR`) and with the geometric
   stiffness R_res/v transversely;
 - lumped mass (paper Eq. 8): m = W L_u / (ne g) per element, half to each node.
@@ -148,14 +148,14 @@ class CSRArrays:
 def band_to_csr(ab: np.ndarray) -> CSRArrays:
     """Upper banded storage (LAPACK 'U', ab[u + i - j, j] = A[i, j]) of a symmetric matrix to
     its CSR arrays: those of scipy's ``dia_matrix(...).tocsr()`` (explicit zeros dropped, each
-    row's columns ascending, int32 indices), gathered in one vectorised pass (issue 20; the same
+    row's columns ascending, int32 indices), gathered in one vectorised pass (the same
     arrays, tested; :func:`band_to_csr_stack` of one matrix)."""
     return band_to_csr_stack(ab[None])[0]
 
 
 def band_to_csr_stack(ab: np.ndarray) -> list[CSRArrays]:
     """:func:`band_to_csr` of many band matrices of one size, shape (n_k, u + 1, n), in one
-    vectorised pass (issue 20: a downburst's 250 mean states)."""
+    vectorised pass (a downburst's 250 mean states)."""
     n_k, u, n = ab.shape[0], ab.shape[1] - 1, ab.shape[2]
     offs = np.arange(-u, u + 1)
     rows = np.arange(n)[:, None]
@@ -193,16 +193,34 @@ def _cable_blocks(nodes: np.ndarray, tension: np.ndarray, ea: float) -> np.ndarr
     return (ea / Le)[..., None, None] * eet + (tension / Le)[..., None, None] * (eye - eet)
 
 
-def build_model(system: LineSystem, state: StaticState) -> LinearModel:
-    """Assemble K, M and the reaction map about the mean state ``state`` (paper Eqs 7-8)."""
-    line = system.line
-    dm = dof_map(system)
-    n_dof = dm.n_dof
-    kb = _cable_blocks(state.nodes, state.element_tension, line.ea)  # (n_el, 3, 3)
-    n_el = kb.shape[0]
+def _insulator_axial_stiffness(system: LineSystem) -> float:
+    """k_ax [N/m]: the insulators' axial penalty, :data:`INSULATOR_AXIAL_FACTOR` times the
+    stiffest cable element of the section (equal spans: every element, EA ne / L_u)."""
+    ea_cable_el = system.line.ea / float(system.element_unstretched_lengths.min())
+    return INSULATOR_AXIAL_FACTOR * ea_cable_el
+
+
+def _lumped_mass(system: LineSystem, dm: DofMap) -> tuple[np.ndarray, np.ndarray]:
+    """Lumped mass by tributary unstretched length (paper Eq. 8), state-independent.
+
+    Returns: tributary length [m] of every global node (n_nodes,) and the mass [kg] per free
+    DOF (n_dof,)."""
+    Le_u = system.element_unstretched_lengths  # (n_elements,)
+    trib = np.zeros(system.n_nodes)
+    trib[:-1] += 0.5 * Le_u
+    trib[1:] += 0.5 * Le_u
+    m_node = system.line.weight * trib / GRAVITY
+    return trib, np.repeat(m_node[dm.free_nodes], 3)
+
+
+def _cable_band(kb: np.ndarray, nd: np.ndarray, n_dof: int) -> np.ndarray:
+    """Cable elements' stiffness (paper Eq. 7) scattered into upper band storage.
+
+    kb: [N/m] element blocks (n_el, 3, 3); nd: first DOF of every node (-1 pinned), (n_nodes,).
+    Returns: [N/m] (BANDWIDTH + 1, n_dof).
+    """
     ab = np.zeros((BANDWIDTH + 1, n_dof))
     u = BANDWIDTH
-    nd = dm.node_dof
     ia, ib = np.triu_indices(3)  # upper triangle of a diagonal 3x3 block
 
     def add_diag_blocks(first: np.ndarray, blocks: np.ndarray) -> None:
@@ -219,6 +237,19 @@ def build_model(system: LineSystem, state: StaticState) -> LinearModel:
     rows = np.broadcast_to((u + a - 3 - b).ravel(), (int(both.sum()), 9))  # right node = left + 3
     cols = right[both][:, None] + b.ravel()[None, :]
     np.add.at(ab, (rows, cols), -kb[both].reshape(-1, 9))
+    return ab
+
+
+def _add_insulators(ab: np.ndarray, system: LineSystem, state: StaticState, nd: np.ndarray):
+    """Add the suspension insulators' stiffness to the band ``ab`` (in place).
+
+    Each insulator is axially stiff (penalty k_ax along its axis) with the geometric stiffness
+    R_res/v transversely (pendulum of length v under the insulator force R_res).
+
+    Returns: {tower: 3x3 block [N/m]}, the unit axes (n_susp, 3), the attachment nodes' first
+    DOFs (n_susp,) and the axial penalty part of the band [N/m] (BANDWIDTH + 1, n_dof).
+    """
+    u = BANDWIDTH
 
     def add_block(r0: int, c0: int, blk: np.ndarray) -> None:
         # one 3x3 block at (r0, c0), upper triangle only (insulators)
@@ -228,11 +259,8 @@ def build_model(system: LineSystem, state: StaticState) -> LinearModel:
                 if i <= j:
                     ab[u + i - j, j] += blk[a_, b_]
 
-    # insulators (issue 4): axially stiff, geometric stiffness R_res/v transversely
-    v_all = system.insulator_lengths  # per tower (issue 17; equal-span form: line.insulator_length)
-    # stiffest cable element of the section (equal spans: every element, L_u / ne)
-    ea_cable_el = line.ea / float(system.element_unstretched_lengths.min())
-    k_ax = INSULATOR_AXIAL_FACTOR * ea_cable_el
+    v_all = system.insulator_lengths  # per tower (equal-span form: line.insulator_length)
+    k_ax = _insulator_axial_stiffness(system)
     ins_blocks = {}
     axes, axial_dof = [], []
     K_axial = np.zeros_like(ab)
@@ -251,16 +279,14 @@ def build_model(system: LineSystem, state: StaticState) -> LinearModel:
                 K_axial[u + a_ - b_, r + b_] += k_ax * P[a_, b_]
         axes.append(axis)
         axial_dof.append(r)
+    return ins_blocks, np.array(axes).reshape(-1, 3), np.array(axial_dof, dtype=int), K_axial
 
-    # lumped mass (paper Eq. 8) by tributary unstretched length
-    Le_u = system.element_unstretched_lengths  # (n_elements,)
-    trib = np.zeros(system.n_nodes)
-    trib[:-1] += 0.5 * Le_u
-    trib[1:] += 0.5 * Le_u
-    m_node = line.weight * trib / GRAVITY
-    mass = np.repeat(m_node[dm.free_nodes], 3)
 
-    # reaction map: force of the system on tower j's fixed point
+def _reaction_map(system: LineSystem, nd: np.ndarray, kb: np.ndarray, ins_blocks: dict,
+                  n_dof: int) -> np.ndarray:
+    """Reaction map G [N/m] (3 n_towers, n_dof): force of the system on every tower's fixed
+    point from the free displacements (R_z positive downward)."""
+    n_el = kb.shape[0]
     G = np.zeros((3 * system.n_towers, n_dof))
     flip = np.array([1.0, 1.0, -1.0])  # R_z is positive downward
     for j in range(system.n_towers):
@@ -275,8 +301,96 @@ def build_model(system: LineSystem, state: StaticState) -> LinearModel:
                 if 0 <= e < n_el and nd[other] >= 0:
                     c = nd[other]
                     G[3 * j:3 * j + 3, c:c + 3] += flip[:, None] * kb[e]
-    return LinearModel(system, dm, ab, mass, trib, G, np.array(axes).reshape(-1, 3),
-                       np.array(axial_dof, dtype=int), K_axial)
+    return G
+
+
+def build_model(system: LineSystem, state: StaticState) -> LinearModel:
+    """Assemble K, M and the reaction map about the mean state ``state`` (paper Eqs 7-8)."""
+    dm = dof_map(system)
+    kb = _cable_blocks(state.nodes, state.element_tension, system.line.ea)  # (n_el, 3, 3)
+    ab = _cable_band(kb, dm.node_dof, dm.n_dof)
+    ins_blocks, axes, axial_dof, K_axial = _add_insulators(ab, system, state, dm.node_dof)
+    trib, mass = _lumped_mass(system, dm)
+    G = _reaction_map(system, dm.node_dof, kb, ins_blocks, dm.n_dof)
+    return LinearModel(system, dm, ab, mass, trib, G, axes, axial_dof, K_axial)
+
+
+def _stacked_cable_band(kb: np.ndarray, nd: np.ndarray, n_dof: int) -> np.ndarray:
+    """:func:`_cable_band` of n_k states at once: kb (n_k, n_el, 3, 3) -> (n_k, BANDWIDTH + 1, n_dof)."""
+    n_k = kb.shape[0]
+    u = BANDWIDTH
+    ia, ib = np.triu_indices(3)
+    ab = np.zeros((n_k, BANDWIDTH + 1, n_dof))
+    diag_rows = (u + ia - ib)[None, :]  # upper triangle of a diagonal 3x3 block
+    # no DOF repeats within one scatter, so a fancy-indexed += adds exactly as np.add.at
+    left, right = nd[:-1], nd[1:]
+    for ends, mask in ((left, left >= 0), (right, right >= 0)):  # same order as build_model
+        ab[:, diag_rows, ends[mask][:, None] + ib[None, :]] += kb[:, mask][:, :, ia, ib]
+    both = (left >= 0) & (right >= 0)  # element between two free nodes: -k off the diagonal
+    a, b = np.meshgrid(np.arange(3), np.arange(3), indexing="ij")
+    rows = (u + a - 3 - b).ravel()[None, :]  # right node = left + 3
+    cols = right[both][:, None] + b.ravel()[None, :]
+    ab[:, rows, cols] += -kb[:, both].reshape(n_k, -1, 9)
+    return ab
+
+
+def _stacked_insulators(ab: np.ndarray, system: LineSystem, states: list[StaticState], nd: np.ndarray):
+    """:func:`_add_insulators` of n_k states at once (adds to ``ab`` (n_k, BANDWIDTH + 1, n_dof)).
+
+    Returns: insulator blocks [N/m] (n_k, n_susp, 3, 3), unit axes (n_k, n_susp, 3), the
+    attachment nodes' first DOFs (n_susp,) and the axial penalty bands [N/m] (n_k, BANDWIDTH + 1, n_dof).
+    """
+    u = BANDWIDTH
+    ia, ib = np.triu_indices(3)
+    diag_rows = (u + ia - ib)[None, :]  # upper triangle of a diagonal 3x3 block
+    susp = np.flatnonzero(system.suspension)
+    v = system.insulator_lengths[susp]  # (n_s,)
+    k_ax = _insulator_axial_stiffness(system)
+    d = np.stack([s.displacement for s in states])[:, susp]  # (n_k, n_s, 3)
+    axes = np.stack([d[..., 0], d[..., 1], d[..., 2] - v], axis=-1) / v[:, None]  # fixed point -> attachment
+    # |axis| element-wise, as build_model (a BLAS dot of a 3-vector rounds by its alignment on
+    # OpenBLAS's SSE3 kernels, so a stacked state would not match one built alone)
+    axes /= np.sqrt((axes[..., 0] * axes[..., 0] + axes[..., 1] * axes[..., 1]) + axes[..., 2] * axes[..., 2])[..., None]
+    P = axes[..., :, None] * axes[..., None, :]  # (n_k, n_s, 3, 3)
+    fins = np.stack([s.insulator_force for s in states])[:, susp]  # (n_k, n_s)
+    ins_blocks = k_ax * P + (fins / v)[..., None, None] * (np.eye(3) - P)
+    r = nd[system.tower_nodes[susp]]  # first DOF of every attachment node
+    ins_cols = r[:, None] + ib[None, :]
+    ab[:, diag_rows, ins_cols] += ins_blocks[:, :, ia, ib]
+    K_axial = np.zeros_like(ab)
+    K_axial[:, diag_rows, ins_cols] += (k_ax * P)[:, :, ia, ib]
+    return ins_blocks, axes, np.array(r, dtype=int), K_axial
+
+
+def _stacked_reaction_maps(system: LineSystem, nd: np.ndarray, kb: np.ndarray, ins_blocks: np.ndarray,
+                           r: np.ndarray, n_dof: int) -> list[np.ndarray]:
+    """:func:`_reaction_map` of n_k states: suspension towers k_ins u_node, strain towers
+    -(K_rf u); one dense (3 n_towers, n_dof) map per state, allocated state by state (no
+    (n_k, 3 n_towers, n_dof) stack)."""
+    n_el = kb.shape[1]
+    susp = np.flatnonzero(system.suspension)
+    flip = np.array([1.0, 1.0, -1.0])[:, None]  # R_z is positive downward
+    i3 = np.arange(3)
+    susp_rows, susp_cols = (3 * susp)[:, None, None] + i3[:, None], r[:, None, None] + i3
+    susp_vals = flip * ins_blocks  # (n_k, n_s, 3, 3)
+    strain_rows, strain_cols, strain_el = [], [], []
+    for j in np.flatnonzero(~system.suspension):
+        node = system.tower_nodes[j]
+        for e, other in ((node - 1, node - 1), (node, node + 1)):
+            if 0 <= e < n_el and nd[other] >= 0:
+                strain_rows.append(3 * j)
+                strain_cols.append(nd[other])
+                strain_el.append(e)
+    rr = np.array(strain_rows, dtype=int)[:, None, None] + i3[:, None]
+    cc = np.array(strain_cols, dtype=int)[:, None, None] + i3
+    strain_vals = flip * kb[:, strain_el]  # (n_k, n_blocks, 3, 3)
+    G = []
+    for k in range(kb.shape[0]):
+        Gk = np.zeros((3 * system.n_towers, n_dof))
+        Gk[susp_rows, susp_cols] = susp_vals[k]
+        Gk[rr, cc] += strain_vals[k]
+        G.append(Gk)
+    return G
 
 
 def build_models(system: LineSystem, states: Sequence[StaticState]) -> list[LinearModel]:
@@ -301,82 +415,18 @@ def build_models(system: LineSystem, states: Sequence[StaticState]) -> list[Line
     states = list(states)
     if not states:
         return []
-    line = system.line
     dm = dof_map(system)
-    n_dof = dm.n_dof
-    n_k = len(states)
     nodes = np.stack([s.nodes for s in states])  # (n_k, n_nodes, 3)
     tension = np.stack([s.element_tension for s in states])  # (n_k, n_el)
-    kb = _cable_blocks(nodes, tension, line.ea)  # (n_k, n_el, 3, 3)
-    n_el = kb.shape[1]
-    u = BANDWIDTH
-    nd = dm.node_dof
-    ia, ib = np.triu_indices(3)
-    ab = np.zeros((n_k, BANDWIDTH + 1, n_dof))
-    diag_rows = (u + ia - ib)[None, :]  # upper triangle of a diagonal 3x3 block
-    # no DOF repeats within one scatter, so a fancy-indexed += adds exactly as np.add.at
-    left, right = nd[:-1], nd[1:]
-    for ends, mask in ((left, left >= 0), (right, right >= 0)):  # same order as build_model
-        ab[:, diag_rows, ends[mask][:, None] + ib[None, :]] += kb[:, mask][:, :, ia, ib]
-    both = (left >= 0) & (right >= 0)  # element between two free nodes: -k off the diagonal
-    a, b = np.meshgrid(np.arange(3), np.arange(3), indexing="ij")
-    rows = (u + a - 3 - b).ravel()[None, :]  # right node = left + 3
-    cols = right[both][:, None] + b.ravel()[None, :]
-    ab[:, rows, cols] += -kb[:, both].reshape(n_k, -1, 9)
-
-    # insulators (issue 4): axially stiff, geometric stiffness R_res/v transversely
-    susp = np.flatnonzero(system.suspension)
-    v = system.insulator_lengths[susp]  # (n_s,)
-    ea_cable_el = line.ea / float(system.element_unstretched_lengths.min())
-    k_ax = INSULATOR_AXIAL_FACTOR * ea_cable_el
-    d = np.stack([s.displacement for s in states])[:, susp]  # (n_k, n_s, 3)
-    axes = np.stack([d[..., 0], d[..., 1], d[..., 2] - v], axis=-1) / v[:, None]  # fixed point -> attachment
-    # |axis| element-wise, as build_model (a BLAS dot of a 3-vector rounds by its alignment on
-    # OpenBLAS's SSE3 kernels, so a stacked state would not match one built alone)
-    axes /= np.sqrt((axes[..., 0] * axes[..., 0] + axes[..., 1] * axes[..., 1]) + axes[..., 2] * axes[..., 2])[..., None]
-    P = axes[..., :, None] * axes[..., None, :]  # (n_k, n_s, 3, 3)
-    fins = np.stack([s.insulator_force for s in states])[:, susp]  # (n_k, n_s)
-    ins_blocks = k_ax * P + (fins / v)[..., None, None] * (np.eye(3) - P)
-    r = nd[system.tower_nodes[susp]]  # first DOF of every attachment node
-    ins_cols = r[:, None] + ib[None, :]
-    ab[:, diag_rows, ins_cols] += ins_blocks[:, :, ia, ib]
-    K_axial = np.zeros_like(ab)
-    K_axial[:, diag_rows, ins_cols] += (k_ax * P)[:, :, ia, ib]
-
-    # lumped mass (paper Eq. 8) by tributary unstretched length: state-independent
-    Le_u = system.element_unstretched_lengths
-    trib = np.zeros(system.n_nodes)
-    trib[:-1] += 0.5 * Le_u
-    trib[1:] += 0.5 * Le_u
-    m_node = line.weight * trib / GRAVITY
-    mass = np.repeat(m_node[dm.free_nodes], 3)
-
-    # reaction map: suspension towers k_ins u_node, strain towers -(K_rf u) (as build_model)
-    flip = np.array([1.0, 1.0, -1.0])[:, None]  # R_z is positive downward
-    i3 = np.arange(3)
-    susp_rows, susp_cols = (3 * susp)[:, None, None] + i3[:, None], r[:, None, None] + i3
-    susp_vals = flip * ins_blocks  # (n_k, n_s, 3, 3)
-    strain_rows, strain_cols, strain_el = [], [], []
-    for j in np.flatnonzero(~system.suspension):
-        node = system.tower_nodes[j]
-        for e, other in ((node - 1, node - 1), (node, node + 1)):
-            if 0 <= e < n_el and nd[other] >= 0:
-                strain_rows.append(3 * j)
-                strain_cols.append(nd[other])
-                strain_el.append(e)
-    rr = np.array(strain_rows, dtype=int)[:, None, None] + i3[:, None]
-    cc = np.array(strain_cols, dtype=int)[:, None, None] + i3
-    strain_vals = flip * kb[:, strain_el]  # (n_k, n_blocks, 3, 3)
-    G = []  # one dense map per state, allocated state by state (no (n_k, 3 n_towers, n_dof) stack)
-    for k in range(n_k):
-        Gk = np.zeros((3 * system.n_towers, n_dof))
-        Gk[susp_rows, susp_cols] = susp_vals[k]
-        Gk[rr, cc] += strain_vals[k]
-        G.append(Gk)
-    axial_dof = np.array(r, dtype=int)
+    kb = _cable_blocks(nodes, tension, system.line.ea)  # (n_k, n_el, 3, 3)
+    ab = _stacked_cable_band(kb, dm.node_dof, dm.n_dof)
+    ins_blocks, axes, axial_dof, K_axial = _stacked_insulators(ab, system, states, dm.node_dof)
+    trib, mass = _lumped_mass(system, dm)
+    G = _stacked_reaction_maps(system, dm.node_dof, kb, ins_blocks, axial_dof, dm.n_dof)
     for x in (dm.free_nodes, dm.node_dof, mass, trib, axial_dof):
         x.flags.writeable = False  # shared by all the models
-    return [LinearModel(system, dm, ab[k], mass, trib, G[k], axes[k], axial_dof, K_axial[k]) for k in range(n_k)]
+    return [LinearModel(system, dm, ab[k], mass, trib, G[k], axes[k], axial_dof, K_axial[k])
+            for k in range(len(states))]
 
 
 def mul3(A: np.ndarray, B: np.ndarray) -> np.ndarray:
@@ -497,7 +547,7 @@ def _condensed_sparse(model: LinearModel, damping_band: np.ndarray | None) -> Co
     """:func:`condensed` with sparse K, M, C, T and S (the same algebra): each axial direction
     couples only to its node's neighbours, and the axial DOFs of different towers are never
     coupled (K_aa is diagonal), so S = T - A K_aa^-1 K_at stays sparse; the products are then
-    O(n) and only the condensed matrices are made dense (issue 20: long sections)."""
+    O(n) and only the condensed matrices are made dense (long sections)."""
     from scipy.sparse import coo_matrix, diags
 
     n = model.mass.size

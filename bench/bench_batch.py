@@ -1,4 +1,4 @@
-"""Bench: batch scaling (1 vs N workers) and a 1,000-point critical-downburst scan (issue 8).
+"""Bench: batch scaling (1 vs N workers) and a 1,000-point critical-downburst scan.
 
     .venv/bin/python bench/bench_batch.py                 # 24 paper cases + 1,000-point scan
     .venv/bin/python bench/bench_batch.py --cases 6       # first 6 paper cases only

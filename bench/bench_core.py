@@ -99,7 +99,7 @@ def main() -> None:
     args = ap.parse_args()
     rows = []
 
-    # ---- issue 2: step 1, six spans, 250 downburst-like states
+    # ---- step 1, six spans, 250 downburst-like states
     case = case_with("case09-six")
     system = LineSystem(case.line)
     g = float(drag_intensity(40.0, 1.25, 1.0, 0.022))
@@ -109,7 +109,7 @@ def main() -> None:
     rows.append(("step 1, six spans, per state", f"{1e3 * t250 / 250:.2f} ms", "<= 5 ms", ""))
     rows.append(("step 1, six spans, 250 states", f"{t250:.2f} s", "<= 1.5 s", ""))
 
-    # ---- issue 4: one realization of the six-span synoptic case, 600 s at 0.05 s, wind included
+    # ---- one realization of the six-span synoptic case, 600 s at 0.05 s, wind included
     one = case_with("case09-six", realizations=1)
     t1 = timed(lambda: service.run_case(one), 3)
     if args.quick:
@@ -121,7 +121,7 @@ def main() -> None:
     t10 = timed(lambda: service.run_case(case_with("case09-six", realizations=10)), 1)
     rows.append(("six spans, 10 realizations (columns of one RHS)", f"{t10:.2f} s", "", f"{t10 / t1:.1f} x one"))
 
-    # ---- issue 5: frequency domain
+    # ---- frequency domain
     st = service.static_analysis(one)
     ts = timed(lambda: service.spectral_analysis(one, static=st), 3)
     rows.append(("estimate 1 (exact), six spans", f"{ts:.3f} s", "<= 0.2 s", "incl. complex modes"))
@@ -134,7 +134,7 @@ def main() -> None:
                                               duration=600.0, height=43.0), 5)
     rows.append(("estimate 2 (closed form)", f"{1e3 * te2:.1f} ms", "<= 10 ms", ""))
 
-    # ---- issue 9: scaling with spans and record length (1 realization, synoptic)
+    # ---- scaling with spans and record length (1 realization, synoptic)
     base = case_with("case09-six", realizations=1)
     spans_list = (1, 6, 20) if args.quick else (1, 6, 20, 60)
     ref = None

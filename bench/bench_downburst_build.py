@@ -1,10 +1,10 @@
-"""Benchmark of the downburst mean-state models built in one vectorised pass (issue 20).
+"""Benchmark of the downburst mean-state models built in one vectorised pass.
 
 Run from the repository root:  ``.venv/bin/python bench/bench_downburst_build.py [--case ...] [--repeat 5]``
 
-Target (issue 20): one six-span downburst realization >= 30x faster than OpenSeesPy (8.6x
-before this work; bench/bench_nonlinear.py measures that ratio).  This script measures, in
-one process, interleaved and best of ``--repeat``, the phases that issue 20 vectorises
+Target: one six-span downburst realization >= 30x faster than OpenSeesPy (8.6x with
+the one-state-at-a-time code; bench/bench_nonlinear.py measures that ratio).  This script
+measures, in one process, interleaved and best of ``--repeat``, the phases vectorised
 across the n_k mean states against the one-state-at-a-time code they replace:
 
 - models: ``[build_model(system, s) for s in states]`` vs ``build_models(system, states)``;
@@ -15,10 +15,10 @@ across the n_k mean states against the one-state-at-a-time code they replace:
   functions patched back in (before) vs as shipped (after).
 
 Both sides give bit-identical results (tests/test_build_models.py); the script checks the
-realization's reactions are equal.  With ``--baseline REV`` (default: fe644a7, the last
-commit before this work) the package as it was at REV is also extracted (``git archive``)
-and imported under another name, and its ``run_case`` is timed in the same loop: the
-speed-up of the whole realization over the code before issue 20, whatever else changed.
+realization's reactions are equal.  With ``--baseline REV`` (default: fe644a7, the last commit
+with the one-state-at-a-time code) the package as it was at REV is also extracted
+(``git archive``) and imported under another name, and its ``run_case`` is timed in the same
+loop: the speed-up of the whole realization over the code at REV, whatever else changed.
 """
 
 from __future__ import annotations
@@ -63,7 +63,7 @@ def main() -> None:
     states = [mean.state(k) for k in range(mean.time.size)]
     nm = dynamics.Newmark(case.analysis.time_step)
 
-    # ---- the one-state-at-a-time code (before issue 20), from the per-state functions
+    # ---- the one-state-at-a-time code (before the vectorised pass), from the per-state functions
     def models_before():
         return [build_model(system, s) for s in states]
 

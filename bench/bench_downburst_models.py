@@ -1,13 +1,13 @@
-"""Benchmark of the downburst running-mean models (issue 15 speed target).
+"""Benchmark of the downburst running-mean models against their speed target.
 
 Run from the repository root:  ``.venv/bin/python bench/bench_downburst_models.py [--case ...] [--realizations 10]``
 
-Target: a six-span downburst run with 10 realizations takes at most 1.5x today's time per
-model.  "Today" is the "holmes-oliver" model (the paper cases pin it; bit-identical to the
-code before issue 15), run in the same process as the baseline; every other model is
+Target: a six-span downburst run with 10 realizations takes at most 1.5x the baseline's time per
+model.  The baseline is the "holmes-oliver" model (the paper cases pin it; bit-identical to the
+code before running-mean models could be chosen), run in the same process; every other model is
 timed the same way (one full ``service.run_case``, best of ``--repeat``) and its ratio printed.
-The table also gives each run's record length, since the event window of "ring-jet" scales
-with D_j/V_j and the cost of steps 2-3 with the record length, and R_x / g*_yp L at the tower.
+The table also gives each run's record length, since the event window of "ring-jet" scales with
+D_j/V_j and the cost of steps 2-3 with the record length, and R_x / g*_yp L at the tower.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
-"""Issue 20 targets for long lines: one realization of 60 and 200 spans with the frequency-domain
-check, the check's cost against the whole-line check, and the peak memory of a 200-span,
-10-realization run.
+"""Speed and memory targets for long lines: one realization of 60 and 200 spans with the
+frequency-domain check, the check's cost against the whole-line check, and the peak memory of a
+200-span, 10-realization run.
 
     .venv/bin/python bench/bench_long.py            # everything (about 10 minutes)
     .venv/bin/python bench/bench_long.py --quick    # 6/20/60 spans, no 200-span or memory rows

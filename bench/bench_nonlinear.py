@@ -1,4 +1,4 @@
-"""linecheck's three steps against a full non-linear dynamic analysis (OpenSeesPy), issue 9.
+"""linecheck's three steps against a full non-linear dynamic analysis (OpenSeesPy).
 
 Run from the repository root (needs the ``bench`` extra: ``pip install -e '.[bench]'``):
 
@@ -44,8 +44,8 @@ docs/validation.md and docs/performance.md come from
     .venv/bin/python bench/bench_nonlinear.py --diagnostic --transverse --dt-check --mesh 20 40
     .venv/bin/python bench/bench_nonlinear.py --diagnostic --realizations 0 1 2 3 4
     .venv/bin/python bench/bench_nonlinear.py --no-paper --repeat 2 --ensemble 10
-    .venv/bin/python bench/bench_nonlinear.py --no-paper --repeat 2 --ensemble 10 --fft-length fast  # issue 20
-    .venv/bin/python bench/bench_nonlinear.py --options --no-paper --realizations 0 1 2 3 4   # issue 16
+    .venv/bin/python bench/bench_nonlinear.py --no-paper --repeat 2 --ensemble 10 --fft-length fast  # fast FFT length
+    .venv/bin/python bench/bench_nonlinear.py --options --no-paper --realizations 0 1 2 3 4   # drag/tension options
 
 ``--options`` adds linecheck with every combination of ``[analysis] drag`` and ``tension``
 (``linecheck_quadratic_linear``, ``linecheck_linear_second-order``,
@@ -204,7 +204,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--diagnostic", action="store_true", help="extra run with the drag linearised about the mean")
     ap.add_argument("--transverse", action="store_true", help="extra run with the transverse-only drag, no structural damping")
     ap.add_argument("--options", action="store_true",
-                    help="also linecheck with drag = quadratic and/or tension = second-order (issue 16)")
+                    help="also linecheck with drag = quadratic and/or tension = second-order")
     ap.add_argument("--no-paper", action="store_true", help="skip linecheck's \"paper\" damping")
     ap.add_argument("--repeat", type=int, default=1, help="time both analyses best of N")
     ap.add_argument("--fft-length", choices=("record", "fast"), default="record",
@@ -316,7 +316,7 @@ def run_one(name: str, r: int, args) -> dict:
             "linecheck_quasi_steady": statistics(R_lc, None if synoptic else M_lc),
         },
     }
-    if args.options:  # issue 16: every drag/tension combination (quasi-steady damping), same wind
+    if args.options:  # every drag/tension combination (quasi-steady damping), same wind
         for drag, tension in OPTION_COMBOS[1:]:
             co = with_analysis(case, drag=drag, tension=tension, burn_in=burn)  # same record, same wind
             ro = service.run_case(co, realizations=[r])

@@ -13,7 +13,7 @@ ratio of the best times, and the median over the rounds of each round's ratio (t
 All four runs analyse the same record: the burn-in is derived once (linear/linear) and imposed
 (the derived burn-in can move by one step with the mean state, which changes the wind
 synthesis' FFT length and its cost by up to 20 %, unrelated to the options).
-Target (issue 16): both options together add at most 15 %.
+Target: both options together add at most 15 %.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Cost of line sections (issue 17): steps 1-3 per span, equal-span form vs the section form.
+"""Cost of line sections: steps 1-3 per span, equal-span form vs the section form.
 
 Run from the repository root:
 
@@ -6,16 +6,16 @@ Run from the repository root:
     .venv/bin/python bench/bench_sections.py --repeat 5 --realizations 4
 
 ``service.run_case`` (step 1, wind synthesis, steps 2-3; the frequency-domain check is off: its
-cost on long lines is the speed issue's, bench/bench_long.py) of
+cost on long lines is measured by bench/bench_long.py) of
 
 - the baseline: paper case 9 on six equal spans (equal-span form, the paper's Appendix-A step 1),
 - the same six spans written as towers (section form: exact-span step 1, Markov coherence),
 - the 12-span example section (cases/examples/section-12span.toml: unequal, inclined, two angles),
 - that section repeated to 24 and 48 spans (linearity in the number of spans),
 
-all with the same record (``--duration`` s, ``--realizations``), the issue-16 defaults and
-``time_step`` 0.05 s, timed in this process, interleaved, best of ``--repeat``.  The table gives
-the time per span and its ratio to the baseline's.  Targets (issue 17): the 12-span section costs
+all with the same record (``--duration`` s, ``--realizations``), the default drag/tension
+options and ``time_step`` 0.05 s, timed in this process, interleaved, best of ``--repeat``.  The
+table gives the time per span and its ratio to the baseline's.  Targets: the 12-span section costs
 no more per span than the six equal spans, and the time per span stays flat from 12 to 48 spans.
 """
 
@@ -95,7 +95,7 @@ def main(argv: list[str] | None = None) -> int:
           f"no frequency-domain check, best of {args.repeat}")
     # the dense eigen-analyses inside a run (complex modes for the burn-in's significant modes,
     # the lowest undamped mode that calibrates the structural damping) are timed apart: their
-    # cost is cubic in the spans and belongs to the speed issue (issue 20)
+    # cost is cubic in the spans and is measured on long lines (bench/bench_long.py)
     import linecheck.core.modes as modes_mod
 
     spent = {"modes": 0.0}

@@ -1,10 +1,10 @@
-"""Benchmark: cost of the issue 18 statistics relative to a 10-realization six-span run.
+"""Benchmark: cost of the statistics over realizations relative to a 10-realization six-span run.
 
 Run from the repository root:  ``.venv/bin/python bench/bench_stats.py [--repeat 3] [--case case09-six]``
 
-Target (issue 18): the statistics add <= 5 % to a 10-realization six-span run.  "baseline"
+Target: the statistics add <= 5 % to a 10-realization six-span run.  "baseline"
 is ``service.run_case`` (steps 1-3, the per-realization statistics of Eqs 15-17 and the
-frequency-domain check, as before issue 18); "measured" is what issue 18 adds on top:
+frequency-domain check); "measured" is what the statistics over realizations add on top:
 ``RunResult.summary()`` (moments, fractiles, Gumbel fits, intervals, flags at every tower)
 plus the typed :class:`~linecheck.io.document.RunDocument` of those summaries.  Both in the
 same process, best of ``--repeat``; the table prints the ratio.

@@ -1,8 +1,8 @@
-"""Benchmark of the turbulence synthesis against the issue 3 targets.
+"""Benchmark of the turbulence synthesis against its speed targets.
 
 Run from the repository root:  ``.venv/bin/python bench/bench_wind.py [--repeat 3] [--threads 1]``
 
-Targets (issue 3): six-span field (61 nodes), 600 s at 0.05 s, 10 realizations <= 2 s;
+Targets: six-span field (61 nodes), 600 s at 0.05 s, 10 realizations <= 2 s;
 60-span line (601 nodes), same record, 1 realization <= 10 s.  "measured" is the public
 ``fluctuating_velocity`` (KMS closed-form Cholesky, O(N) per frequency), best of
 ``--repeat`` runs.  "baseline" is the straightforward method run in the same process on

@@ -1,4 +1,4 @@
-"""Independent full non-linear dynamic reference of a line section, with OpenSeesPy (issue 9).
+"""Independent full non-linear dynamic reference of a line section, with OpenSeesPy.
 
 Not a runtime dependency of linecheck: install the ``bench`` extra (``pip install -e '.[bench]'``).
 OpenSeesPy's Linux wheel links the system BLAS/LAPACK (Debian ``libblas3``, ``liblapack3``);

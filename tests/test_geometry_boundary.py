@@ -1,8 +1,9 @@
 """LineSystem owns the geometry (issue 17, "Structure first").
 
 No module under linecheck/ reads the case's ``span_length`` key except the geometry code
-(linecheck/core/case.py defines and validates it, linecheck/core/system.py turns it into the
-per-span and per-node arrays) and the front ends listed below, which only DISPLAY the key.
+(linecheck/core/case_model.py defines it, case_load.py reads it for a downburst preset,
+linecheck/core/system.py turns it into the per-span and per-node arrays) and the front ends
+listed below, which only DISPLAY the key.
 Everything numerical goes through ``LineSystem`` arrays, so that unequal spans change one place.
 """
 
@@ -19,7 +20,8 @@ from linecheck.core.system import LineSystem
 
 PACKAGE = Path(linecheck.__file__).resolve().parent
 
-GEOMETRY_CODE = {"core/case.py", "core/system.py"}
+# the case model (defines the key), its loader (derives L_x for a downburst preset) and the system
+GEOMETRY_CODE = {"core/case_model.py", "core/case_load.py", "core/system.py"}
 
 # front ends / documents that display or copy the case's key; they never compute with it
 DISPLAY_ONLY = {
@@ -43,7 +45,7 @@ def _readers() -> dict[str, list[int]]:
 def test_only_geometry_code_reads_span_length():
     readers = _readers()
     # the scan sees real reads (otherwise this test could not fail)
-    assert "core/system.py" in readers and "core/case.py" in readers
+    assert "core/system.py" in readers and "core/case_load.py" in readers
     offenders = {m: ln for m, ln in readers.items() if m not in GEOMETRY_CODE and m not in DISPLAY_ONLY}
     assert not offenders, f"read LineSystem arrays (span_lengths, tower_x, ...) instead of .span_length: {offenders}"
 

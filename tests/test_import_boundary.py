@@ -32,6 +32,7 @@ CORE_MODULES = [
     "linecheck.core.second_order",
     "linecheck.core.banded",
     "linecheck.core.catenary",
+    "linecheck.core.pieces",
     "linecheck.core.wind.mean",
     "linecheck.core.wind.turbulence",
     "linecheck.core.wind.point",
@@ -47,7 +48,7 @@ CORE_MODULES = [
 ]
 #: core modules that import Numba themselves: loaded only by linecheck.core.kernel when the
 #: optional compiled kernel is asked for (issue 20)
-KERNEL_MODULES = ["linecheck.core._loops"]
+KERNEL_MODULES = ["linecheck.core._loops", "linecheck.core._loops_wind", "linecheck.core._loops_second_order"]
 
 
 def test_core_imports_no_ui_libraries():

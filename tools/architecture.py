@@ -8,7 +8,7 @@ Rules (docs/architecture.md):
 1. **Layers.** Every module of ``linecheck`` belongs to one layer; it imports only modules of its
    own layer or of a lower one.  Lowest first::
 
-       kernel (core._loops, core.kernel, core.errors)
+       kernel (core._loops, core._loops_wind, core._loops_second_order, core.kernel, core.errors)
        core   (linecheck.core.*, linecheck.reference)
        analysis (linecheck.analysis.*, linecheck.service, linecheck.validation)
        io     (linecheck.io.*)
@@ -43,7 +43,8 @@ MAX_LONG_FUNCTIONS = 10
 
 #: (layer name, rank, module prefixes); a module takes the layer of its longest matching prefix
 LAYERS = [
-    ("kernel", 0, ("linecheck.core._loops", "linecheck.core.kernel", "linecheck.core.errors")),
+    ("kernel", 0, ("linecheck.core._loops", "linecheck.core._loops_wind", "linecheck.core._loops_second_order",
+                 "linecheck.core.kernel", "linecheck.core.errors")),
     ("core", 1, ("linecheck.core", "linecheck.reference")),
     ("analysis", 2, ("linecheck.analysis", "linecheck.service", "linecheck.validation")),
     ("io", 3, ("linecheck.io",)),

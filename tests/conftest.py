@@ -18,7 +18,7 @@ def cases_dir() -> Path:
     return CASES
 
 
-# --------------------------------------------------------------------------- result schema (issue 18)
+# --------------------------------------------------------------------------- result schema
 # Every run-result document the suite produces (RunDocument.to_json: `run --json`, batch, the TUI,
 # Excel inputs) and every result JSON a test writes under tmp_path is validated against
 # docs/results.schema.json.

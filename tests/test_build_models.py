@@ -1,4 +1,4 @@
-"""Issue 20: the mean-state models of a downburst built in one vectorised pass.
+"""The mean-state models of a downburst built in one vectorised pass.
 
 :func:`build_models` must give, for every mean state, exactly (bit for bit) the model that
 :func:`build_model` gives for that state alone: the paper's six-span downburst (level,
@@ -94,7 +94,7 @@ def stepper_fields_identical(a, b) -> bool:
     ("section_states", "quasi-steady", 0.002),
 ])
 def test_damping_and_steppers_stacked_bit_identical(which, damping, zeta, request):
-    """Step 2 of issue 20: damping matrices, node bases (batched eigh), rotated bands and the
+    """The stacked build's second part: damping matrices, node bases (batched eigh), rotated bands and the
     Newmark operators of all states at once equal those built state by state, bit for bit."""
     import dataclasses
 
@@ -163,7 +163,7 @@ def _dia_csr(ab: np.ndarray):
 
 @pytest.mark.parametrize("n, u", [(2, 1), (6, 5), (7, 5), (183, 5), (30, 0)])
 def test_band_to_sparse_gives_scipys_csr_arrays(n, u):
-    """model.band_to_csr / band_to_sparse (one vectorised gather, issue 20) against scipy's dia -> csr: the same
+    """model.band_to_csr / band_to_sparse (one vectorised gather) against scipy's dia -> csr: the same
     indptr, indices (int32) and data, explicit zeros dropped, columns ascending -- the
     structural-damping remainder's products (CSR order) keep their bits -- and the dense matrix."""
     from linecheck.core.model import band_to_csr, band_to_dense, band_to_sparse

@@ -1,4 +1,4 @@
-"""Design-code conductor wind loads (issue 19): linecheck.core.codes and service.codes_analysis.
+"""Design-code conductor wind loads: linecheck.core.codes and service.codes_analysis.
 
 References: published table values where they could be read (cited per test), closed forms
 derived from each code's own equations (the reference-wind inversion must give back the
@@ -213,7 +213,7 @@ def short_run():
 def test_codes_analysis_ratios_and_verdicts(short_run):
     res = service.codes_analysis(short_run.case, short_run)
     assert [c.code for c in res.checks] == list(C.CODES)
-    # linecheck's value is the design peak (issue 18): the method-of-moments Gumbel median of the
+    # linecheck's value is the design peak (docs/method.md): the method-of-moments Gumbel median of the
     # realizations' peaks, u - beta ln(-ln 0.5), beta = sqrt(6) s / pi, u = mean - 0.5772 beta
     p = short_run.stats.values("peak_dynamic")[:, :, 1]  # (n_real, n_towers)
     beta = np.sqrt(6.0) * p.std(axis=0, ddof=1) / np.pi

@@ -1,4 +1,4 @@
-"""Statistics over realizations (issue 18): moments, Gumbel fits, confidence intervals, the
+"""Statistics over realizations: moments, Gumbel fits, confidence intervals, the
 Cont_R flag, peak windows and --until.
 
 The coverage tests use synthetic Gaussian records with a known spectrum, generated here with

@@ -199,7 +199,7 @@ def test_unrefined_pole_gets_an_exclusion_zone():
 
 
 def test_structural_damping_product_without_dispatch_is_the_same_bits(monkeypatch):
-    """The step loop's C~_off (a1 u + v) calls scipy's CSR kernel directly (issue 20); a run with
+    """The step loop's C~_off (a1 u + v) calls scipy's CSR kernel directly; a run with
     quasi-steady damping (structural damping on: the remainder exists) gives the same bits as
     with the public ``rest @ x`` product (of the scipy matrix built from the stepper's CSR arrays)."""
     from linecheck.core import dynamics
@@ -220,7 +220,7 @@ def test_structural_damping_product_without_dispatch_is_the_same_bits(monkeypatc
                                   "examples/section-12span"])
 def test_record_wind_is_the_mean_wind_and_modulation_bit_for_bit(name):
     """service.record_wind (one evaluation of an equal-span downburst's field at the distinct
-    stations of the span and global nodes, issue 20) against record_mean_wind and
+    stations of the span and global nodes) against record_mean_wind and
     turbulence.modulation, which evaluate it at each set by itself: the same bits (the paper's
     single spans have stations that differ in the last bit between the two sets)."""
     from linecheck.core.wind.turbulence import modulation

@@ -1,4 +1,4 @@
-"""The OpenSeesPy non-linear reference (bench/opensees_reference.py, issue 9) in still air.
+"""The OpenSeesPy non-linear reference (bench/opensees_reference.py) in still air.
 
 Skipped when openseespy is not importable (the ``bench`` extra) or cannot load the system
 BLAS/LAPACK.  The reference's static state under the weight alone (corotational trusses of

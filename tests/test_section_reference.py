@@ -1,4 +1,4 @@
-"""Line sections (issue 17) against an independent reference.
+"""Line sections against an independent reference.
 
 Part A validates the reference itself (it runs whatever linecheck can do):
 ``tests/reference/irvine_inclined.py`` (Irvine 1981 inclined elastic catenary, closed form) against
@@ -6,7 +6,7 @@ the level catenary and an ODE integration; ``tests/reference/section_fe.py`` (a 
 non-linear 3-D truss FE reading the raw TOML/CSV, no linecheck import) against Irvine, against the
 older equal-span FE reference, and for the qualitative section behaviour.
 
-Part B is issue 17's acceptance: linecheck's public outputs (``linecheck static/modes CASE
+Part B is the acceptance check for sections: linecheck's public outputs (``linecheck static/modes CASE
 --json``) against the FE reference on the cases in ``tests/data/sections/``.  Those tests skip
 with the reason while linecheck cannot load a towers-form case.
 """
@@ -229,23 +229,23 @@ def test_still_air_modes_of_refined_mesh_converge():
 
 
 # =============================================================================== B. linecheck
-# Known defect at main 30ecb31 ("Section core"), measured with tests/reference/section_report.py: the
-# synoptic step-1 mean wind (linecheck/core/wind/mean.py, mean_wind) puts the full v_ref on every
+# Marker for the defect this reference found in the first section core (measured with
+# tests/reference/section_report.py): a synoptic step-1 mean wind that puts the full v_ref on every
 # span's normal, ignoring the wind direction (V_n = V cos(d + h_i)) and the profile
-# V(z) = v_ref (z_agl/z_ref)^alpha: 17-23 % off (39 % on the 12-span example); with direction and
-# profile removed from the reference the sections agree to 0.004 %.  strict: an XPASS fails, so the
-# marker must go when the wind is fixed.
+# V(z) = v_ref (z_agl/z_ref)^alpha, was 17-23 % off (39 % on the 12-span example); with direction
+# and profile removed from the reference the sections agreed to 0.004 %.  No test carries it now
+# that the mean wind has both; strict: an XPASS fails.
 WIND_DEFECT = pytest.mark.xfail(strict=True, reason="linecheck's synoptic mean wind ignores wind.direction and "
-                                "wind.profile_exponent (issue 17; docs/validation.md 'Independent section reference')")
+                                "wind.profile_exponent (docs/validation.md 'Independent section reference')")
 STATIC_CASES = ["unequal-still", "unequal-wind", "inclined-still", "inclined-wind", "angles-still", "angles-wind"]
-TOL_SECTION = 0.005  # issue 17: 0.5 % of the largest reaction component at that tower
-TOL_IRVINE = 0.001  # issue 17: 0.1 %
-TOL_MODES = 0.02  # issue 17: 2 %
+TOL_SECTION = 0.005  # acceptance: 0.5 % of the largest reaction component at that tower
+TOL_IRVINE = 0.001  # acceptance: 0.1 %
+TOL_MODES = 0.02  # acceptance: 2 %
 
 
 def _linecheck_json(command: str, stem: str, tmp_path: Path, *extra: str) -> dict:
     """Run ``linecheck <command> CASE --json OUT`` in process; skip if linecheck cannot load a
-    towers-form case yet (the issue 17 core has not landed)."""
+    towers-form case (a build without section support)."""
     from typer.testing import CliRunner
 
     from linecheck.cli.app import app
@@ -256,7 +256,7 @@ def _linecheck_json(command: str, stem: str, tmp_path: Path, *extra: str) -> dic
     try:
         load_case(case)
     except CaseError as exc:
-        pytest.skip(f"linecheck cannot load a towers-form section case yet (issue 17 core): {exc}")
+        pytest.skip(f"linecheck cannot load a towers-form section case: {exc}")
     out = tmp_path / f"{stem}.{command}.json"
     r = CliRunner(env={"COLUMNS": "250"}).invoke(app, [command, str(case), "--json", str(out), *extra])
     assert r.exit_code == 0, r.output
@@ -266,7 +266,7 @@ def _linecheck_json(command: str, stem: str, tmp_path: Path, *extra: str) -> dic
 def _lc_reactions(doc: dict) -> tuple[np.ndarray, np.ndarray]:
     """(tower-frame, global) reactions [N] from a static JSON, shape (n_towers, 3) each."""
     missing = [t.get("index") for t in doc["towers"] if not isinstance(t.get("global"), dict)]
-    assert not missing, f'static JSON towers {missing} lack the "global" reactions block (issue 17 contract)'
+    assert not missing, f'static JSON towers {missing} lack the "global" reactions block (docs/method.md, "Line sections")'
     tw = np.array([[t["Rx"], t["Ry"], t["Rz"]] for t in doc["towers"]], dtype=float)
     gl = np.array([[t["global"]["Rx"], t["global"]["Ry"], t["global"]["Rz"]] for t in doc["towers"]], dtype=float)
     return tw, gl
@@ -284,7 +284,7 @@ def _table(name: str, lc: np.ndarray, ref: np.ndarray) -> str:
 @pytest.mark.parametrize("stem", STATIC_CASES)
 def test_static_reactions_match_reference(stem, tmp_path):
     """Every tower, every component, tower frame and global frame: |R_lc - R_ref| <= 0.5 % of the
-    largest reaction component at that tower (issue 17 acceptance).  The reference mesh error
+    largest reaction component at that tower (the acceptance check).  The reference mesh error
     (~3e-5) is negligible against the tolerance."""
     doc = _linecheck_json("static", stem, tmp_path)
     sol = _ref(stem)
@@ -358,7 +358,7 @@ def test_shipped_section_examples_match_reference(example, still, tmp_path):
     """The shipped cases/examples/section-*.toml (real-looking sections with angle towers) under
     the same 0.5 % acceptance, tower frame and global."""
     if example is None:
-        pytest.skip("no cases/examples/section-*.toml shipped yet (issue 17)")
+        pytest.skip("no cases/examples/section-*.toml shipped")
     case = _variant(example, tmp_path, still)
     from linecheck.core.case import load_case
     from linecheck.core.errors import CaseError
@@ -366,7 +366,7 @@ def test_shipped_section_examples_match_reference(example, still, tmp_path):
     try:
         load_case(case)
     except CaseError as exc:
-        pytest.skip(f"linecheck cannot load a towers-form section case yet (issue 17 core): {exc}")
+        pytest.skip(f"linecheck cannot load a towers-form section case: {exc}")
     from typer.testing import CliRunner
 
     from linecheck.cli.app import app

@@ -1,4 +1,4 @@
-"""Wind on real line sections (issue 17): direction, power-law profile, node heights, Markov
+"""Wind on real line sections: direction, power-law profile, node heights, Markov
 coherence on unequal spacing, downbursts placed in the tower-of-interest frame, and the
 paper's equal-span form unchanged bit for bit.
 
@@ -38,7 +38,7 @@ def _towers() -> list[dict]:
 
 
 def _headings_deg() -> np.ndarray:
-    """h_i = sum of the angles of towers 1..i (issue 17), from the CSV."""
+    """h_i = sum of the angles of towers 1..i (docs/method.md, "Line sections"), from the CSV."""
     ang = np.array([float(t["angle"]) for t in _towers()])
     return np.cumsum(ang[:-1])
 
@@ -66,7 +66,7 @@ def test_synoptic_normal_is_profile_times_cos_d_plus_h_per_span():
     np.testing.assert_array_equal(h, [0, 0, 0, 0, 18, 18, 18, 18, 14, 14, 14, 14])
     z = s.node_height[_span_nodes(s)]
     # the span ends are the clamps: their heights above ground are the CSV's plus the still-air
-    # lift of a swung insulator (angle towers; issue 17: heights from the still-air shape)
+    # lift of a swung insulator (angle towers; the profile's heights come from the still-air shape)
     from linecheck.core.static import still_air_state
 
     hc = np.array([float(t["height"]) for t in _towers()]) + still_air_state(s).displacement[:, 2]

@@ -1,6 +1,6 @@
 """Closed-form elastic catenary of an inclined span (Irvine 1981, "Cable Structures", ch. 2,
 "the elastic catenary" with supports at different levels) -- an independent reference for the
-section tests (issue 17).  Written from the equilibrium of a cable element, shares no code with
+section tests.  Written from the equilibrium of a cable element, shares no code with
 linecheck.
 
 Frame: the span's vertical plane, x horizontal from support A toward support B, z UP;

@@ -1,7 +1,7 @@
-"""Independent non-linear 3-D finite-element reference for a line SECTION (issue 17 acceptance).
+"""Independent non-linear 3-D finite-element reference for a line SECTION (the acceptance check for sections).
 
 Self-contained: it reads the case's RAW inputs (the TOML with :mod:`tomllib`, a towers CSV with
-:mod:`csv`) and implements the section model of docs/method.md / issue 17 from its definitions,
+:mod:`csv`) and implements the section model of docs/method.md ("Line sections") from its definitions,
 sharing no code with ``linecheck`` (it imports nothing from it).  The only other helper it uses
 is the closed-form inclined elastic catenary (Irvine 1981) in ``irvine_inclined.py``.
 

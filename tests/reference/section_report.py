@@ -1,9 +1,9 @@
-"""Print the issue 17 acceptance numbers as Markdown: linecheck's public outputs against the
+"""Print the sections' acceptance numbers as Markdown: linecheck's public outputs against the
 independent section reference (``python -m tests.reference.section_report`` from the repository root).
 
 Runs ``linecheck static CASE --json`` / ``linecheck modes CASE --json`` in process on every case of
 tests/data/sections/ and prints, per tower and component, linecheck, the reference and the
-difference relative to the largest reference component at that tower (the issue's measure).
+difference relative to the largest reference component at that tower (the acceptance measure).
 """
 
 from __future__ import annotations

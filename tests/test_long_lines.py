@@ -1,4 +1,4 @@
-"""Long lines (issue 20): the frequency-domain check and the burn-in on windows around the tower
+"""Long lines: the frequency-domain check and the burn-in on windows around the tower
 of interest, the O(n) reactions of steps 2-3, and the sparse lowest mode.
 
 References: the whole-line check (the exact estimate of the same model, computed without

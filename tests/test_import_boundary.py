@@ -17,6 +17,7 @@ CORE_MODULES = [
     "linecheck.core.case_geometry",
     "linecheck.core.case_load",
     "linecheck.core.errors",
+    "linecheck.core.names",
     "linecheck.core.system",
     "linecheck.core.static",
     "linecheck.core.model",
@@ -43,6 +44,9 @@ CORE_MODULES = [
     "linecheck.io.jsonout",
     "linecheck.io.display",
     "linecheck.io.document",
+    "linecheck.io.stat_table",
+    "linecheck.io.result_blocks",
+    "linecheck.io.result_schema",
     "linecheck.io.section",
     "linecheck.io.provenance",
 ]

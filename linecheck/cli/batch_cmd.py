@@ -23,7 +23,8 @@ from ..core.errors import CaseError, printable
 from ..core.extremes import (
     CONT_R_THRESHOLD as CONT_R_FLAG,  # Cont_R flag, paper Sect. 5 (one definition)
 )
-from ..io.display import STAT_ROWS
+from ..core.names import REACTIONS
+from ..io.display import STAT_ROWS, kn, kn_text
 from ..io.document import RunDocument, SanityCheckRow
 from .common import CaseArg, app, console, err_console, error_line, handle_errors, path_value, read_case
 from .export_cmd import (
@@ -267,7 +268,6 @@ def _kn(doc: RunDocument | None, reaction: str, stat: str, fmt: str = "{:.2f}") 
     return "**" if v is None else fmt.format(v * STAT_ROWS[stat].scale)
 
 
-REACTION_NAMES = ("Rx", "Ry", "Rz")
 QUANTITY_TEXT = {"rms_background": "background r.m.s.", "rms_fluctuating": "fluctuating r.m.s."}
 
 
@@ -276,7 +276,7 @@ def cont_r_flags(doc: RunDocument | None, state: str = "recommended") -> list[st
     of Cont_R lies above :data:`CONT_R_FLAG`; "inconclusive": it straddles it; issue 18)."""
     if doc is None:
         return []
-    return [r for r in REACTION_NAMES if doc.reactions[r].dynamic_analysis == state]
+    return [r for r in REACTIONS if doc.reactions[r].dynamic_analysis == state]
 
 
 def sanity_failures(doc: RunDocument | None) -> list[SanityCheckRow]:
@@ -287,12 +287,9 @@ def sanity_failures(doc: RunDocument | None) -> list[SanityCheckRow]:
 
 
 def _sanity_text(item: SanityCheckRow) -> str:
-    def kn(v: Any) -> str:
-        return "?" if v is None else f"{v / 1e3:.3f}"
-
     return (f"{item.reaction} {QUANTITY_TEXT.get(item.quantity, item.quantity)} "
-            f"{kn(item.time_domain)} vs {kn(item.frequency_domain)} kN "
-            f"(allowed difference {kn(item.allowed_difference)})")
+            f"{kn_text(item.time_domain, '?')} vs {kn_text(item.frequency_domain, '?')} kN "
+            f"(allowed difference {kn_text(item.allowed_difference, '?')})")
 
 
 def _flag_names(doc: RunDocument | None, reactions: list[str], columns: dict[str, str]) -> str:
@@ -474,7 +471,7 @@ def models_scan_table(results: list[Any]) -> Table:
     for res in results:
         for c in res.criticals(("Rx", "Ry")):
             t.add_row(res.model or "", c.reaction, f"{c.distance:.0f}", f"{c.distance_over_dj:.2f}", f"{c.angle:g}",
-                      f"{c.jet_diameter:.0f}", f"{c.value / 1e3:.3f}", f"{c.time:.1f}")
+                      f"{c.jet_diameter:.0f}", f"{kn(c.value):.3f}", f"{c.time:.1f}")
     return t
 
 
@@ -487,7 +484,7 @@ def scan_table(result: Any) -> Table:
     for c in result.criticals(("Rx", "Ry")):
         name, ratio, theta = PAPER_CRITICAL[c.reaction]
         t.add_row(c.reaction, f"{c.distance:.0f}", f"{c.distance_over_dj:.2f}", f"{c.angle:g}", f"{c.jet_diameter:.0f}",
-                  f"{c.value / 1e3:.3f}", f"{c.time:.1f}", f"{c.v_ref:.1f}", f"{name}: R = {ratio:g} D_j, Θ = {theta:g}°")
+                  f"{kn(c.value):.3f}", f"{c.time:.1f}", f"{c.v_ref:.1f}", f"{name}: R = {ratio:g} D_j, Θ = {theta:g}°")
     return t
 
 
@@ -508,7 +505,7 @@ def peak_scan_table(result: Any) -> Table:
             same = "yes" if (cm is not None and cp is not None and cm.index == cp.index) else "no"
             label = "expected peak" if by == "peak" else "max |mean|"
             t.add_row(r, label, f"{c.distance:.0f}", f"{c.distance_over_dj:.2f}", f"{c.angle:g}", f"{c.jet_diameter:.0f}",
-                      f"{c.value / 1e3:.3f}", f"{c.v_ref:.1f}", same)
+                      f"{kn(c.value):.3f}", f"{c.v_ref:.1f}", same)
     return t
 
 
@@ -536,7 +533,7 @@ def dynamic_table(report: Any, result: Any = None, v_ref: float | None = None) -
         scan = ()
         if groups:
             crits = groups[k][1] if k < len(groups) else []
-            scan = (", ".join(f"{c.reaction} {abs(c.value) / 1e3:.3f}" for c in crits),
+            scan = (", ".join(f"{c.reaction} {kn(abs(c.value)):.3f}" for c in crits),
                     ", ".join(sorted({f"{c.v_ref:.1f}" for c in crits})))
         vr = "" if d is None or d.v_ref is None else f"{d.v_ref:g}"
         t.add_row(escape(o.name), o.status if not o.error else escape(f"failed: {o.error}"), *scan,

@@ -8,6 +8,7 @@ import typer
 from rich.table import Table
 
 from ..io.atomic import check_target
+from ..io.display import kn_text
 from ..io.document import CodeCheckRecord
 from ..io.outputs import case_inputs, check_outputs
 from .common import CaseArg, JsonOpt, app, console, handle_errors, read_case
@@ -20,14 +21,11 @@ def codes_table(codes: dict[str, CodeCheckRecord], title: str) -> Table:
     for col in ("code", "verified", "tower", "code load kN", "linecheck peak kN", "ratio", "verdict"):
         t.add_column(col, justify="left" if col in ("code", "verdict") else "right")
 
-    def kn(x):
-        return "-" if x is None else f"{x / 1e3:.3f}"
-
     for name, block in codes.items():
         for k, tower in enumerate(block.towers):
             ry = tower.reactions["Ry"]
             t.add_row(name if k == 0 else "", ("yes" if block.verified else "no") if k == 0 else "",
-                      str(tower.index), kn(ry.code_load), kn(ry.linecheck_peak),
+                      str(tower.index), kn_text(ry.code_load), kn_text(ry.linecheck_peak),
                       "-" if ry.ratio is None else f"{ry.ratio:.3f}", ry.verdict)
     return t
 

@@ -7,7 +7,9 @@ from rich.markup import escape
 from rich.table import Table
 
 from ..core.errors import CaseError
+from ..core.names import REACTIONS
 from ..io.atomic import check_target
+from ..io.display import kn
 from ..io.outputs import case_inputs, check_outputs
 from .common import CaseArg, CasesArg, JsonOpt, app, console, error_line, handle_errors, read_case
 from .limits import warn as limits_warn
@@ -61,7 +63,7 @@ def static_table(doc: dict, name: str) -> Table:
     section = "name" in towers[0]
     table = Table(title=f"{name}: step-1 mean reactions (kN), each tower in its own frame", title_justify="left")
     names = ("name", "station (m)", "heading (deg)") if section else ()
-    for col in ("tower", *names, "support", "Rx", "Ry", "Rz", "Rx wind", "Ry wind", "Rz wind"):
+    for col in ("tower", *names, "support", *REACTIONS, *(f"{r} wind" for r in REACTIONS)):
         table.add_column(col, justify="left" if col == "name" else "right")
     toi = doc["tower_of_interest"]
     for t in towers:
@@ -70,7 +72,7 @@ def static_table(doc: dict, name: str) -> Table:
         ident = (escape(t["name"]), f"{t['station']:g}", f"{t['heading']:.1f}") if section else ()
         table.add_row(
             f"{t['index']}{' *' if t['index'] == toi else ''}", *ident, t["support"],
-            *(f"{_at(t[c], k) / 1e3:.3f}" for c in ("Rx", "Ry", "Rz", "Rx_wind", "Ry_wind", "Rz_wind")),
+            *(f"{kn(_at(t[c], k)):.3f}" for c in (*REACTIONS, *(f"{r}_wind" for r in REACTIONS))),
         )
     return table
 
@@ -96,11 +98,11 @@ def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
                   "reactions (conductor weight included), \"wind\" their wind-induced part (still air subtracted); "
                   f"{escape(tower_frame_caption(straight=res.system.straight_in_plan))}.[/]", highlight=False)
     series = case.wind.type == "downburst"
-    tens = ", ".join(f"{h / 1e3:.2f}" for h in (m.tension.max(axis=0) if series else m.tension[0]))
+    tens = ", ".join(f"{kn(h):.2f}" for h in (m.tension.max(axis=0) if series else m.tension[0]))
     console.print(f"span tensions H (kN{', largest over the event' if series else ''}): {tens}   "
-                  f"still air: {m.still_air.tension[0] / 1e3:.2f}   "
-                  + (f"H0 at clipping-in: {res.system.tension_nominal / 1e3:.2f}" if res.system.is_section
-                     else f"nominal T0: {res.system.tension_nominal / 1e3:.2f}"))
+                  f"still air: {kn(m.still_air.tension[0]):.2f}   "
+                  + (f"H0 at clipping-in: {kn(res.system.tension_nominal):.2f}" if res.system.is_section
+                     else f"nominal T0: {kn(res.system.tension_nominal):.2f}"))
     if case.wind.type == "downburst":
         console.print(f"[dim]{m.time.size} mean states over t = {m.time[0]:.0f} to {m.time[-1]:.0f} s; "
                       "rows show the instant of peak wind-induced Ry at each tower.[/]")

@@ -10,7 +10,7 @@ from rich.table import Table
 
 from ..core.case import Case
 from ..core.extremes import CONT_R_THRESHOLD as CONT_R_FLAG  # Cont_R flag, paper Sect. 5 (one definition)
-from ..core.results import REACTIONS
+from ..core.names import REACTIONS
 from ..io.atomic import check_target
 from ..io.display import STAT_ROWS, SUMMARY_STATS, number_text, stat_text
 from ..io.document import RunDocument, StatDef

@@ -7,6 +7,7 @@ from typing import Any
 from rich.table import Table
 
 from ..io.atomic import check_target
+from ..io.display import kn
 from ..io.outputs import case_inputs, check_outputs
 from .common import CaseArg, JsonOpt, app, console, handle_errors, read_case
 from .limits import warn as limits_warn
@@ -77,8 +78,8 @@ def print_sanity(doc: Any, *, explained: bool = False) -> None:
     parts = []
     for i in items:
         tag = "" if i.ok else " [bold red]FLAG[/]"
-        parts.append(f"{i.reaction} {i.quantity.replace('rms_', 'rms ')}: time {i.time_domain / 1e3:.3f} "
-                     f"vs freq {i.frequency_domain / 1e3:.3f} kN{tag}")
+        parts.append(f"{i.reaction} {i.quantity.replace('rms_', 'rms ')}: time {kn(i.time_domain):.3f} "
+                     f"vs freq {kn(i.frequency_domain):.3f} kN{tag}")
     head = "[green]sanity check ok[/]" if not bad else (
         f"[bold red]sanity check: {len(bad)} difference(s) larger than sampling error explains[/]")
     console.print(head + ": " + "; ".join(parts), highlight=False)

@@ -12,7 +12,8 @@ from openpyxl.worksheet.worksheet import Worksheet
 
 from ..core.case import SCHEMA, Line
 from ..io.display import flag_state, flag_text
-from ..io.document import STAT_BY_NAME, STAT_TABLE, RunDocument
+from ..io.display import kn as to_kn
+from ..io.document import SPECTRAL_EXACT, STAT_BY_NAME, STAT_TABLE, RunDocument
 from ..io.section import (
     COLUMN_UNITS,
     insulators_known,
@@ -167,7 +168,7 @@ def _section_table(cur: Cursor, doc: RunDocument, line: Line) -> None:
     """The Section block (issue 17): one row per tower, as in the case, plus the span to the next."""
     rows = tower_rows(line)
     src = f", towers from {line.towers_file}" if line.towers_file else ""
-    cur.section(f"Section: {len(rows)} towers, {section_summary(line)}, H0 = {line.tension / 1e3:g} kN{src}")
+    cur.section(f"Section: {len(rows)} towers, {section_summary(line)}, H0 = {to_kn(line.tension):g} kN{src}")
     labels = ["Tower", "station", "ground", "height", "support", "angle", "insulator", "span to next"]
     cur.header(labels)
     keys = ("station", "ground", "height", "support", "angle", "insulator_length", "span")
@@ -369,13 +370,6 @@ def _towers_table(cur: Cursor, doc: RunDocument, section: Line | None = None) ->
     cur.note("* tower of interest; peaks are means over the realizations, wind-induced.")
 
 
-#: Rows of the spectral block's estimate 1: frequency-domain key -> time-domain statistic of the one
-#: table (labels, units and formats from it); None: a frequency-domain quantity only [Hz].
-SPECTRAL_EXACT = {
-    "mean": "mean_max", "rms_background": "rms_background", "rms_resonant": "rms_resonant",
-    "rms_fluctuating": "rms_fluctuating", "peak_quasi_static": "peak_quasi_static", "peak_dynamic": "peak_dynamic",
-    "GF_Dy": "GF_Dy", "GF_QS": "GF_QS", "Cont_R": "Cont_R", "nu_background": None, "nu_fluctuating": None,
-}
 #: Davenport closed-form factors: key -> (unit, format); its GF_*/Cont_R use the statistics table.
 SPECTRAL_DAVENPORT = {
     "background_factor": ("-", "0.000"), "resonant_factor": ("-", "0.000"), "peak_factor": ("-", "0.00"),
@@ -402,7 +396,7 @@ def _spectral(cur: Cursor, doc: RunDocument, sp) -> None:
         w = sp.window
         cur.put(cur.row, 1, f"window: {w['spans']} spans from tower {w['first_tower']}; estimated error", "lc_text")
         cur.put(cur.row, 2, "-", "lc_text")
-        for c, r in enumerate(("Rx", "Ry", "Rz")):
+        for c, r in enumerate(REACTIONS):
             cur.put(cur.row, 3 + c, w["estimated_error"][r], fmt="0.00%")
         cur.row += 1
     cur.row += 1
@@ -410,7 +404,7 @@ def _spectral(cur: Cursor, doc: RunDocument, sp) -> None:
     align(cur.ws.cell(row=cur.row, column=1), horizontal="left")
     cur.row += 1
     cur.header(["Quantity", "Unit", "freq. Rx", "freq. Ry", "freq. Rz", "time Rx", "time Ry", "time Rz"])
-    for key, td in SPECTRAL_EXACT.items():
+    for key, td in SPECTRAL_EXACT:
         st = STAT_BY_NAME[td] if td is not None else None
         cur.put(cur.row, 1, key if td is None or td == key else f"{key} (time: {td})", "lc_text")
         cur.put(cur.row, 2, "Hz" if st is None else st.display_unit, "lc_text")

@@ -12,9 +12,11 @@ from openpyxl.utils import get_column_letter
 from openpyxl.worksheet.hyperlink import Hyperlink
 from openpyxl.worksheet.worksheet import Worksheet
 
+from ..core.names import REACTIONS
+from ..io.display import kn as to_kn
 from ..io.document import StatDef
 
-REACTIONS = ("Rx", "Ry", "Rz")
+__all__ = ["REACTIONS"]  # the reaction names, for the sheets
 #: Reactions of the Summary and Peaks sheets by default: the paper's Table 5 and Fig. 13 (Rz, the
 #: vertical reaction, whose wind-induced part is small beside the conductor weight, is on the case sheets).
 SUMMARY_REACTIONS = ("Rx", "Ry")
@@ -110,7 +112,8 @@ def is_num(v: Any) -> bool:
 
 
 def kn(v: Any) -> Any:
-    return v / 1000.0 if is_num(v) else None
+    """A force [N] as a cell value [kN]; empty (None) unless a finite number."""
+    return to_kn(v) if is_num(v) else None
 
 
 def sheet_name(name: str, taken: set[str]) -> str:

@@ -12,6 +12,7 @@ from openpyxl.chart.title import Title
 from openpyxl.drawing.text import CharacterProperties, Paragraph, ParagraphProperties, RegularTextRun
 from openpyxl.worksheet.worksheet import Worksheet
 
+from ..io.display import kn
 from .cells import clean_text, is_num, set_value
 
 #: Layout of a case sheet: charts to the right of the tables (columns A-H), data outside the print area.
@@ -104,7 +105,7 @@ def case_charts(ws: Worksheet, doc: Any, chart_points: int, contrib_rows: tuple[
             comp = th.series[r]
             m, b, rr = as_array(comp["M"]), as_array(comp["B"]), as_array(comp["R"])
             if m.size == t.size and b.size == t.size and rr.size == t.size:
-                series[r] = {"M": m / 1e3, "M+B": (m + b) / 1e3, "M+B+R": (m + b + rr) / 1e3}
+                series[r] = {"M": kn(m), "M+B": kn(m + b), "M+B+R": kn(m + b + rr)}
         if series:
             full = th.decimated is False
             idx = np.arange(t.size) if full else chart_indices(
@@ -147,7 +148,7 @@ def case_charts(ws: Worksheet, doc: Any, chart_points: int, contrib_rows: tuple[
             _write_column(ws, col, row0, "t (s)", times)
             xcol = col
             col += 1
-            ch = _scatter(f"Running-mean span tension H / T0 (Fig. 7), T0 = {t0 / 1e3:.1f} kN",
+            ch = _scatter(f"Running-mean span tension H / T0 (Fig. 7), T0 = {kn(t0):.1f} kN",
                           "time (s)", "H / T0", "0.00")
             for s, color in zip(spans, ("2E75B6", "C55A11")):
                 side = "left" if s == toi - 1 else "right"

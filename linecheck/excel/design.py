@@ -15,9 +15,8 @@ from openpyxl.worksheet.worksheet import Worksheet
 from ..io.display import flag_text, how_to_read
 from ..io.document import STAT_BY_NAME, RunDocument, StatValue
 from . import template as tpl
-from .cells import KN, Cursor, align, excel_format, is_num, stat_cell
+from .cells import KN, REACTIONS, Cursor, align, excel_format, is_num, kn, stat_cell
 
-REACTIONS_ALL = ("Rx", "Ry", "Rz")
 #: Header and column width (characters) of each column; a 95 % interval is two number cells
 #: (low, high) in the statistic's own format, so a spreadsheet can compute with them.
 HEADERS = (("Case", 16), ("Reaction", 8), ("still air\n(kN)", 9), ("design peak\nwind (kN)", 10),
@@ -58,13 +57,13 @@ def write_design_block(ws: Worksheet, docs: list, top: int, left: int = 1) -> in
     for doc in ok:
         still = doc.still_air.reactions if doc.still_air is not None else {}
         pk_def, tot_def = STAT_BY_NAME["peak_dynamic"], STAT_BY_NAME["peak_dynamic_total"]
-        for r in REACTIONS_ALL:
+        for r in REACTIONS:
             e = doc.reactions[r]
             pk, tot = e[pk_def.name].gumbel, e[tot_def.name].gumbel
             sa = still.get(r)
             vals: list[tuple[Any, str | None]] = [
                 (doc.case, None), (r, None),
-                (sa / 1000.0 if is_num(sa) else None, KN),
+                (kn(sa), KN),
                 (stat_cell(pk_def, pk.design if pk else None), KN),
                 (stat_cell(tot_def, tot.design if tot else None), KN),
                 (pk.ppcc if pk and is_num(pk.ppcc) else None, "0.000"),

@@ -3,7 +3,8 @@
 Forces in kN with 3 decimals, Cont_* in % with 1 decimal, ratios with 3 decimals,
 ``± std`` over realizations when there are several, ``**`` where a gust factor is
 undefined (mean zero by symmetry).  Names, labels, units and formats come from the one
-statistics table, :data:`linecheck.io.document.STAT_TABLE`.
+statistics table, :data:`linecheck.io.stat_table.STAT_TABLE`.  Forces are converted to kN here
+(:func:`kn`), the one place for the display unit of a force.
 """
 
 from __future__ import annotations
@@ -11,6 +12,19 @@ from __future__ import annotations
 from typing import Any
 
 from .document import STAT_BY_NAME, STAT_TABLE, StatDef, StatValue
+
+#: Forces are computed in N and shown in kN: a force [N] / N_PER_KN is the force [kN].
+N_PER_KN = 1e3
+
+
+def kn(force: Any) -> Any:
+    """A force [N] (a number or an array) in [kN]."""
+    return force / N_PER_KN
+
+
+def kn_text(force: float | None, missing: str = "-", fmt: str = "{:.3f}") -> str:
+    """A force [N] as text in [kN] (3 decimals unless ``fmt``); ``missing`` when None."""
+    return missing if force is None else fmt.format(kn(force))
 
 #: The statistics of the summary tables (console, TUI, Excel Summary), in table order.
 SUMMARY_STATS: tuple[StatDef, ...] = tuple(s for s in STAT_TABLE if s.summary)

@@ -12,7 +12,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..core.names import REACTIONS
 from .atomic import write_text_atomic
+from .stat_table import SPECTRAL_EXACT
 
 if TYPE_CHECKING:  # annotations only: importing the service loads the numerical core
     from ..service import StaticResult
@@ -192,7 +194,6 @@ def run_document(res: Any, *, full_histories: bool = False, max_points: int = 20
     the tower of interest, thinned to about ``max_points`` samples keeping every block's
     extremes unless ``full_histories``.
     """
-    from ..core.results import REACTIONS
     from .document import BurnInRecord, SanityCheckRow, StaticSeries, StillAir, TimeHistories, document_of
     from .provenance import provenance
 
@@ -295,11 +296,8 @@ def model_reactions(results: dict[str, Any]) -> dict[str, Any]:
 
 def spectral_to_dict(sp: Any) -> dict[str, Any]:
     """JSON block of a :class:`~linecheck.service.SpectralResult` (reactions at the tower of interest)."""
-    from ..core.results import REACTIONS
-
     ex = sp.exact
-    keys = ("mean", "rms_background", "rms_resonant", "rms_fluctuating", "peak_quasi_static", "peak_dynamic",
-            "GF_Dy", "GF_QS", "Cont_R", "nu_background", "nu_fluctuating")
+    keys = [k for k, _ in SPECTRAL_EXACT]
     exact = {r: {k: _num(getattr(ex, k)[c]) for k in keys} for c, r in enumerate(REACTIONS)}
     d = sp.davenport
     dav = {

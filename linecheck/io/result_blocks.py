@@ -243,7 +243,7 @@ class Spectral(_Block):
         err = w["estimated_error"]
         return (f"long line: estimate 1 on the {w['spans']}-span window from tower {w['first_tower']} "
                 f"(windows tried: {', '.join(str(x) for x in w['windows'])} spans); estimated error "
-                + ", ".join(f"{r} {100 * (err[r] or 0.0):.2f} %" for r in ("Rx", "Ry", "Rz")))
+                + ", ".join(f"{r} {100 * (err[r] or 0.0):.2f} %" for r in REACTIONS))
 
     @classmethod
     def from_json(cls, d: dict[str, Any]) -> Spectral:

@@ -12,6 +12,8 @@ from typing import Any
 
 import numpy as np
 
+from ..core.names import REACTIONS
+from ..io.display import kn
 from ..io.document import RunDocument
 
 REACTION_NAMES = {"Rx": "longitudinal Rx", "Ry": "transverse Ry", "Rz": "vertical Rz"}
@@ -53,7 +55,7 @@ def reaction_history(doc: RunDocument, reaction: str) -> Figure:
     blk = th.series[reaction]
 
     def arr(key: str) -> np.ndarray:
-        return np.array([np.nan if v is None else v for v in blk[key]], dtype=float) / 1e3
+        return kn(np.array([np.nan if v is None else v for v in blk[key]], dtype=float))
 
     M, B, R = arr("M"), arr("B"), arr("R")
     return Figure(
@@ -91,7 +93,7 @@ def mean_tension(result: Any) -> Figure:
     notes = () if varies else ("synoptic wind: one mean state for the whole record",)
     return Figure(
         title=f"{result.case.name}: running-mean tension of span {n + 1} / T0 "
-              f"(nominal still-air T0 = {t0 / 1e3:.2f} kN)",
+              f"(nominal still-air T0 = {kn(t0):.2f} kN)",
         xlabel="time (s)", ylabel="T / T0", series=(Series(f"span {n + 1}", t, y),), notes=notes,
     )
 
@@ -137,7 +139,7 @@ def contributions(docs: list[tuple[str, RunDocument]]) -> Figure:
     cats: list[str] = []
     parts: dict[str, list[float]] = {"Cont_M": [], "Cont_BG": [], "Cont_R": []}
     for label, doc in docs:
-        for r in ("Rx", "Ry", "Rz"):
+        for r in REACTIONS:
             vals = {k: doc.reactions[r][k].mean for k in parts}
             for k in parts:
                 parts[k].append(0.0 if vals[k] is None else 100.0 * vals[k])

@@ -14,6 +14,7 @@ import tomllib
 from typing import Any
 
 from ..core.case import SCHEMA, Case, FieldSpec
+from ..core.names import REACTIONS
 from ..io.display import (  # noqa: F401  (shared with the CLI)
     STAT_ROWS,
     SUMMARY_STATS,
@@ -24,8 +25,7 @@ from ..io.display import (  # noqa: F401  (shared with the CLI)
     stat_text,
 )
 from ..io.document import RunDocument, StatDef
-
-REACTIONS = ("Rx", "Ry", "Rz")
+from ..io.stat_table import SPECTRAL_EXACT
 
 
 def summary_rows(doc: RunDocument) -> list[tuple[str, str, str, str, str]]:
@@ -259,21 +259,6 @@ def number_text(v: Any) -> str:
     return f"{v:.4g}" if abs(v) < 1e4 else f"{v:.6g}"
 
 
-#: Rows of the spectral comparison: frequency-domain key -> time-domain statistic (its label,
-#: unit and format from the one statistics table).
-SPECTRAL_STATS: tuple[tuple[str, str], ...] = (
-    ("mean", "mean_max"),
-    ("rms_background", "rms_background"),
-    ("rms_resonant", "rms_resonant"),
-    ("rms_fluctuating", "rms_fluctuating"),
-    ("peak_quasi_static", "peak_quasi_static"),
-    ("peak_dynamic", "peak_dynamic"),
-    ("GF_Dy", "GF_Dy"),
-    ("GF_QS", "GF_QS"),
-    ("Cont_R", "Cont_R"),
-)
-
-
 def _scaled(v: Any, st: StatDef) -> str:
     if v is None or isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
         return "**"
@@ -290,7 +275,9 @@ def spectral_compare_rows(doc: RunDocument) -> list[tuple[str, ...]]:
         return []
     exact = doc.spectral.exact
     rows = []
-    for fkey, tkey in SPECTRAL_STATS:
+    for fkey, tkey in SPECTRAL_EXACT:
+        if tkey is None:  # a frequency-domain quantity only
+            continue
         st = STAT_ROWS[tkey]
         row = [st.label if fkey != "mean" else "mean", st.display_unit]
         for r in REACTIONS:

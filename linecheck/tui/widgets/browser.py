@@ -11,6 +11,7 @@ from textual.widgets import Static, Tree
 
 from ...core.case import load_case
 from ...core.errors import LinecheckError
+from ...io.display import kn
 from ...io.section import line_summary
 from ..catalog import CaseEntry, Catalog, Folder, shown_path
 from ..messages import OpenCaseRequested
@@ -41,10 +42,10 @@ def preview(path: Path) -> Text:
     out.append("line      ", style="bold")
     out.append(f"{line_summary(ln)}, tower of interest {ln.tower_of_interest}\n")
     out.append("          ", style="bold")
-    if ln.is_section:  # issue 17: the towers, not one support word per tower
+    if ln.is_section:  # a section: the towers, not one support word per tower
         src = f" from {ln.towers_file}" if ln.towers_file else ""
         turns = [f"{t.name} {t.angle:+g} deg" for t in ln.towers if t.angle]
-        out.append(f"{ln.n_towers} towers{src}, H0 {ln.tension / 1e3:g} kN"
+        out.append(f"{ln.n_towers} towers{src}, H0 {kn(ln.tension):g} kN"
                    + (f", angles {', '.join(turns)}" if turns else "") + "\n")
     else:
         out.append(f"supports {', '.join(ln.supports)}\n")

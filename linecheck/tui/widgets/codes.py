@@ -12,6 +12,7 @@ from textual.containers import Vertical
 from textual.widgets import DataTable, Static
 
 from ...core.codes import CODES_PEAK
+from ...io.display import kn_text
 from ...io.document import CodeCheckRecord, RunDocument
 
 HELP = "No result yet. Run a case (r): the four design codes' conductor wind loads appear here beside its peaks."
@@ -21,18 +22,15 @@ PEAK_NOTE = (f"linecheck peak: {CODES_PEAK}; ratio = peak / code load. "
 
 def codes_rows(codes: dict[str, CodeCheckRecord], names: dict[int, str] | None = None) -> list[tuple[str, ...]]:
     """Table rows (text, kN) of a typed ``codes`` block; ``names``: tower labels by 1-based index
-    (a section's ``towers[].name``, issue 17), shown as "7 T7"."""
-    def kn(x):
-        return "-" if x is None else f"{x / 1e3:.3f}"
-
+    (a section's ``towers[].name``), shown as "7 T7"."""
     names = names or {}
     rows = []
     for name, block in codes.items():
         for t in block.towers:
             label = f"{t.index} {names[t.index]}" if t.index in names else str(t.index)
             for r, v in t.reactions.items():
-                rows.append((name, "yes" if block.verified else "no", label, r, kn(v.code_load),
-                             kn(v.linecheck_peak), "-" if v.ratio is None else f"{v.ratio:.3f}", v.verdict))
+                rows.append((name, "yes" if block.verified else "no", label, r, kn_text(v.code_load),
+                             kn_text(v.linecheck_peak), "-" if v.ratio is None else f"{v.ratio:.3f}", v.verdict))
     return rows
 
 

@@ -9,7 +9,7 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.widgets import DataTable, RadioButton, RadioSet, Static, TabbedContent, TabPane
 
-from ...io.display import STAT_ROWS, doc_frame_caption, number_text
+from ...io.display import STAT_ROWS, doc_frame_caption, kn_text, number_text
 from ...io.document import RunDocument
 from .. import figures
 from ..formatting import (
@@ -84,7 +84,7 @@ class ResultsView(Vertical):
 
     def on_mount(self) -> None:
         t = self.query_one("#summary-table", DataTable)
-        for c in ("statistic", "unit", "Rx", "Ry", "Rz"):
+        for c in ("statistic", "unit", *REACTIONS):
             t.add_column(c, key=c)
         self.query_one("#sanity-table", DataTable).add_columns(
             "reaction", "sanity check", "time domain ± std", "frequency domain", "allowed difference", "verdict")
@@ -156,7 +156,7 @@ class ResultsView(Vertical):
             notes.append("\n" + models_text(doc))
         sa = doc.still_air.reactions if doc.still_air is not None else {}
         if sa:
-            notes.append("\nstill air: " + ", ".join(f"{r} {v / 1e3:.3f} kN" for r, v in sa.items() if v is not None),
+            notes.append("\nstill air: " + ", ".join(f"{r} {kn_text(v)} kN" for r, v in sa.items() if v is not None),
                          style="dim")
         self.query_one("#summary-notes", Static).update(notes)
 

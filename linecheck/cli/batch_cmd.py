@@ -273,7 +273,7 @@ QUANTITY_TEXT = {"rms_background": "background r.m.s.", "rms_fluctuating": "fluc
 
 def cont_r_flags(doc: RunDocument | None, state: str = "recommended") -> list[str]:
     """Reactions whose ``dynamic_analysis`` flag is ``state`` ("recommended": the 95 % interval
-    of Cont_R lies above :data:`CONT_R_FLAG`; "inconclusive": it straddles it; issue 18)."""
+    of Cont_R lies above :data:`CONT_R_FLAG`; "inconclusive": it straddles it)."""
     if doc is None:
         return []
     return [r for r in REACTIONS if doc.reactions[r].dynamic_analysis == state]
@@ -464,7 +464,7 @@ PAPER_CRITICAL = {"Rx": ("Db_x", 1.6, 30.0), "Ry": ("Db_y", 1.2, 0.0)}  # paper 
 
 
 def models_scan_table(results: list[Any]) -> Table:
-    """Critical configuration per downburst model (issue 15)."""
+    """Critical configuration per downburst model."""
     t = Table(title="critical configuration per downburst model", title_justify="left")
     for col in ("model", "reaction", "R m", "R/D_j", "Θ deg", "D_j m", "max |mean| kN", "at t s"):
         t.add_column(col, justify="right" if col not in ("model", "reaction") else "left")
@@ -489,7 +489,7 @@ def scan_table(result: Any) -> Table:
 
 
 def peak_scan_table(result: Any) -> Table:
-    """Critical configurations by the expected dynamic peak beside those by the mean (issue 20)."""
+    """Critical configurations by the expected dynamic peak beside those by the mean."""
     t = Table(title=f"critical configurations by the expected dynamic peak |M + B + R| "
                     f"(mean of {result.dynamic_realizations} realization(s) per position) and by the mean, "
                     "at the scanned storm (V_ref at p): they rank the positions, the design values follow",

@@ -1,4 +1,4 @@
-"""`codes` command: the design codes' conductor wind loads beside linecheck's peaks (issue 19)."""
+"""`codes` command: the design codes' conductor wind loads beside linecheck's peaks."""
 
 from __future__ import annotations
 

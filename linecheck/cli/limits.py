@@ -1,4 +1,4 @@
-"""``--max-memory`` and resource warnings shared by the commands (issue 14, resource guard).
+"""``--max-memory`` and resource warnings shared by the commands (resource guard).
 
 The limit travels in the environment variable ``LINECHECK_MAX_MEMORY`` so that local batch
 workers (spawned processes) inherit it; the estimate itself is

@@ -42,7 +42,7 @@ SeedOpt = Annotated[int | None, typer.Option("--seed", help="Random seed (overri
 
 
 def override(case: Case, realizations: int | None, seed: int | None) -> Case:
-    """The case with CLI overrides of [analysis] applied, validated like the file (issue 14)."""
+    """The case with CLI overrides of [analysis] applied, validated like the file."""
     from ..core.case import with_options
 
     return with_options(case, {"--realizations": ("analysis.realizations", realizations),
@@ -96,7 +96,7 @@ def results_table(doc: RunDocument) -> Table:
 
 def cont_r_flagged(doc: RunDocument, reaction: str) -> bool:
     """Whether ``reaction`` (Rx, Ry only) has the flag "recommended": the 95 % interval of its
-    Cont_R lies above :data:`CONT_R_FLAG` (issue 18, docs/method.md)."""
+    Cont_R lies above :data:`CONT_R_FLAG` (docs/method.md)."""
     return reaction in FLAGGED_REACTIONS and doc.reactions[reaction].dynamic_analysis == "recommended"
 
 
@@ -112,7 +112,7 @@ def print_legend(doc: RunDocument) -> None:
 
 
 def burn_in_note(doc: RunDocument) -> str | None:
-    """One line on a synoptic record that is not stationary: what it means and what to do (issue 10, 14).
+    """One line on a synoptic record that is not stationary: what it means and what to do.
 
     ``None`` when the burn-in is sufficient (or the run is not synoptic).
     """
@@ -132,7 +132,7 @@ def burn_in_note(doc: RunDocument) -> str | None:
 
 
 def models_table(doc: RunDocument) -> Table:
-    """Rich table of the model spread (issue 15): one row per model and the envelope."""
+    """Rich table of the model spread: one row per model and the envelope."""
     n = doc.realizations
     keys = ("mean_max", "peak_dynamic", "GF_Dy", "GF_QS", "peak_normalised")
     t = Table(title=f"{doc.case}: downburst model spread at tower {doc.tower_of_interest}", title_justify="left")
@@ -154,7 +154,7 @@ def models_table(doc: RunDocument) -> Table:
 
 
 def print_burn_in(doc: RunDocument) -> None:
-    """Say how much of a synoptic record was discarded, and when it is not enough (issue 10): one line."""
+    """Say how much of a synoptic record was discarded, and when it is not enough: one line."""
     b = doc.burn_in
     if b is None or doc.wind != "synoptic":
         return

@@ -1,4 +1,4 @@
-"""`spectral` command: the frequency-domain check of a synoptic case (issue 5)."""
+"""`spectral` command: the frequency-domain check of a synoptic case."""
 
 from __future__ import annotations
 
@@ -34,7 +34,7 @@ def davenport_line(doc: dict) -> str:
                 f"Cont_R {100 * d['Cont_R']:.1f} % (B {d['background_factor']:.3f}, R {d['resonant_factor']:.3f}, "
                 f"g {d['peak_factor']:.2f}, zeta_a {d['zeta_a']:.3f}); {d['note']}; "
                 f"ASCE 74 wire GRF {d['GF_ASCE74']:.3f}. Rx, Rz: not applicable (closed form ignores their influence lines).")
-    # a section of unequal spans (issue 17): no closed form, hence no ASCE 74 wire factor either
+    # a section of unequal spans: no closed form, hence no ASCE 74 wire factor either
     grf = "n/a" if d["GF_ASCE74"] is None else f"{d['GF_ASCE74']:.3f}"
     return f"closed form (Davenport/Castanheta): not shown: {d['note']}. ASCE 74 wire GRF {grf}."
 

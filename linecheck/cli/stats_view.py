@@ -1,4 +1,4 @@
-"""Console views of the issue 18 statistics: design values, intervals, flag states, the
+"""Console views of the run statistics: design values, intervals, flag states, the
 ``--until`` option and the "how to read" notes (shared by ``run`` and ``batch``)."""
 
 from __future__ import annotations

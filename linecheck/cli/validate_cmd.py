@@ -1,4 +1,4 @@
-"""`validate` command: the built-in verification set (issue 5)."""
+"""`validate` command: the built-in verification set."""
 
 from __future__ import annotations
 

@@ -38,7 +38,7 @@ CSV_COLUMNS = (
 
 def _point_p_block(case: Any, s: Any) -> dict[str, Any]:
     """JSON of point p: x (the equal-span form's abscissa; a section's station-like coordinate),
-    the nearest node; on a section (issue 17) also that node's plan position and height in the
+    the nearest node; on a section also that node's plan position and height in the
     global frame (x along the first span, y to its left)."""
     block: dict[str, Any] = {"x": _f(s.point_p), "node": s.node + 1, "node_x": _f(s.node_x)}
     if case.line.is_section:
@@ -142,7 +142,7 @@ def wind(
     from ..io.jsonout import with_provenance, write_json
     from .limits import warn as limits_warn
 
-    service.check_budget(case, "wind", warn=limits_warn)  # resource guard (issue 14)
+    service.check_budget(case, "wind", warn=limits_warn)  # resource guard
     if field_out is not None:
         check_target(field_out, what="NPZ")
     s = point_series(case, realization - 1)

@@ -93,7 +93,7 @@ def write_case(ws: Worksheet, doc: RunDocument, threshold: float, chart_points: 
     # ---- charts (data outside the print area)
     bottom = 2
     charts = case_charts(ws, doc, chart_points, contrib_rows)
-    if section is not None:  # plan and profile first: they describe the sheet's line (issue 17)
+    if section is not None:  # plan and profile first: they describe the sheet's line
         geo, _next = section_charts(ws, section_geometry(section), [r.name for r in tower_rows(section)],
                                     ws.max_column + 2)
         charts = geo + charts
@@ -113,7 +113,7 @@ def _inputs_table(cur: Cursor, doc: RunDocument, params: dict) -> None:
     cur.header(["Key", "Unit", "Value", "", "Description", "", "", ""])
     is_section = _is_section_doc(doc)
     for section, specs in SCHEMA.items():
-        if section == "line.towers":  # one row per tower: the Section block (issue 17)
+        if section == "line.towers":  # one row per tower: the Section block
             continue
         if section == "":
             table = params
@@ -165,7 +165,7 @@ def _is_section_doc(doc: RunDocument) -> bool:
 
 
 def _section_table(cur: Cursor, doc: RunDocument, line: Line) -> None:
-    """The Section block (issue 17): one row per tower, as in the case, plus the span to the next."""
+    """The Section block: one row per tower, as in the case, plus the span to the next."""
     rows = tower_rows(line)
     src = f", towers from {line.towers_file}" if line.towers_file else ""
     cur.section(f"Section: {len(rows)} towers, {section_summary(line)}, H0 = {to_kn(line.tension):g} kN{src}")
@@ -231,7 +231,7 @@ def _still_air_and_step1(cur: Cursor, doc: RunDocument) -> None:
             cur.row += 1
         rows = (("sag S", still.sag, "m", "0.00"),
                 ("nominal tension T0 = W Lx² / 8S", kn(still.tension_nominal), "kN", KN3))
-        if _is_section_doc(doc):  # a section: H0 at clipping-in, the parabolic sag of Eq. 17's L_x (issue 17)
+        if _is_section_doc(doc):  # a section: H0 at clipping-in, the parabolic sag of Eq. 17's L_x
             rows = (("sag W Lx² / 8 H0 (span Lx of Eq. 17)", still.sag, "m", "0.00"),
                     ("tension H0 at clipping-in", kn(still.tension_nominal), "kN", KN3))
         for label, v, unit, fmt in rows:
@@ -307,7 +307,7 @@ def _stats_table(cur: Cursor, doc: RunDocument) -> None:
 
 
 def _models_table(cur: Cursor, doc: RunDocument) -> None:
-    """Downburst model spread (issue 15): each model's realization means and the envelope."""
+    """Downburst model spread: each model's realization means and the envelope."""
     stats = [STAT_BY_NAME[k] for k in ("mean_max", "peak_dynamic", "GF_Dy", "peak_normalised")]
     cur.section(f"Downburst model spread at tower {doc.tower_of_interest} (realization means; "
                 f"this sheet's other tables: model {doc.model or '?'})")
@@ -336,7 +336,7 @@ def _contributions_table(cur: Cursor, doc: RunDocument, threshold: float,
         cur.put(cur.row, 2, "%", "lc_text")
         for k, stat in enumerate(("Cont_M", "Cont_BG", "Cont_R")):
             cur.put(cur.row, 3 + k, stat_cell(STAT_BY_NAME[stat], doc.reactions[r][stat].mean), fmt=PCT)
-        state = flag_state(doc, r, threshold) if r in flagged else None  # issue 18: on the 95 % interval
+        state = flag_state(doc, r, threshold) if r in flagged else None  # on the 95 % interval
         flag = state is not None
         c = cur.put(cur.row, 6, FLAG_NOTE if state == "recommended" else flag_text(state), "lc_text")
         align(c, indent=1)
@@ -392,7 +392,7 @@ def _spectral(cur: Cursor, doc: RunDocument, sp) -> None:
     cur.put(cur.row, 3, sp.band_hz[0], fmt="0.00E+00")
     cur.put(cur.row, 4, sp.band_hz[1], fmt="0.00")
     cur.row += 1
-    if sp.window is not None:  # a long line: estimate 1 on a window around the tower of interest (issue 20)
+    if sp.window is not None:  # a long line: estimate 1 on a window around the tower of interest
         w = sp.window
         cur.put(cur.row, 1, f"window: {w['spans']} spans from tower {w['first_tower']}; estimated error", "lc_text")
         cur.put(cur.row, 2, "-", "lc_text")
@@ -400,6 +400,13 @@ def _spectral(cur: Cursor, doc: RunDocument, sp) -> None:
             cur.put(cur.row, 3 + c, w["estimated_error"][r], fmt="0.00%")
         cur.row += 1
     cur.row += 1
+    _spectral_exact(cur, doc, sp)
+    _spectral_davenport(cur, sp.davenport, sp.not_applicable)
+    _sanity_check(cur, sp.sanity_check or ())
+
+
+def _spectral_exact(cur: Cursor, doc: RunDocument, sp) -> None:
+    """Estimate 1, exact linear random vibration, beside the time-domain statistics [kN, -, %, Hz]."""
     cur.put(cur.row, 1, "Estimate 1: exact linear random vibration (frequency) vs time domain", "lc_label")
     align(cur.ws.cell(row=cur.row, column=1), horizontal="left")
     cur.row += 1
@@ -414,7 +421,10 @@ def _spectral(cur: Cursor, doc: RunDocument, sp) -> None:
             cur.put(cur.row, 3 + k, v if st is None else stat_cell(st, v), fmt=fmt)
             cur.put(cur.row, 6 + k, None if st is None else stat_cell(st, doc.reactions[r][td].mean), fmt=fmt)
         cur.row += 1
-    dav = sp.davenport
+
+
+def _spectral_davenport(cur: Cursor, dav, not_applicable: dict[str, str]) -> None:
+    """Estimate 2, the Davenport closed form, and why it does not apply to the other reactions."""
     cur.row += 1
     cur.put(cur.row, 1, f"Estimate 2: closed form (Davenport/Castanheta), {dav.reaction}", "lc_label")
     align(cur.ws.cell(row=cur.row, column=1), horizontal="left")
@@ -431,9 +441,12 @@ def _spectral(cur: Cursor, doc: RunDocument, sp) -> None:
         cur.put(cur.row, 2, unit, "lc_text")
         cur.put(cur.row, 3, v if is_num(v) else "n/a", "lc_number", fmt)
         cur.row += 1
-    for r, why in sp.not_applicable.items():
+    for r, why in not_applicable.items():
         cur.note(f"closed form, {r}: not applicable ({why})")
-    checks = sp.sanity_check or ()
+
+
+def _sanity_check(cur: Cursor, checks) -> None:
+    """The time-vs-frequency sanity check rows [kN]; FLAG marked."""
     if checks:
         cur.row += 1
         cur.header(["Sanity check", "Unit", "time", "± std", "frequency", "allowed", "result"])

@@ -199,7 +199,7 @@ def _marker_series(ws: Worksheet, xcol: int, ycol: int, row0: int, n: int, color
 
 
 def section_charts(ws: Worksheet, geom: Any, names: list[str], col: int) -> tuple[list, int]:
-    """Plan and profile of a line section (issue 17) from ``geom``
+    """Plan and profile of a line section from ``geom``
     (:class:`~linecheck.io.section.SectionGeometry`); data written from column ``col``.
 
     Plan: the still-air clamp points, y against x (first span along +x).  Profile: clamp

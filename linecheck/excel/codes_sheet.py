@@ -1,4 +1,4 @@
-"""The "Codes" sheet: design-code conductor wind loads beside linecheck's peaks (issue 19).
+"""The "Codes" sheet: design-code conductor wind loads beside linecheck's peaks.
 
 Reads the typed ``codes`` block of each :class:`~linecheck.io.document.RunDocument`;
 it computes nothing itself.

@@ -1,4 +1,4 @@
-"""The "Design values" block of the Summary sheet (issue 18): per case and reaction (R_x, R_y, R_z)
+"""The "Design values" block of the Summary sheet: per case and reaction (R_x, R_y, R_z)
 the Gumbel design peak, the total (still air + wind) design reaction, GF_Dy / GF_QS / Cont_R with
 their 95 % intervals (two number cells, low and high), the Cont_R flag state, and a "how to read"
 block where GF < 1, a negative Cont_BG or a negative Cont_R occurs.  Names, units and meanings come from the one statistics table

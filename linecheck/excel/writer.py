@@ -172,7 +172,7 @@ def validate_doc(doc: Any, source: str) -> RunDocument | FailedRun:
     if "reactions" not in doc and "towers" in doc and "spans" in doc:
         raise CaseError("is a step-1 (static) result: export needs run results (`linecheck run --json`)",
                         file=source)
-    return load_document(doc, source=source)  # schema version and layout (issue 18)
+    return load_document(doc, source=source)  # schema version and layout
 
 
 def load_result_docs(paths: Iterable[str | Path]) -> list[RunDocument | FailedRun]:
@@ -214,7 +214,7 @@ def build_workbook(wb: Workbook, docs: list[RunDocument | FailedRun], title: dic
     for d, name in ok:
         ws = wb.create_sheet(name)
         write_case(ws, d, threshold, chart_points, summary, header_text, reactions)
-    if any(d.codes for d, _ in ok):  # design codes (issue 19)
+    if any(d.codes for d, _ in ok):  # design codes
         from .codes_sheet import write_codes
 
         at = wb.sheetnames.index(peaks_name) + 1 if peaks_name in wb.sheetnames else None

@@ -1,4 +1,4 @@
-"""JSON documents of results (public contract: key names are spelled out in the issues).
+"""JSON documents of results (a public contract: the key names are part of it).
 
 Forces in N, lengths in m, Cont_* as fractions; no UI imports.
 """
@@ -67,7 +67,7 @@ def static_to_dict(res: StaticResult) -> dict[str, Any]:
         return _num(a if series else a[0])
 
     still = m.still_air
-    # every tower's reactions in its own frame (issue 17; the equal-span form: the global frame)
+    # every tower's reactions in its own frame (the equal-span form: the global frame)
     R = system.to_tower_frames(m.reactions)
     R0 = system.to_tower_frames(still.reactions)
     towers = []
@@ -176,7 +176,7 @@ def case_parameters(case: Any) -> dict[str, Any]:
 
 
 def run_to_dict(res: Any, *, full_histories: bool = False, max_points: int = 2000) -> dict[str, Any]:
-    """JSON document of a run: ``run_document(res, ...).to_json()`` (issue 18 contract,
+    """JSON document of a run: ``run_document(res, ...).to_json()`` (contract,
     :class:`~linecheck.io.document.RunDocument`; layout in docs/results.schema.json)."""
     return run_document(res, full_histories=full_histories, max_points=max_points).to_json()
 
@@ -201,7 +201,7 @@ def run_document(res: Any, *, full_histories: bool = False, max_points: int = 20
     j = res.tower_index
     still = res.static.mean.still_air
     m = res.static.mean
-    still_r = res.system.to_tower_frames(still.reactions)  # the tower's own frame (issue 17)
+    still_r = res.system.to_tower_frames(still.reactions)  # the tower's own frame
     wind_r = res.system.to_tower_frames(m.reactions_wind)
     blocks: dict[str, Any] = {
         "still_air": StillAir({r: _num(still_r[j, c]) for c, r in enumerate(REACTIONS)}, _num(still.tension),
@@ -240,7 +240,7 @@ def run_document(res: Any, *, full_histories: bool = False, max_points: int = 20
 
 
 def codes_to_dict(cr: Any) -> dict[str, Any]:
-    """JSON of a :class:`~linecheck.service.CodesResult` (issue 19 contract):
+    """JSON of a :class:`~linecheck.service.CodesResult` (contract):
     ``{"ASCE74": {"edition", "verified", "provision", "inputs", "note", "load_per_length",
     "towers": [{"index", "Ry": {"code_load", "linecheck_peak", "ratio", "verdict"}}]}, ...}``, N."""
     out: dict[str, Any] = {}
@@ -277,7 +277,7 @@ def codes_document(cr: Any) -> dict[str, Any]:
 
 def with_models(doc: Any, model: str, reactions: dict[str, Any], failed: dict[str, str] | None = None) -> Any:
     """``doc`` (a :class:`~linecheck.io.document.RunDocument`) with the downburst model spread of
-    issue 15: ``model`` (the run shown), ``models`` (each model's typed reaction blocks at the
+    the downburst model spread: ``model`` (the run shown), ``models`` (each model's typed reaction blocks at the
     tower of interest), ``models_envelope`` and, when some failed, ``models_failed``."""
     from dataclasses import replace
 
@@ -319,7 +319,7 @@ def spectral_to_dict(sp: Any) -> dict[str, Any]:
            "not_applicable": {"Rx": "closed form ignores the longitudinal influence line",
                               "Rz": "closed form ignores the vertical influence line"}}
     w = getattr(sp, "window", None)
-    if w is not None:  # a long line's check ran on a window (issue 20); absent for the whole line
+    if w is not None:  # a long line's check ran on a window; absent for the whole line
         out["window"] = {"spans": int(w.spans), "first_tower": int(w.first_tower) + 1,
                          "estimated_error": {r: _num(w.estimated_error[c]) for c, r in enumerate(REACTIONS)},
                          "windows": [int(x) for x in w.windows]}

@@ -1,4 +1,4 @@
-"""What every front end shows of a line section (issue 17): the tower table, a one-line summary
+"""What every front end shows of a line section: the tower table, a one-line summary
 and the plan/profile geometry.  Plain Python + numpy, no UI library; the geometry itself comes
 from :class:`~linecheck.core.system.LineSystem` (docs/method.md "Line sections"), never
 recomputed here.

@@ -277,7 +277,7 @@ class LinecheckApp(App[None]):
 
     # ------------------------------------------------------------------ run
     def action_run_models(self) -> None:
-        """Run the case under every built-in downburst model (issue 15), same seeds."""
+        """Run the case under every built-in downburst model, same seeds."""
         if self.case is not None and self.case.wind.type != "downburst":
             self.notify("The model spread is for downburst cases.", severity="warning")
             return

@@ -131,7 +131,7 @@ ONLY_FOR = {"downburst": ("wind.downburst.", "analysis.mean_states"),
             "synoptic": ("wind.span_speeds", "analysis.burn_in")}
 
 
-# keys of one form of the line (issue 17): a section's towers derive the equal-span keys (shown in
+# keys of one form of the line: a section's towers derive the equal-span keys (shown in
 # the tower table instead), and an equal-span case has no tower table to go with tension/towers_file
 EQUAL_SPAN_KEYS = ("line.spans", "line.span_length", "line.sag", "line.height", "line.supports")
 SECTION_KEYS = ("line.tension", "line.towers_file")
@@ -319,7 +319,7 @@ def davenport_lines(doc: RunDocument) -> list[str]:
     else:
         out.append(f"closed form (Davenport/Castanheta), {d.reaction}: not shown - {d.note or 'not applicable'}")
     out += [f"closed form not applicable to {k}: {v}" for k, v in doc.spectral.not_applicable.items()]
-    window = doc.spectral.window_text()  # a long line's check ran on a window (issue 20)
+    window = doc.spectral.window_text()  # a long line's check ran on a window
     if window:
         out.append(window)
     return out

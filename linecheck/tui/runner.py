@@ -54,7 +54,7 @@ def execute(
 ) -> RunOutput:
     """Run ``case`` and collect the result tabs' data (raises ``Cancelled`` when ``cancel`` is set).
 
-    ``models``: e.g. ``"all"``: the downburst model spread (issue 15; :func:`service.run_models`);
+    ``models``: e.g. ``"all"``: the downburst model spread (:func:`service.run_models`);
     the result tabs show the case's own model, the document gets the ``"models"`` block."""
     t0 = time.perf_counter()
     threads = default_jobs()  # realization chunks in threads: the same bits (service.run_case)

@@ -1,4 +1,4 @@
-"""Codes: the design codes' conductor wind loads beside linecheck's peaks (issue 19).
+"""Codes: the design codes' conductor wind loads beside linecheck's peaks.
 
 Shows the ``"codes"`` block of the run document (computed by the service); no code value is
 computed here.

@@ -4,7 +4,7 @@ Every row comes from :data:`linecheck.core.case.SCHEMA`; a new value is checked 
 :func:`linecheck.core.case.with_value`, i.e. the same validation and the same
 messages as the CLI's case loader.
 
-A section case (issue 17) also shows its tower table (one row per tower, a cell per
+A section case also shows its tower table (one row per tower, a cell per
 [[line.towers]] key and the derived span to the next tower); ``+``/``insert`` adds a tower after
 the highlighted one, ``-``/``delete`` removes it; ``enter``/``e`` on a cell edits it:
 the whole table goes through :func:`linecheck.core.case.with_values` (``line.towers``, the
@@ -188,7 +188,7 @@ class ParameterEditor(Vertical):
         key = table.coordinate_to_cell_key(table.cursor_coordinate).row_key.value
         self.start_editing(key)
 
-    # ------------------------------------------------------------------ tower rows (issue 17)
+    # ------------------------------------------------------------------ tower rows
     def _tower_cursor(self) -> int | None:
         """0-based tower under the cursor of a focused tower table, else None."""
         towers = self.query_one("#towers-table", DataTable)

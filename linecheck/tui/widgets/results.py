@@ -234,7 +234,7 @@ class ResultsView(Vertical):
 
 
 def models_text(doc: RunDocument) -> str:
-    """Downburst model spread (issue 15): peak dynamic Rx/Ry and GF_Dy per model, and the envelope."""
+    """Downburst model spread: peak dynamic Rx/Ry and GF_Dy per model, and the envelope."""
     pk, gf = STAT_ROWS["peak_dynamic"], STAT_ROWS["GF_Dy"]
 
     def fmt(v, st):

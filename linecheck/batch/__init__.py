@@ -1,4 +1,4 @@
-"""Batch runs, parallel/distributed execution and the critical-downburst scan (issue 8).
+"""Batch runs, parallel/distributed execution and the critical-downburst scan.
 
 This package runs inside process-pool and Dask workers: it imports only the
 numerical core, the service layer and :mod:`linecheck.io` -- never a UI library

@@ -1,4 +1,5 @@
-"""Model spread in a batch (issue 15): one run per (case, downburst model), then one document per
+"""Model spread in a batch (``batch --models``: the same cases under several downburst
+running-mean models): one run per (case, downburst model), then one document per
 case with the typed ``models`` block and the envelope (:func:`linecheck.io.jsonout.with_models`)."""
 
 from __future__ import annotations

@@ -45,6 +45,7 @@ from ..core.results import REACTIONS
 from .executors import Executor, SequentialExecutor
 from .report import BatchProgress, BatchReport, RunJob
 from .runner import run_batch
+from .scheduler import POLL_S
 from .tasks import Failure, ScanChunk, scan_changes, scan_chunk
 
 MAX_POINTS = 1_000_000
@@ -57,6 +58,13 @@ _NUMBER = re.compile(r"^\s*(?P<num>[^:,]*?)\s*(?:(?P<dj>\*?\s*d_?j)|(?P<m>m))?\s
 UNIT_WORDS = {"m": "m (metres)", "Dj": "Dj (multiples of the jet diameter)"}
 
 
+#: the forms a scan option's value may take
+VALUE_FORMS = "START:STOP:STEP (STOP included), a comma-separated list or a number"
+#: examples of the lengths in messages, per option
+_EXAMPLES = {"--distance": "720m; 1.2Dj; 1.2Dj,1.6Dj; 0.5:2.5:0.1Dj",
+             "--jet-diameter": "600m; 600m,900m; 600:900:100m"}
+
+
 def parse_values(text: str, option: str, units: tuple[str, ...] = ()) -> tuple[tuple[float, ...], bool]:
     """Values of a scan option: ``A:B:STEP`` (B included), a comma list or one number.
 
@@ -67,67 +75,96 @@ def parse_values(text: str, option: str, units: tuple[str, ...] = ()) -> tuple[t
     Returns (values, relative: in multiples of D_j).  Raises CaseError (exit 2) on bad text,
     one line naming the option, the value and what is allowed.
     """
+    spec = _OptionText(option, text, units)
     raw = text.strip()
     sep = ":" if ":" in raw else ","
-    form = "START:STOP:STEP (STOP included), a comma-separated list or a number"
-    allowed = " or ".join(UNIT_WORDS[u] for u in units)
-    examples = {"--distance": "720m; 1.2Dj; 1.2Dj,1.6Dj; 0.5:2.5:0.1Dj",
-                "--jet-diameter": "600m; 600m,900m; 600:900:100m"}
-    eg = examples.get(option, "; ".join(f"1.2{u}" for u in units))
-    with_unit = (f"{form}, in {allowed}: a unit after every number, or once after the last for all "
-                 f"of them (e.g. {eg})")
-    expected = with_unit if units else form
-
-    def refuse(why: str) -> CaseError:
-        return CaseError(f"{option}: value {text!r} is not allowed: {why}")
-
-    if not raw:
-        raise CaseError(f"{option}: empty value: expected {expected}")
-    tokens = [p for p in raw.split(sep) if p.strip()] if sep == "," else raw.split(sep)
+    tokens = ([p for p in raw.split(sep) if p.strip()] if sep == "," else raw.split(sep)) if raw else []
     if not tokens:
-        raise CaseError(f"{option}: empty value: expected {expected}")
+        raise CaseError(f"{option}: empty value: expected {spec.expected}")
+    nums, found = _numbers(tokens, spec)
+    unit = _common_unit(found, spec)
+    values = _range(nums, spec) if sep == ":" else tuple(nums)
+    return values, unit == "Dj"
+
+
+@dataclass(frozen=True)
+class _OptionText:
+    """The text of one scan option being parsed, and the wording of its error messages."""
+
+    option: str
+    text: str
+    units: tuple[str, ...]
+
+    @property
+    def allowed(self) -> str:
+        return " or ".join(UNIT_WORDS[u] for u in self.units)
+
+    @property
+    def example(self) -> str:
+        return _EXAMPLES.get(self.option, "; ".join(f"1.2{u}" for u in self.units))
+
+    @property
+    def expected(self) -> str:
+        if not self.units:
+            return VALUE_FORMS
+        return (f"{VALUE_FORMS}, in {self.allowed}: a unit after every number, or once after the last for all "
+                f"of them (e.g. {self.example})")
+
+    def refuse(self, why: str) -> CaseError:
+        return CaseError(f"{self.option}: value {self.text!r} is not allowed: {why}")
+
+
+def _numbers(tokens: list[str], spec: _OptionText) -> tuple[list[float], list[str]]:
+    """The finite numbers of ``tokens`` and the unit written after each (``""``: none)."""
     nums, found = [], []
     for tok in tokens:
         mt = _NUMBER.match(tok)
         if mt is None:
-            raise refuse(f"expected {expected}")
+            raise spec.refuse(f"expected {spec.expected}")
         found.append("Dj" if mt["dj"] else "m" if mt["m"] else "")
         try:
             v = float(mt["num"])
         except ValueError:
-            raise refuse(f"expected {expected}") from None
+            raise spec.refuse(f"expected {spec.expected}") from None
         if not math.isfinite(v):
-            raise refuse("expected finite numbers")
+            raise spec.refuse("expected finite numbers")
         nums.append(v)
+    return nums, found
+
+
+def _common_unit(found: list[str], spec: _OptionText) -> str:
+    """The one unit of all the values (``""`` for plain numbers); CaseError when the units
+    written do not fit the option (see :func:`parse_values`)."""
     given = {u for u in found if u}
-    if not units:
+    eg, allowed = spec.example, spec.allowed
+    if not spec.units:
         if given:
-            raise refuse(f"expected plain numbers, {form} (no unit)")
-        unit = ""
-    else:
-        if not given:
-            raise refuse(f"a length needs its unit, {allowed} (e.g. {eg}; one unit after the last number "
-                         "applies to all)")
-        if len(given) > 1:
-            raise refuse(f"one unit for every number ({' and '.join(sorted(given))} given; e.g. {eg})")
-        (unit,) = given
-        if unit not in units:
-            raise refuse(f"{option} takes {allowed}, not {unit} (e.g. {eg})")
-        if not (all(found) or (found[-1] and not any(found[:-1]))):
-            raise refuse(f"a unit after every number, or once after the last for all of them (e.g. {eg})")
-    if sep == ":":
-        if len(nums) != 3:
-            raise refuse(f"expected {expected}")
-        a, b, step = nums
-        if step == 0 or (b - a) * step < 0:
-            raise refuse("STEP must be non-zero and go from A toward B")
-        n = int(math.floor((b - a) / step + 1e-9)) + 1
-        if n > MAX_POINTS:
-            raise CaseError(f"{option}: value {text!r} gives {n} values: expected at most {MAX_POINTS}")
-        values = tuple(float(round(a + i * step, 10)) for i in range(n))
-    else:
-        values = tuple(nums)
-    return values, unit == "Dj"
+            raise spec.refuse(f"expected plain numbers, {VALUE_FORMS} (no unit)")
+        return ""
+    if not given:
+        raise spec.refuse(f"a length needs its unit, {allowed} (e.g. {eg}; one unit after the last number "
+                          "applies to all)")
+    if len(given) > 1:
+        raise spec.refuse(f"one unit for every number ({' and '.join(sorted(given))} given; e.g. {eg})")
+    (unit,) = given
+    if unit not in spec.units:
+        raise spec.refuse(f"{spec.option} takes {allowed}, not {unit} (e.g. {eg})")
+    if not (all(found) or (found[-1] and not any(found[:-1]))):
+        raise spec.refuse(f"a unit after every number, or once after the last for all of them (e.g. {eg})")
+    return unit
+
+
+def _range(nums: list[float], spec: _OptionText) -> tuple[float, ...]:
+    """The values of ``START:STOP:STEP`` (STOP included, at most :data:`MAX_POINTS`)."""
+    if len(nums) != 3:
+        raise spec.refuse(f"expected {spec.expected}")
+    a, b, step = nums
+    if step == 0 or (b - a) * step < 0:
+        raise spec.refuse("STEP must be non-zero and go from A toward B")
+    n = int(math.floor((b - a) / step + 1e-9)) + 1
+    if n > MAX_POINTS:
+        raise CaseError(f"{spec.option}: value {spec.text!r} gives {n} values: expected at most {MAX_POINTS}")
+    return tuple(float(round(a + i * step, 10)) for i in range(n))
 
 
 @dataclass(frozen=True)
@@ -241,8 +278,8 @@ class ScanResult:
     v_max: float | None = None
     elapsed: float = 0.0
     executor: str = ""
-    model: str | None = None  # downburst model scanned (issue 15); None: the case's own
-    dynamic: np.ndarray | None = None  # [N] expected dynamic peak |M+B+R| per point (n, 3) (issue 20)
+    model: str | None = None  # downburst running-mean model scanned; None: the case's own
+    dynamic: np.ndarray | None = None  # [N] expected dynamic peak |M+B+R| per point (n, 3), with dynamic_realizations
     dynamic_realizations: int = 0  # realizations behind ``dynamic``
 
     @property
@@ -273,7 +310,7 @@ class ScanResult:
     def centre_offsets(self) -> np.ndarray:
         """[m] each point's downburst centre relative to the tower of interest in the global frame
         (x along the first span, y to its left), (n, 2): R sin(Theta) x' - R cos(Theta) y' with
-        (x', y') the tower's own frame (issue 17; the equal-span form: (R sin Theta, -R cos Theta))."""
+        (x', y') the tower's own frame ((R sin Theta, -R cos Theta) where that is the global frame)."""
         from ..core.system import LineSystem
 
         psi = float(LineSystem(self.case.line).tower_headings[self.case.line.tower_of_interest - 1])
@@ -343,9 +380,9 @@ def run_scan(
 ) -> ScanResult:
     """Step 1 at every grid point of ``grid`` for the case in ``case_path``.
 
-    ``model``: scan under this downburst running-mean model (issue 15; ``None``: the case's own).
+    ``model``: scan under this downburst running-mean model (``None``: the case's own).
     ``dynamic_realizations``: k > 0 runs steps 1-3 with realizations 0..k-1 at every point too,
-    so that positions are ranked by the expected dynamic peak (issue 20; ``critical(r, "peak")``).
+    so that positions are ranked by the expected dynamic peak (``critical(r, "peak")``).
 
     Args:
         hold: ``"jet"`` (default): one storm, V_max held at its value for the case's own
@@ -366,6 +403,25 @@ def run_scan(
     t0 = time.perf_counter()
     executor = executor or SequentialExecutor()
     path = Path(case_path)
+    case, v_max = _scan_case(path, hold, model)
+    digest = case_hash(path)
+    scan_estimate(case, grid.size, dynamic_realizations=dynamic_realizations, workers=executor.workers, warn=warn)
+    pts = grid.points()
+    n = pts.shape[0]
+    size = chunk_size or default_scan_chunk(n, executor.workers)
+    if progress is not None:
+        progress("scan", 0, n)
+    submit = _PointSubmitter(executor, str(path), digest, v_max, n, cancel, progress, model, dynamic_realizations)
+    handles = [submit(pts, a, size) for a in range(0, n, size)]
+    table = _ScanTable.empty(n, dynamic_realizations > 0)
+    _collect_points(executor, handles, table, progress, cancel)
+    return ScanResult(case, path, pts, table.peak, table.time, table.v_ref, tuple(table.errors), hold, v_max,
+                      time.perf_counter() - t0, executor.describe(), model, table.dynamic, int(dynamic_realizations))
+
+
+def _scan_case(path: Path, hold: str, model: str | None) -> tuple[Case, float | None]:
+    """The case to scan (under ``model`` if given) and, for ``hold="jet"``, the V_max [m/s] of
+    its own configuration's field; CaseError for a case that is not a downburst or a bad ``hold``."""
     case = load_case(path)
     if case.wind.type != "downburst" or case.wind.downburst is None:
         raise CaseError('wind.type: a scan needs a downburst case (type = "downburst")', file=str(path))
@@ -380,36 +436,77 @@ def run_scan(
         from ..core.wind.mean import downburst_field
 
         v_max = float(downburst_field(case).v_max)  # CaseError if the case's own configuration is invalid
-    digest = case_hash(path)
-    scan_estimate(case, grid.size, dynamic_realizations=dynamic_realizations, workers=executor.workers, warn=warn)
-    pts = grid.points()
-    n = pts.shape[0]
-    size = chunk_size or default_scan_chunk(n, executor.workers)
-    done = 0
-    if progress is not None:
-        progress("scan", 0, n)
-    handles = []
-    for a in range(0, n, size):
+    return case, v_max
+
+
+@dataclass(frozen=True)
+class _PointSubmitter:
+    """Submits the scan's chunks of points (:func:`~.tasks.scan_chunk`) to the executor;
+    ``n``: the number of points, for per-point progress in this process."""
+
+    executor: Executor
+    path: str
+    digest: str
+    v_max: float | None
+    n: int
+    cancel: threading.Event | None
+    progress: Callable[[str, int, int], None] | None
+    model: str | None
+    dynamic_realizations: int
+
+    def __call__(self, pts: np.ndarray, a: int, size: int) -> Any:
+        """Submit points ``a`` to ``a + size`` of ``pts``; returns the handle."""
+        ex, progress, n = self.executor, self.progress, self.n
         chunk = [tuple(map(float, p)) for p in pts[a:a + size]]
-        kwargs: dict[str, Any] = {"cancel": cancel} if executor.in_process and cancel is not None else {}
-        if executor.in_process and progress is not None:  # per point: a chunk of --dynamic positions is long
-            kwargs["progress"] = lambda i, a=a: progress("scan", a + i, n)
-        if model is not None:
-            kwargs["model"] = model
-        if dynamic_realizations > 0:
-            kwargs["dynamic_realizations"] = int(dynamic_realizations)
-        handles.append(executor.submit(scan_chunk, str(path), chunk, a, digest, v_max, **kwargs))
-    peak = np.full((n, 3), np.nan)
-    dyn = np.full((n, 3), np.nan) if dynamic_realizations > 0 else None
-    tt = np.full((n, 3), np.nan)
-    vref = np.full(n, np.nan)
-    errors: list[str | None] = [None] * n
+        kwargs: dict[str, Any] = {"cancel": self.cancel} if ex.in_process and self.cancel is not None else {}
+        if ex.in_process and progress is not None:  # per point: a chunk of --dynamic positions is long
+            kwargs["progress"] = lambda i: progress("scan", a + i, n)
+        if self.model is not None:
+            kwargs["model"] = self.model
+        if self.dynamic_realizations > 0:
+            kwargs["dynamic_realizations"] = int(self.dynamic_realizations)
+        return ex.submit(scan_chunk, self.path, chunk, a, self.digest, self.v_max, **kwargs)
+
+
+@dataclass
+class _ScanTable:
+    """The scan's results as its chunks come in (NaN where a point is not in or failed); units
+    as in :class:`ScanResult`."""
+
+    peak: np.ndarray
+    time: np.ndarray
+    v_ref: np.ndarray
+    dynamic: np.ndarray | None
+    errors: list[str | None]
+    done: int = 0  # points in
+
+    @classmethod
+    def empty(cls, n: int, dynamic: bool) -> _ScanTable:
+        return cls(np.full((n, 3), np.nan), np.full((n, 3), np.nan), np.full(n, np.nan),
+                   np.full((n, 3), np.nan) if dynamic else None, [None] * n)
+
+    def add(self, value: ScanChunk) -> None:
+        a, m = value.start, value.peak.shape[0]
+        self.peak[a:a + m] = value.peak
+        self.time[a:a + m] = value.time
+        self.v_ref[a:a + m] = value.v_ref
+        if self.dynamic is not None and value.dynamic is not None:
+            self.dynamic[a:a + m] = value.dynamic
+        self.errors[a:a + m] = list(value.errors)
+        self.done += m
+
+
+def _collect_points(executor: Executor, handles: list[Any], table: _ScanTable,
+                    progress: Callable[[str, int, int], None] | None, cancel: threading.Event | None) -> None:
+    """Wait for every chunk and put it in ``table``; on a failed chunk (raised as its error),
+    cancellation or Ctrl-C the chunks still pending are aborted."""
+    n = len(table.errors)
     pending = list(range(len(handles)))
     try:
         while pending:
             if cancel is not None and cancel.is_set():
                 raise Cancelled("scan cancelled")
-            idx = executor.wait([handles[i] for i in pending], timeout=0.2)
+            idx = executor.wait([handles[i] for i in pending], timeout=POLL_S)
             finished = [pending[i] for i in idx]
             for h in finished:
                 value = executor.outcome(handles[h])
@@ -417,23 +514,14 @@ def run_scan(
                     _raise_failure(value)
                 if not isinstance(value, ScanChunk):  # pragma: no cover - an executor bug
                     raise TypeError(f"scan task returned {type(value).__name__}, expected ScanChunk")
-                m = value.peak.shape[0]
-                peak[value.start:value.start + m] = value.peak
-                tt[value.start:value.start + m] = value.time
-                vref[value.start:value.start + m] = value.v_ref
-                if dyn is not None and value.dynamic is not None:
-                    dyn[value.start:value.start + m] = value.dynamic
-                errors[value.start:value.start + m] = list(value.errors)
-                done += m
+                table.add(value)
                 if progress is not None:
-                    progress("scan", done, n)
+                    progress("scan", table.done, n)
             fs = set(finished)
             pending = [i for i in pending if i not in fs]
     except BaseException:
         executor.abort([handles[i] for i in pending])
         raise
-    return ScanResult(case, path, pts, peak, tt, vref, tuple(errors), hold, v_max,
-                      time.perf_counter() - t0, executor.describe(), model, dyn, int(dynamic_realizations))
 
 
 def scan_estimate(case: Case, points: int, *, dynamic_realizations: int = 0, workers: int = 1,

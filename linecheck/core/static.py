@@ -277,19 +277,94 @@ def solve_static(
                            max_iter=max_iter)[0]
 
 
-def _fig6_iteration(
-    system: LineSystem,
-    gy: np.ndarray,
-    d: np.ndarray,
-    H: np.ndarray,
-    Rres: np.ndarray,
-    *,
-    labels: list[str],
-    tol: float,
-    max_iter: int,
-    progress: Callable[[int, int], None] | None = None,
-    cancel: threading.Event | None = None,
-) -> list[StaticState]:
+def _inner_newton(sp: _Spans, d: np.ndarray, H: np.ndarray, Rres: np.ndarray, inner: np.ndarray, L: np.ndarray,
+                  v: float, idx: np.ndarray, adj: np.ndarray, tol_d: float, labels: list[str]) -> np.ndarray:
+    """Inner Newton on the longitudinal displacements d_x of the suspension clamps (paper Eq. 3)
+    with R_res fixed, on a leading axis of n_s states; moves ``d`` in place.
+
+    Args: d [m] (n_s, n_towers, 3); H [N] start tensions (n_s, n_spans); Rres [N] (n_s, n_towers);
+        inner: bool (n_s,), the states still iterating (others frozen; updated in place);
+        L [m] (n_spans,); v [m] insulator length; idx: suspension towers (k,); adj: positions in
+        idx of towers adjacent to the next one; tol_d [m] the outer tolerance.
+    Returns: H [N] (n_s, n_spans) at the last evaluated d_x.
+    """
+    n_s, nt, k = d.shape[0], d.shape[1], idx.size
+    for _inner in range(50):
+        l = L + np.diff(d[..., 0], axis=-1)
+        H, C = sp.tension(l, np.diff(d[..., 1], axis=-1), np.diff(d[..., 2], axis=-1), H)
+        if k == 0 or not inner.any():
+            break
+        fx = np.zeros((n_s, nt))
+        fx[:, :-1] += H
+        fx[:, 1:] -= H
+        fx = fx - d[..., 0] * Rres / v
+        # tangent (paper K_x with the elastic C_n = dH/dl): tridiagonal over all towers,
+        # restricted to the suspension towers (strain towers are fixed); free neighbours
+        # are adjacent towers j, j+1 -> a symmetric tridiagonal system
+        diag = -Rres / v
+        diag[:, :-1] -= C
+        diag[:, 1:] -= C
+        off = np.zeros((n_s, max(k - 1, 0)))
+        off[:, adj] = C[:, idx[adj]]
+        if n_s == 1:
+            _, _, _, step, info = _dgtsv(off[0], diag[0, idx].copy(), off[0].copy(), -fx[0, idx])
+            if info != 0:
+                raise ConvergenceError(f"{labels[0]}: singular longitudinal tangent (K_x, Eq. 3)")
+            step = step[None]
+        else:
+            step = _tridiag_solve(off, diag[:, idx], off, -fx[:, idx])
+        step[~inner] = 0.0
+        d[:, idx, 0] += step
+        inner &= ~(np.max(np.abs(step), axis=1) <= 1e-3 * tol_d)
+        if n_s == 1 and not inner[0]:
+            # one state stops right after its last Newton step (its H is recomputed below);
+            # several states take one more pass (H of all states at the final d_x) and stop
+            # at the check above.  Unifying the two moves the paper cases' results by the
+            # round-off of the span-tension Newton (up to 8e-6 relative on near-zero
+            # wind-induced Rx histories), so both keep their bit-identical results.
+            break
+    return H
+
+
+def _insulator_update(d: np.ndarray, d_old: np.ndarray, R: np.ndarray, Rn: np.ndarray, Rres: np.ndarray,
+                      active: np.ndarray, v: float, idx: np.ndarray, change: np.ndarray,
+                      residual: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Insulator equilibrium (paper Eq. 4): each active suspension clamp moves to v R / R_res
+    below its fixed point (``d`` updated in place).
+
+    Args: d, d_old [m] (n_s, n_towers, 3) after / before this outer iteration; R [N] reactions
+        (n_s, n_towers, 3), Rn [N] their norms and Rres [N] the insulator forces (n_s, n_towers);
+        active: bool (n_s,); v [m]; idx: suspension towers; change [m], residual [N] (n_s,): the
+        previous values, kept for the frozen states.
+    Returns: the largest displacement change [m] and out-of-balance force [N] per state, (n_s,) each.
+    """
+    n_s = d.shape[0]
+    if not idx.size:
+        return np.where(active, 0.0, change), np.where(active, 0.0, residual)
+    a = active
+    dn = np.stack([v * R[:, idx, 0] / Rres[:, idx], v * R[:, idx, 1] / Rres[:, idx],
+                   v - v * R[:, idx, 2] / Rres[:, idx]], axis=-1)
+    d[:, idx] = np.where(a[:, None, None], dn, d[:, idx])
+    change = np.where(a, np.max(np.abs(d - d_old).reshape(n_s, -1), axis=1), change)
+    # out-of-balance: conductor force minus insulator force along its axis
+    axis = np.stack([d_old[:, idx, 0], d_old[:, idx, 1], v - d_old[:, idx, 2]], axis=-1) / v
+    res = np.max(np.linalg.norm(R[:, idx] - Rn[:, idx, None] * axis, axis=-1), axis=1)
+    return change, np.where(a, res, residual)
+
+
+def _check_finite(R: np.ndarray, d: np.ndarray, active: np.ndarray, labels: list[str], it: int) -> None:
+    """Raise :class:`ConvergenceError` naming the first active state whose reactions R (n_s, n_towers, 3)
+    or displacements d (n_s, n_towers, 3) are not all finite after ``it`` iterations."""
+    n_s = d.shape[0]
+    finite = np.all(np.isfinite(R.reshape(n_s, -1)), axis=1) & np.all(np.isfinite(d.reshape(n_s, -1)), axis=1)
+    if not np.all(finite | ~active):
+        j = int(np.flatnonzero(~finite & active)[0])
+        raise ConvergenceError(f"{labels[j]}: non-finite values after {it} iterations")
+
+
+def _fig6_iteration(system: LineSystem, gy: np.ndarray, d: np.ndarray, H: np.ndarray, Rres: np.ndarray, *,
+                    labels: list[str], tol: float, max_iter: int, progress: Callable[[int, int], None] | None = None,
+                    cancel: threading.Event | None = None) -> list[StaticState]:
     """The paper's Fig. 6 iteration, written once, on a leading axis of n_states load cases.
 
     Inner Newton on d_x (Eq. 3) with R_res fixed, then the reactions (Eq. 2) and the
@@ -306,15 +381,10 @@ def _fig6_iteration(
         progress: ``progress(converged, n_states)`` once per outer iteration.
         cancel: set it to stop; raises :class:`Cancelled`.
     """
-    line = system.line
-    nt = system.n_towers
-    v = line.insulator_length
-    L = system.span_lengths
-    n_s = gy.shape[0]
+    nt, v, L, n_s = system.n_towers, system.line.insulator_length, system.span_lengths, gy.shape[0]
     sp = _Spans(system, gy)
     d, H, Rres = d.copy(), H.copy(), Rres.copy()
     idx = np.flatnonzero(system.suspension)
-    k = idx.size
     adj = np.flatnonzero(np.diff(idx) == 1)
     tol_d = tol * max(v, 1.0)
     active = np.ones(n_s, dtype=bool)
@@ -328,64 +398,15 @@ def _fig6_iteration(
             raise Cancelled("step 1 cancelled")
         d_old = d.copy()
         # ---- inner Newton on d_x (paper Eq. 3), R_res fixed; converged states frozen
-        inner = active.copy()
-        for _inner in range(50):
-            l = L + np.diff(d[..., 0], axis=-1)
-            H, C = sp.tension(l, np.diff(d[..., 1], axis=-1), np.diff(d[..., 2], axis=-1), H)
-            if k == 0 or not inner.any():
-                break
-            fx = np.zeros((n_s, nt))
-            fx[:, :-1] += H
-            fx[:, 1:] -= H
-            fx = fx - d[..., 0] * Rres / v
-            # tangent (paper K_x with the elastic C_n = dH/dl): tridiagonal over all towers,
-            # restricted to the suspension towers (strain towers are fixed); free neighbours
-            # are adjacent towers j, j+1 -> a symmetric tridiagonal system
-            diag = -Rres / v
-            diag[:, :-1] -= C
-            diag[:, 1:] -= C
-            off = np.zeros((n_s, max(k - 1, 0)))
-            off[:, adj] = C[:, idx[adj]]
-            if n_s == 1:
-                _, _, _, step, info = _dgtsv(off[0], diag[0, idx].copy(), off[0].copy(), -fx[0, idx])
-                if info != 0:
-                    raise ConvergenceError(f"{labels[0]}: singular longitudinal tangent (K_x, Eq. 3)")
-                step = step[None]
-            else:
-                step = _tridiag_solve(off, diag[:, idx], off, -fx[:, idx])
-            step[~inner] = 0.0
-            d[:, idx, 0] += step
-            inner &= ~(np.max(np.abs(step), axis=1) <= 1e-3 * tol_d)
-            if n_s == 1 and not inner[0]:
-                # one state stops right after its last Newton step (its H is recomputed below);
-                # several states take one more pass (H of all states at the final d_x) and stop
-                # at the check above.  Unifying the two moves the paper cases' results by the
-                # round-off of the span-tension Newton (up to 8e-6 relative on near-zero
-                # wind-induced Rx histories), so both keep their bit-identical results.
-                break
+        H = _inner_newton(sp, d, H, Rres, active.copy(), L, v, idx, adj, tol_d, labels)
         l = L + np.diff(d[..., 0], axis=-1)
         H, _ = sp.tension(l, np.diff(d[..., 1], axis=-1), np.diff(d[..., 2], axis=-1), H)
         R = _reactions(sp, H, l, d[..., 1], d[..., 2], nt)
         Rn = np.linalg.norm(R, axis=-1)
         Rres = np.where(active[:, None], Rn, Rres)
-        finite = np.all(np.isfinite(R.reshape(n_s, -1)), axis=1) & np.all(np.isfinite(d.reshape(n_s, -1)), axis=1)
-        if not np.all(finite | ~active):
-            j = int(np.flatnonzero(~finite & active)[0])
-            raise ConvergenceError(f"{labels[j]}: non-finite values after {it} iterations")
+        _check_finite(R, d, active, labels, it)
         # ---- insulator equilibrium (paper Eq. 4)
-        if k:
-            a = active
-            dn = np.stack([v * R[:, idx, 0] / Rres[:, idx], v * R[:, idx, 1] / Rres[:, idx],
-                           v - v * R[:, idx, 2] / Rres[:, idx]], axis=-1)
-            d[:, idx] = np.where(a[:, None, None], dn, d[:, idx])
-            change = np.where(a, np.max(np.abs(d - d_old).reshape(n_s, -1), axis=1), change)
-            # out-of-balance: conductor force minus insulator force along its axis
-            axis = np.stack([d_old[:, idx, 0], d_old[:, idx, 1], v - d_old[:, idx, 2]], axis=-1) / v
-            res = np.max(np.linalg.norm(R[:, idx] - Rn[:, idx, None] * axis, axis=-1), axis=1)
-            residual = np.where(a, res, residual)
-        else:
-            change = np.where(active, 0.0, change)
-            residual = np.where(active, 0.0, residual)
+        change, residual = _insulator_update(d, d_old, R, Rn, Rres, active, v, idx, change, residual)
         done = active & (change <= tol_d)
         out_d[done], out_H[done], out_R[done] = d[done], H[done], R[done]
         out_Rres[done], out_res[done], out_it[done] = Rres[done], residual[done], it
@@ -396,10 +417,8 @@ def _fig6_iteration(
             break
     else:
         j = int(np.flatnonzero(active)[0])
-        raise ConvergenceError(
-            f"{labels[j]}: step-1 static solver did not converge in {max_iter} iterations "
-            f"(last displacement change {change[j]:.3g} m, out-of-balance force {residual[j]:.3g} N)"
-        )
+        raise ConvergenceError(f"{labels[j]}: step-1 static solver did not converge in {max_iter} iterations (last "
+                               f"displacement change {change[j]:.3g} m, out-of-balance force {residual[j]:.3g} N)")
     return _final_states(system, sp.Lu, sp.my_hat, sp.mz_hat, out_d, out_H, out_R, out_Rres, out_it, out_res, labels)
 
 
@@ -408,7 +427,7 @@ def _final_states(system: LineSystem, Lu: np.ndarray, my_hat: np.ndarray, mz_hat
                   labels: list[str]) -> list[StaticState]:
     """Strain check and deformed shape of converged equilibria, on a leading axis of n_s states
     (shallow cable: y = chord + M_y/H, z = chord - M_z/H; element tension T = H ds/dx).  Every
-    operation is elementwise along the states (issue 20: one pass for a downburst's 250 states
+    operation is elementwise along the states (one pass for a downburst's 250 states
     instead of one call each), so a state's arrays do not depend on the others (tested).
 
     Args: Lu [m] (n_spans,); my_hat [N m/m] (n_s, n_spans, ne+1); mz_hat (ne+1,); d [m]
@@ -457,7 +476,7 @@ def section_loads(system: LineSystem, gy: np.ndarray) -> np.ndarray:
 
 def _section_states(system: LineSystem, gy: np.ndarray, labels: list[str], *, tol: float, max_iter: int,
                     initial: StaticState | None = None, progress=None, cancel=None) -> list[StaticState]:
-    """Step 1 of the section form (issue 17): exact elastic spans, Newton over the suspension
+    """Step 1 of the section form: exact elastic spans, Newton over the suspension
     clamps (:mod:`linecheck.core.catenary`); the same StaticState as the paper's solver."""
     from .catenary import equilibrium, start_tension
 

@@ -100,3 +100,35 @@ def solve(c: np.ndarray, B: np.ndarray) -> np.ndarray:
     if B.ndim == 1:
         return solver.columns(B[:, None])[:, 0]
     return solver.columns(B)
+
+
+# ---- the banded solves of the compiled kernel's piece ``newmark`` (linecheck.core.kernel):
+# their part of its load check (registered by linecheck.core.dynamics)
+
+def band_solve_pairs(fns, kd: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The compiled banded solves (``fns.band_solve``: four lanes, ``band_solve_1``: one vector,
+    ``solve_columns``) beside LAPACK ``dpbtrs`` on diagonally dominant systems (condition ≲ 10)
+    of half-bandwidth kd, long and short: (reference, compiled) pairs of solutions."""
+    rng = np.random.default_rng(20)
+    pairs = []
+    for n in (60, 4):
+        ab = np.zeros((kd + 1, n))
+        for off in range(kd + 1):
+            ab[kd - off, off:] = rng.uniform(-1.0, 1.0, max(n - off, 0))
+        ab[kd] = 4.0 * (kd + 1) + rng.uniform(0.0, 1.0, n)  # diagonally dominant
+        c, info = _dpbtrf(ab, lower=0)
+        if info != 0:  # pragma: no cover - diagonally dominant by construction
+            raise NumericalError("load check: test matrix not positive definite")
+        B = rng.standard_normal((4, n))
+        ref = _dpbtrs(c, np.asfortranarray(B.T), lower=0)[0]
+        X = np.ascontiguousarray(B.T)[None]  # one group of four lanes
+        fns.band_solve(c, X)
+        pairs.append((ref, X[0]))
+        for q in range(4):
+            x = B[q].copy()
+            fns.band_solve_1(c, x)
+            pairs.append((ref[:, q], x))
+        cols = np.array(B.T)
+        fns.solve_columns(c, cols)
+        pairs.append((ref, cols))
+    return pairs

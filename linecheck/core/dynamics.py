@@ -25,14 +25,15 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import lapack
 
 from . import kernel
-from .banded import ColumnSolver
+from .banded import ColumnSolver, band_solve_pairs
 from .banded import factor as _factor
 from .banded import solve as _solve
 from .errors import Cancelled, NumericalError
-from .model import BANDWIDTH, CSRArrays, LinearModel, band_blocks, band_to_csr, band_to_csr_stack, rotate_band
+from .model import BANDWIDTH, CSRArrays, LinearModel, band_to_csr, band_to_csr_stack, rotate_band
+from .node_bases import node_bases, node_bases_stack
+from .second_order import second_order_of_loads, second_order_reactions
 
 try:  # the kernel behind scipy's CSR @ dense product, called without the per-call dispatch
     from scipy.sparse._sparsetools import csr_matvecs as _csr_matvecs
@@ -120,232 +121,328 @@ def integrate(
         second_order: optional :class:`~linecheck.core.second_order.SecondOrder` operator of
             every mean state (same length as ``models``): the reactions of F and of B then
             include the second-order tension increment of their own displacement histories
-            (issue 16; with ``model_at`` the operator of the nearest state is used), from step
+            (with ``model_at`` the operator of the nearest state is used), from step
             ``second_order_start`` on (the steps before it, a burn-in the caller discards, keep
             the linear reactions).
         progress: ``progress(done, total)`` about every 1 % of the steps (per block).
         cancel: stop early (raises :class:`Cancelled`).
         load_dirs: [-] unit direction of every free node's transverse load, shape (n_free, 3)
-            (issue 17: a section's span normals); None = the global y axis (a straight line).
+            (a section: its span normals); None = the global y axis (a straight line).
 
     Returns:
         :class:`DynamicResponse` with tower reactions.  The record starts from the
         quasi-static solution at t = 0 (u0 = K^-1 F0, u'0 = 0), so no background
         transient is created.
     """
-    nm = Newmark(dt)
-    n_steps, n_real, n_free = loads.shape
-    n_dof = models[0].mass.size
-    ydof = 3 * np.arange(n_free) + 1  # node-major DOFs: y is the second of each node
-    n_r = models[0].G.shape[0]
     if not np.all(np.isfinite(loads)):
         raise NumericalError("non-finite fluctuating wind load")
-    # Vectors are kept "transposed", shape (n_real, n_dof) C-ordered, i.e. (n_dof, n_real)
-    # Fortran-ordered as LAPACK wants them: no copies in the step loop.
-
-    def model_of(n: int) -> tuple[LinearModel, np.ndarray]:
-        """Linear model and damping band in force at step n."""
-        if model_at is not None:
-            return model_at(n)
-        k = int(state_of_step[n])
-        return models[k], damping[k]
-
-    def loads_full(f: np.ndarray) -> np.ndarray:
-        """y-loads (m, n_free) -> full transposed right-hand sides (m, n_dof)."""
-        out = np.zeros((f.shape[0], n_dof))
-        if load_dirs is None:
-            out[:, ydof] = f
-        else:  # along every node's load direction
-            out.reshape(f.shape[0], n_free, 3)[:] = f[..., None] * load_dirs
-        return out
-
-    def from_ydof(A: np.ndarray) -> np.ndarray:
-        """Rows of a (n_dof, m) array combined along the load directions -> (n_free, m)."""
-        if load_dirs is None:
-            return A[ydof]
-        return np.einsum("nca,nc->na", A.reshape(n_free, 3, -1), load_dirs)
-
-    # -------- step 3: quasi-static background, one factorisation per mean state
-    R_B = np.empty((n_steps, n_real, n_r))
-    chunk = max(1, 8192 // max(n_real, 1))
-    if second_order is not None:
-        from .second_order import second_order_of_loads, second_order_reactions
-
-        def so(n: int, U: np.ndarray) -> np.ndarray:
-            """Second-order reactions of global displacements U (..., n_dof) under the state of step n."""
-            return second_order_reactions(second_order[int(state_of_step[n])], U.reshape(-1, n_dof)).reshape(
-                U.shape[:-1] + (n_r,))
-    compiled = kernel.use("newmark")  # the optional compiled step loop and banded solves (kernel.py)
-    if model_at is None and n_dof > BACKGROUND_SOLVE_DOF:
-        # a long line (issue 20): the dense static transfer (n_free x n_r) would cost O(n^2) per
-        # step; solve K u_B = P l by the banded Cholesky instead (dpbtrs: column by column, so a
-        # realization's bits do not depend on what else is solved) and take G u_B sparsely
-        rows = max(1, 2_000_000 // n_dof)  # right-hand sides per solve: ~16 MB
-        for k in np.unique(state_of_step):
-            c = _factor(models[k].K_band, np.zeros(n_dof), f"stiffness of mean state {k + 1}")
-            sparse_g = _sparse_rows(models[k].G)
-            all_steps = np.flatnonzero(state_of_step == k)
-            per = max(1, rows // max(n_real, 1))
-            for i0 in range(0, all_steps.size, per):
-                steps = all_steps[i0:i0 + per]
-                if compiled and second_order is None:  # the same arithmetic, compiled and fused (kernel.background)
-                    R_B[steps] = kernel.background(c, loads[steps].reshape(-1, n_free), load_dirs,
-                                                   sparse_g).reshape(steps.size, n_real, n_r)
-                    continue
-                rhs = loads_full(loads[steps].reshape(-1, n_free)).T  # (n_dof, m)
-                UB = (kernel.solve_columns(c, rhs) if compiled else _solve(c, rhs)).T  # (m, n_dof), global
-                R_B[steps] = _sparse_reactions(UB, *sparse_g).reshape(steps.size, n_real, n_r)
-                sk = steps >= second_order_start
-                if second_order is not None and sk.any():  # the quasi-static displacements themselves
-                    R_B[steps[sk]] += so(int(steps[sk][0]), UB.reshape(steps.size, n_real, n_dof)[sk])
-    elif model_at is None:
-        for k in np.unique(state_of_step):
-            c = _factor(models[k].K_band, np.zeros(n_dof), f"stiffness of mean state {k + 1}")
-            # static transfer from the y-loads to the reactions, (G K^-1 P)^T = (K^-1 G^T)[y]
-            # K^-1 G^T by the band factor, compiled with the piece newmark (in place, on a copy of
-            # G^T; dpbtrs copies its right-hand sides itself)
-            GT = models[k].G.T
-            TB = np.ascontiguousarray(from_ydof(kernel.solve_columns(c, np.array(GT, order="F")) if compiled
-                                                else _solve(c, np.asfortranarray(GT))))  # (n_free, n_r)
-            all_steps = np.flatnonzero(state_of_step == k)
-            for i0 in range(0, all_steps.size, chunk):
-                steps = all_steps[i0:i0 + chunk]
-                R_B[steps] = kernel.rowdot(
-                    loads[steps].reshape(-1, n_free), TB).reshape(steps.size, n_real, n_r)
-                sk = steps[steps >= second_order_start]
-                if second_order is not None and sk.size:  # the quasi-static displacements themselves
-                    # K^-1 (loads along y or load_dirs) by the band factor; a run of consecutive
-                    # steps (one mean state) as a view of the loads, not a copy
-                    run = slice(int(sk[0]), int(sk[-1]) + 1) if sk[-1] - sk[0] + 1 == sk.size else sk
-                    R_B[run] += second_order_of_loads(second_order[k], loads[run].reshape(-1, n_free), c,
-                                                      load_dirs).reshape(sk.size, n_real, n_r)
-    else:
-        for n in range(n_steps):
-            m, _ = model_of(n)
-            c = _factor(m.K_band, np.zeros(n_dof), f"stiffness at step {n}")
-            UB = _solve(c, loads_full(loads[n]).T).T
-            R_B[n] = rowdot_numpy(UB, m.G.T)
-            if second_order is not None and n >= second_order_start:
-                R_B[n] += so(n, UB)
-
-    # -------- step 2: Newmark, one factorisation per mean state, in node bases that make
-    # M and C diagonal (so that the per-step products are elementwise; see _Stepper)
-    m0, _ = model_of(0)
-    chol = _factor(m0.K_band, np.zeros(n_dof), "stiffness at t = 0")
-    U = _solve(chol, loads_full(loads[0]).T).T  # quasi-static start, (n_real, n_dof), global
-    R_F = np.empty((n_steps, n_real, n_r))
-    R_F[0] = rowdot_numpy(U, m0.G.T)
-    if second_order is not None and second_order_start == 0:
-        R_F[0] += so(0, U)
-    block = max(1, min(512, 2_000_000 // max(n_real * n_dof, 1)))  # steps per block
-    if second_order is not None and compiled:  # the history the second-order tension reads stays
-        # in cache (L2: 512 instead of 3600 KB for case09-six; median run 30-90 ms faster, measured)
-        block = max(1, min(block, SECOND_ORDER_HISTORY // max(n_real * n_dof, 1)))
-    # the numpy loop's history of a block (its reactions and the second-order tension read it);
-    # the compiled loop keeps only what the second-order tension reads, dof-major (n_dof, steps x
-    # realizations), which the second-order pass reads along its rows (so_nodes_t)
-    buf = None if compiled else np.empty((block, n_real, n_dof))
-    hist = np.empty((n_dof, block * n_real if compiled and second_order is not None else 0))
-    # segments: runs of steps under one linear model (one mean state), cut into blocks
-    keys = np.arange(n_steps) if model_at is not None else np.asarray(state_of_step)
-    starts = np.concatenate([[1], 2 + np.flatnonzero(keys[2:] != keys[1:-1])]) if n_steps > 1 else np.zeros(0, int)
-    ends = np.append(starts[1:], n_steps)
-    report = max(1, n_steps // 100)
-    st: _Stepper | None = None
-    V = A = None
-    # the Newmark operators of all mean states in vectorised chunks (issue 20); the
-    # reference scheme (model_at) builds one operator per step instead
-    stacked = (_StackedBases(models, damping, np.asarray(state_of_step)[starts], nm, load_dirs)
-               if model_at is None else None)
-    rot = kernel.rotate  # the change of node bases (compiled when its piece is on)
-    for s0, s1 in zip(starts, ends):
-        if stacked is None:
-            new = _Stepper.build(*model_of(int(s0)), nm, load_dirs)
-        else:
-            new = stacked.get(int(state_of_step[s0]))
-        if st is None:
-            U = rot(U, None, new)
-            V = np.zeros_like(U)
-            A = np.zeros_like(U)  # M a0 = F0 - K u0 - C v0 = 0
-        else:
-            # A rigid insulator: the attachment node has no velocity or acceleration along
-            # the insulator axis (its axial displacement is the static one).  M and C have no
-            # axial part, so the (-1)^n Newmark residue of that algebraic coordinate is
-            # harmless while the axis stays put; it is removed when the mean state (and the
-            # axis) changes, before it could leak into the tangential motion.
-            V[:, st.axial] = 0.0
-            A[:, st.axial] = 0.0
-            U, V, A = (rot(X, st, new) for X in (U, V, A))
-        st = new
-        cu, cv, dm = (x.reshape(1, -1) for x in (st.cu, st.cv, st.dm))  # (1, n): no broadcast set-up per op
-        r2, chat, rest, a1 = st.r2, st.chat, st.rest, st.a1
-        # work arrays, reused every step (the step loop allocates nothing): the new state is
-        # written into U_new, V_new, A_new and the names are swapped with the old ones
-        U, V, A = (np.ascontiguousarray(X) for X in (U, V, A))
-        if not compiled:
-            U_new, V_new, A_new, tmp = (np.empty_like(U) for _ in range(4))
-            rest_product = None if rest is None else _RestProduct(rest, a1, U.shape)
-            solver = ColumnSolver(chat)  # each realization solved as if alone (banded.py)
-        for b0 in range(int(s0), int(s1), block):
-            b1 = min(b0 + block, int(s1))
-            if compiled:  # the same arithmetic as the loop below, compiled (kernel.py)
-                kernel.newmark_block(U, V, A, loads[b0:b1], st.ycoef, st.cu, st.cv, st.dm, st.r2, chat, rest,
-                                     a1, hist, st.nz, st.GT,
-                                     st.cols, R_F[b0:b1])
-                b_range = ()
-            else:
-                Fb = (loads[b0:b1][..., None] * st.ycoef).reshape(b1 - b0, n_real, n_dof)
-                b_range = range(b1 - b0)
-            for k in b_range:
-                # K_hat u_{n+1} = F_{n+1} + M (a0 u + a2 v + a) + C (a1 u + v)   (Bathe Table 9.3)
-                np.multiply(cu, U, out=U_new)
-                np.multiply(cv, V, out=tmp)
-                U_new += tmp
-                np.multiply(dm, A, out=tmp)
-                U_new += tmp
-                U_new += Fb[k]
-                if rest_product is not None:
-                    U_new += rest_product(U, V)  # C~_off (a1 u + v)
-                solver.rows_in_place(U_new)
-                # trapezoidal relations of average acceleration: v' = 2/dt (u' - u) - v,
-                # a' = 2/dt (v' - v) - a  (= a0 (u' - u) - a2 v - a, Bathe Table 9.3)
-                np.subtract(U_new, U, out=V_new)
-                V_new *= r2
-                V_new -= V
-                np.subtract(V_new, V, out=A_new)
-                A_new *= r2
-                A_new -= A
-                U, U_new = U_new, U
-                V, V_new = V_new, V
-                A, A_new = A_new, A
-                buf[k] = U
-            if not compiled:
-                R_F[b0:b1] = st.reactions(buf[: b1 - b0])
-            c0 = max(b0, second_order_start)
-            if second_order is not None and c0 < b1:  # from the node bases, u = T u~ node by node
-                if compiled:  # the dof-major history of the compiled loop
-                    H = hist[:, (c0 - b0) * n_real:(b1 - b0) * n_real]
-                    R2 = second_order_reactions(second_order[int(state_of_step[c0])], H, T=st.T, transposed=True)
-                else:
-                    R2 = second_order_reactions(second_order[int(state_of_step[c0])],
-                                                buf[c0 - b0: b1 - b0].reshape(-1, n_dof), T=st.T)
-                R_F[c0:b1] += R2.reshape(b1 - c0, n_real, n_r)
-            if progress is not None and b1 // report != b0 // report:
-                progress(b1, n_steps)
-            if cancel is not None and cancel.is_set():
-                raise Cancelled("step 2 cancelled")
+    run = _Run(models, damping, state_of_step, loads, Newmark(dt), load_dirs, model_at, second_order,
+               second_order_start, kernel.use("newmark"))
+    R_B = _background(run)  # step 3
+    R_F = _newmark(run, progress, cancel)  # step 2
     if not (np.all(np.isfinite(R_F)) and np.all(np.isfinite(R_B))):
         raise NumericalError("non-finite response in the time integration")
     if direct is not None:
         R_F += direct
         R_B += direct
     if progress is not None:
-        progress(n_steps, n_steps)
-    shape = (n_steps, n_real, n_r // 3, 3)
+        progress(run.n_steps, run.n_steps)
+    shape = (run.n_steps, run.n_real, run.n_r // 3, 3)
     return DynamicResponse(
         fluctuating=np.ascontiguousarray(R_F.reshape(shape).transpose(1, 0, 2, 3)),
         background=np.ascontiguousarray(R_B.reshape(shape).transpose(1, 0, 2, 3)),
     )
+
+
+@dataclass
+class _Run:
+    """What steps 2 and 3 of one :func:`integrate` call share: its arguments, the sizes, and
+    the maps between the free nodes' transverse loads and the DOFs.  Vectors are kept
+    "transposed", shape (n_real, n_dof) C-ordered, i.e. (n_dof, n_real) Fortran-ordered as
+    LAPACK wants them: no copies in the step loop."""
+
+    models: list[LinearModel]
+    damping: np.ndarray  # [N s/m] (n_k, BANDWIDTH + 1, n_dof)
+    state_of_step: np.ndarray  # (n_steps,)
+    loads: np.ndarray  # [N] (n_steps, n_real, n_free)
+    nm: Newmark
+    load_dirs: np.ndarray | None  # [-] (n_free, 3) or None (global y)
+    model_at: Callable[[int], tuple[LinearModel, np.ndarray]] | None
+    second_order: list | None
+    second_order_start: int
+    compiled: bool  # the kernel's piece ``newmark`` (compiled step loop and banded solves)
+
+    def __post_init__(self) -> None:
+        self.n_steps, self.n_real, self.n_free = self.loads.shape
+        self.n_dof = self.models[0].mass.size
+        self.n_r = self.models[0].G.shape[0]
+        self.ydof = 3 * np.arange(self.n_free) + 1  # node-major DOFs: y is the second of each node
+
+    def model_of(self, n: int) -> tuple[LinearModel, np.ndarray]:
+        """Linear model and damping band in force at step n."""
+        if self.model_at is not None:
+            return self.model_at(n)
+        k = int(self.state_of_step[n])
+        return self.models[k], self.damping[k]
+
+    def loads_full(self, f: np.ndarray) -> np.ndarray:
+        """y-loads [N] (m, n_free) -> full transposed right-hand sides (m, n_dof)."""
+        out = np.zeros((f.shape[0], self.n_dof))
+        if self.load_dirs is None:
+            out[:, self.ydof] = f
+        else:  # along every node's load direction
+            out.reshape(f.shape[0], self.n_free, 3)[:] = f[..., None] * self.load_dirs
+        return out
+
+    def from_ydof(self, A: np.ndarray) -> np.ndarray:
+        """Rows of a (n_dof, m) array combined along the load directions -> (n_free, m)."""
+        if self.load_dirs is None:
+            return A[self.ydof]
+        return np.einsum("nca,nc->na", A.reshape(self.n_free, 3, -1), self.load_dirs)
+
+    def so(self, n: int, U: np.ndarray) -> np.ndarray:
+        """[N] second-order reactions (..., n_r) of global displacements U [m] (..., n_dof) under
+        the state of step n."""
+        op = self.second_order[int(self.state_of_step[n])]
+        return second_order_reactions(op, U.reshape(-1, self.n_dof)).reshape(U.shape[:-1] + (self.n_r,))
+
+
+# -------- step 3: the quasi-static background K u_B = F (paper Eq. 14), R_B = G u_B
+
+def _background(run: _Run) -> np.ndarray:
+    """[N] step 3's reactions R_B (n_steps, n_real, n_r): one factorisation per mean state (the
+    static transfer, or on a long line banded solves), or per step with ``model_at``."""
+    R_B = np.empty((run.n_steps, run.n_real, run.n_r))
+    if run.model_at is not None:
+        _background_per_step(run, R_B)
+    elif run.n_dof > BACKGROUND_SOLVE_DOF:
+        _background_solves(run, R_B)
+    else:
+        _background_transfer(run, R_B)
+    return R_B
+
+
+def _background_solves(run: _Run, R_B: np.ndarray) -> None:
+    """A long line: the dense static transfer (n_free x n_r) would cost O(n^2) per step; solve
+    K u_B = P l by the banded Cholesky instead (dpbtrs: column by column, so a realization's bits
+    do not depend on what else is solved) and take G u_B sparsely."""
+    n_dof, n_real, n_r, n_free = run.n_dof, run.n_real, run.n_r, run.n_free
+    per = max(1, max(1, 2_000_000 // n_dof) // max(n_real, 1))  # right-hand sides per solve: ~16 MB
+    for k in np.unique(run.state_of_step):
+        c = _factor(run.models[k].K_band, np.zeros(n_dof), f"stiffness of mean state {k + 1}")
+        sparse_g = _sparse_rows(run.models[k].G)
+        all_steps = np.flatnonzero(run.state_of_step == k)
+        for i0 in range(0, all_steps.size, per):
+            steps = all_steps[i0:i0 + per]
+            if run.compiled and run.second_order is None:  # the same arithmetic, compiled and fused
+                R_B[steps] = kernel.background(c, run.loads[steps].reshape(-1, n_free), run.load_dirs,
+                                               sparse_g).reshape(steps.size, n_real, n_r)
+                continue
+            rhs = run.loads_full(run.loads[steps].reshape(-1, n_free)).T  # (n_dof, m)
+            UB = (kernel.solve_columns(c, rhs) if run.compiled else _solve(c, rhs)).T  # (m, n_dof), global
+            R_B[steps] = _sparse_reactions(UB, *sparse_g).reshape(steps.size, n_real, n_r)
+            sk = steps >= run.second_order_start
+            if run.second_order is not None and sk.any():  # the quasi-static displacements themselves
+                R_B[steps[sk]] += run.so(int(steps[sk][0]), UB.reshape(steps.size, n_real, n_dof)[sk])
+
+
+def _background_transfer(run: _Run, R_B: np.ndarray) -> None:
+    """Step 3 by the static transfer from the y-loads to the reactions, (G K^-1 P)^T =
+    (K^-1 G^T)[y], one per mean state, applied row by row (:func:`kernel.rowdot`)."""
+    n_dof, n_real, n_r, n_free = run.n_dof, run.n_real, run.n_r, run.n_free
+    chunk = max(1, 8192 // max(n_real, 1))
+    for k in np.unique(run.state_of_step):
+        c = _factor(run.models[k].K_band, np.zeros(n_dof), f"stiffness of mean state {k + 1}")
+        # K^-1 G^T by the band factor, compiled with the piece newmark (in place, on a copy of
+        # G^T; dpbtrs copies its right-hand sides itself)
+        GT = run.models[k].G.T
+        TB = np.ascontiguousarray(run.from_ydof(kernel.solve_columns(c, np.array(GT, order="F")) if run.compiled
+                                                else _solve(c, np.asfortranarray(GT))))  # (n_free, n_r)
+        all_steps = np.flatnonzero(run.state_of_step == k)
+        for i0 in range(0, all_steps.size, chunk):
+            steps = all_steps[i0:i0 + chunk]
+            R_B[steps] = kernel.rowdot(run.loads[steps].reshape(-1, n_free), TB).reshape(steps.size, n_real, n_r)
+            sk = steps[steps >= run.second_order_start]
+            if run.second_order is not None and sk.size:  # the quasi-static displacements themselves
+                # K^-1 (loads along y or load_dirs) by the band factor; a run of consecutive
+                # steps (one mean state) as a view of the loads, not a copy
+                rows = slice(int(sk[0]), int(sk[-1]) + 1) if sk[-1] - sk[0] + 1 == sk.size else sk
+                R_B[rows] += second_order_of_loads(run.second_order[k], run.loads[rows].reshape(-1, n_free), c,
+                                                   run.load_dirs).reshape(sk.size, n_real, n_r)
+
+
+def _background_per_step(run: _Run, R_B: np.ndarray) -> None:
+    """Step 3 of the reference scheme (``model_at``): the model of every step factorised."""
+    for n in range(run.n_steps):
+        m, _ = run.model_of(n)
+        c = _factor(m.K_band, np.zeros(run.n_dof), f"stiffness at step {n}")
+        UB = _solve(c, run.loads_full(run.loads[n]).T).T
+        R_B[n] = rowdot_numpy(UB, m.G.T)
+        if run.second_order is not None and n >= run.second_order_start:
+            R_B[n] += run.so(n, UB)
+
+
+# -------- step 2: Newmark (Bathe 1996 Table 9.3), one factorisation per mean state, in node
+# bases that make M and C diagonal (so that the per-step products are elementwise; see _Stepper)
+
+def _newmark(run: _Run, progress: Callable[[int, int], None] | None,
+             cancel: threading.Event | None) -> np.ndarray:
+    """[N] step 2's reactions R_F (n_steps, n_real, n_r): the segments of steps under one
+    linear model, cut into blocks run by the compiled or the numpy stepper (one interface,
+    :class:`_BlockStepper`), the second-order tension added per block."""
+    n_steps, n_real, n_r = run.n_steps, run.n_real, run.n_r
+    m0, _ = run.model_of(0)
+    chol = _factor(m0.K_band, np.zeros(run.n_dof), "stiffness at t = 0")
+    U = _solve(chol, run.loads_full(run.loads[0]).T).T  # quasi-static start, (n_real, n_dof), global
+    R_F = np.empty((n_steps, n_real, n_r))
+    R_F[0] = rowdot_numpy(U, m0.G.T)
+    if run.second_order is not None and run.second_order_start == 0:
+        R_F[0] += run.so(0, U)
+    stepper = (_CompiledSteps if run.compiled else _NumpySteps)(run, U)
+    starts, ends = _segments(run)
+    report = max(1, n_steps // 100)
+    # the Newmark operators of all mean states in vectorised chunks; the reference scheme
+    # (model_at) builds one operator per step instead
+    stacked = (_StackedBases(run.models, run.damping, np.asarray(run.state_of_step)[starts], run.nm, run.load_dirs)
+               if run.model_at is None else None)
+    for s0, s1 in zip(starts, ends):
+        stepper.enter(_Stepper.build(*run.model_of(int(s0)), run.nm, run.load_dirs) if stacked is None
+                      else stacked.get(int(run.state_of_step[s0])))
+        for b0 in range(int(s0), int(s1), stepper.block):
+            b1 = min(b0 + stepper.block, int(s1))
+            stepper.steps(b0, b1, R_F)
+            c0 = max(b0, run.second_order_start)
+            if run.second_order is not None and c0 < b1:  # from the node bases, u = T u~ node by node
+                H, transposed = stepper.history(c0 - b0, b1 - b0)
+                R2 = second_order_reactions(run.second_order[int(run.state_of_step[c0])], H, T=stepper.st.T,
+                                            transposed=transposed)
+                R_F[c0:b1] += R2.reshape(b1 - c0, n_real, n_r)
+            if progress is not None and b1 // report != b0 // report:
+                progress(b1, n_steps)
+            if cancel is not None and cancel.is_set():
+                raise Cancelled("step 2 cancelled")
+    return R_F
+
+
+def _segments(run: _Run) -> tuple[np.ndarray, np.ndarray]:
+    """First and end steps of the runs of steps under one linear model (one mean state; every
+    step with ``model_at``), from step 1 on (step 0 is the quasi-static start)."""
+    n_steps = run.n_steps
+    keys = np.arange(n_steps) if run.model_at is not None else np.asarray(run.state_of_step)
+    starts = np.concatenate([[1], 2 + np.flatnonzero(keys[2:] != keys[1:-1])]) if n_steps > 1 else np.zeros(0, int)
+    return starts, np.append(starts[1:], n_steps)
+
+
+class _BlockStepper:
+    """Newmark's average-acceleration steps of one :func:`integrate` call, block by block: the
+    state U, V, A [m, m/s, m/s²] (n_real, n_dof) of every realization in the node bases of the
+    current segment's :class:`_Stepper` ``st``.  :meth:`enter` changes the segment,
+    :meth:`steps` runs a block and writes its reactions, :meth:`history` gives the block's
+    displacements to the second-order tension."""
+
+    def __init__(self, run: _Run, U: np.ndarray, block: int) -> None:
+        self.run, self.block = run, block
+        self.U, self.V, self.A = U, None, None  # U global until the first segment
+        self.st: _Stepper | None = None
+
+    def enter(self, new: _Stepper) -> None:
+        """Move the state into the node bases of ``new`` (the segment's operator)."""
+        st, rot = self.st, kernel.rotate  # the change of node bases (compiled when its piece is on)
+        if st is None:
+            self.U = rot(self.U, None, new)
+            self.V = np.zeros_like(self.U)
+            self.A = np.zeros_like(self.U)  # M a0 = F0 - K u0 - C v0 = 0
+        else:
+            # A rigid insulator: the attachment node has no velocity or acceleration along
+            # the insulator axis (its axial displacement is the static one).  M and C have no
+            # axial part, so the (-1)^n Newmark residue of that algebraic coordinate is
+            # harmless while the axis stays put; it is removed when the mean state (and the
+            # axis) changes, before it could leak into the tangential motion.
+            self.V[:, st.axial] = 0.0
+            self.A[:, st.axial] = 0.0
+            self.U, self.V, self.A = (rot(X, st, new) for X in (self.U, self.V, self.A))
+        self.st = new
+        self.U, self.V, self.A = (np.ascontiguousarray(X) for X in (self.U, self.V, self.A))
+
+
+class _CompiledSteps(_BlockStepper):
+    """The compiled step loop (:func:`kernel.newmark_block`, piece ``newmark``): the same
+    arithmetic as :class:`_NumpySteps`; it keeps only what the second-order tension reads,
+    dof-major (n_dof, steps x realizations), which the second-order pass reads along its rows."""
+
+    def __init__(self, run: _Run, U: np.ndarray) -> None:
+        n = max(run.n_real * run.n_dof, 1)
+        block = max(1, min(512, 2_000_000 // n))  # steps per block
+        if run.second_order is not None:  # the history the second-order tension reads stays in
+            # cache (L2: 512 instead of 3600 KB for case09-six; median run 30-90 ms faster, measured)
+            block = max(1, min(block, SECOND_ORDER_HISTORY // n))
+        super().__init__(run, U, block)
+        self.hist = np.empty((run.n_dof, block * run.n_real if run.second_order is not None else 0))
+
+    def steps(self, b0: int, b1: int, R_F: np.ndarray) -> None:
+        st = self.st
+        kernel.newmark_block(self.U, self.V, self.A, self.run.loads[b0:b1], st.ycoef, st.cu, st.cv, st.dm, st.r2,
+                             st.chat, st.rest, st.a1, self.hist, st.nz, st.GT, st.cols, R_F[b0:b1])
+
+    def history(self, i0: int, i1: int) -> tuple[np.ndarray, bool]:
+        """Displacements of the block's steps i0..i1 in the node bases, dof-major (transposed)."""
+        n_real = self.run.n_real
+        return self.hist[:, i0 * n_real:i1 * n_real], True
+
+
+class _NumpySteps(_BlockStepper):
+    """The numpy step loop: work arrays reused every step (the loop allocates nothing), the new
+    state written into U_new, V_new, A_new and the names swapped with the old ones; the block's
+    history kept row-major for its reactions and the second-order tension."""
+
+    def __init__(self, run: _Run, U: np.ndarray) -> None:
+        super().__init__(run, U, max(1, min(512, 2_000_000 // max(run.n_real * run.n_dof, 1))))
+        self.buf = np.empty((self.block, run.n_real, run.n_dof))
+
+    def enter(self, new: _Stepper) -> None:
+        super().enter(new)
+        U, rest = self.U, new.rest
+        self.work = tuple(np.empty_like(U) for _ in range(4))  # U_new, V_new, A_new, tmp
+        self.rest_product = None if rest is None else _RestProduct(rest, new.a1, U.shape)
+        self.solver = ColumnSolver(new.chat)  # each realization solved as if alone (banded.py)
+
+    def steps(self, b0: int, b1: int, R_F: np.ndarray) -> None:
+        st, buf, rest_product, solver = self.st, self.buf, self.rest_product, self.solver
+        cu, cv, dm = (x.reshape(1, -1) for x in (st.cu, st.cv, st.dm))  # (1, n): no broadcast set-up per op
+        r2 = st.r2
+        U, V, A = self.U, self.V, self.A
+        U_new, V_new, A_new, tmp = self.work
+        Fb = (self.run.loads[b0:b1][..., None] * st.ycoef).reshape(b1 - b0, self.run.n_real, self.run.n_dof)
+        for k in range(b1 - b0):
+            # K_hat u_{n+1} = F_{n+1} + M (a0 u + a2 v + a) + C (a1 u + v)   (Bathe Table 9.3)
+            np.multiply(cu, U, out=U_new)
+            np.multiply(cv, V, out=tmp)
+            U_new += tmp
+            np.multiply(dm, A, out=tmp)
+            U_new += tmp
+            U_new += Fb[k]
+            if rest_product is not None:
+                U_new += rest_product(U, V)  # C~_off (a1 u + v)
+            solver.rows_in_place(U_new)
+            # trapezoidal relations of average acceleration: v' = 2/dt (u' - u) - v,
+            # a' = 2/dt (v' - v) - a  (= a0 (u' - u) - a2 v - a, Bathe Table 9.3)
+            np.subtract(U_new, U, out=V_new)
+            V_new *= r2
+            V_new -= V
+            np.subtract(V_new, V, out=A_new)
+            A_new *= r2
+            A_new -= A
+            U, U_new = U_new, U
+            V, V_new = V_new, V
+            A, A_new = A_new, A
+            buf[k] = U
+        self.U, self.V, self.A = U, V, A
+        self.work = (U_new, V_new, A_new, tmp)
+        R_F[b0:b1] = st.reactions(buf[: b1 - b0])
+
+    def history(self, i0: int, i1: int) -> tuple[np.ndarray, bool]:
+        """Displacements of the block's steps i0..i1 in the node bases, (m, n_dof)."""
+        return self.buf[i0:i1].reshape(-1, self.run.n_dof), False
 
 
 def rowdot_numpy(X: np.ndarray, BT: np.ndarray) -> np.ndarray:
@@ -354,60 +451,6 @@ def rowdot_numpy(X: np.ndarray, BT: np.ndarray) -> np.ndarray:
     workers); a BLAS gemm rounds differently for different numbers of rows.  X is made
     C-contiguous first: einsum sums a contiguous row in another order than a strided one."""
     return np.einsum("rd,dk->rk", np.ascontiguousarray(X), BT, optimize=False)
-
-
-def node_bases(model: LinearModel, c_band: np.ndarray) -> np.ndarray:
-    """Per-node orthonormal bases in which M and the node blocks of C are diagonal.
-
-    A free node's mass is isotropic (m I), so the eigenvectors of its 3x3 damping block
-    diagonalise both.  At a suspension attachment node the mass and damping are projected
-    normal to the insulator axis a (rigid insulator): the basis is (t1, t2, a) with t1, t2
-    the eigenvectors of the in-plane 2x2 damping block.
-
-    Returns: [-] bases as columns (local axes in global coordinates), shape (n_nodes, 3, 3).
-    """
-    D, _ = band_blocks(c_band)
-    _, T = np.linalg.eigh(D)
-    if model.axial_dof.size:
-        k = model.axial_dof // 3
-        a = model.axes / np.linalg.norm(model.axes, axis=1)[:, None]
-        h = np.where(np.abs(a[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
-        t1 = np.cross(a, h)
-        t1 /= np.linalg.norm(t1, axis=1)[:, None]
-        t2 = np.cross(a, t1)
-        Q = np.stack([t1, t2], axis=2)  # (n_s, 3, 2) orthonormal basis of the plane
-        _, W = np.linalg.eigh(np.einsum("sai,sab,sbj->sij", Q, D[k], Q))
-        T[k] = np.concatenate([np.einsum("sai,sij->saj", Q, W), a[:, :, None]], axis=2)
-    return T
-
-
-def node_bases_stack(models: list[LinearModel], c_bands: np.ndarray) -> np.ndarray:
-    """:func:`node_bases` of many mean states of one system in one vectorised pass (issue 20):
-    the eigen-decompositions of all states' 3x3 node blocks in one batched LAPACK call;
-    bit-identical to calling it state by state.
-
-    Args:
-        models: linear models of the states (one system: same DOF map), length n_k.
-        c_bands: [N s/m] their damping bands, shape (n_k, BANDWIDTH + 1, n_dof).
-
-    Returns: [-] bases, shape (n_k, n_nodes, 3, 3).
-    """
-    D, _ = band_blocks(c_bands)  # (n_k, n_nodes, 3, 3)
-    _, T = np.linalg.eigh(D)
-    axial_dof = models[0].axial_dof
-    if axial_dof.size:
-        n_k, n_s = len(models), axial_dof.size
-        k = axial_dof // 3
-        axes = np.stack([m.axes for m in models]).reshape(-1, 3)  # (n_k n_s, 3): as node_bases, flattened
-        a = axes / np.linalg.norm(axes, axis=1)[:, None]
-        h = np.where(np.abs(a[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
-        t1 = np.cross(a, h)
-        t1 /= np.linalg.norm(t1, axis=1)[:, None]
-        t2 = np.cross(a, t1)
-        Q = np.stack([t1, t2], axis=2)  # (n_k n_s, 3, 2) orthonormal basis of the plane
-        _, W = np.linalg.eigh(np.einsum("sai,sab,sbj->sij", Q, D[:, k].reshape(-1, 3, 3), Q))
-        T[:, k] = np.concatenate([np.einsum("sai,sij->saj", Q, W), a[:, :, None]], axis=2).reshape(n_k, n_s, 3, 3)
-    return T
 
 
 def _rotated_stack(models: list[LinearModel], c_bands: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -601,40 +644,14 @@ def st_rotate(X: np.ndarray, old: _Stepper | None, new: _Stepper) -> np.ndarray:
 # ---- the compiled kernel's pieces ``newmark``, ``rotate`` and ``rowdot`` (linecheck.core.kernel):
 # their load checks and numpy forms
 
-def _band_check_system(rng, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """A random diagonally dominant banded SPD matrix (upper band storage, (BANDWIDTH + 1, n);
-    condition ≲ 10) and its Cholesky factor (LAPACK ``dpbtrf``)."""
-    kd = BANDWIDTH
-    ab = np.zeros((kd + 1, n))
-    for off in range(kd + 1):
-        ab[kd - off, off:] = rng.uniform(-1.0, 1.0, max(n - off, 0))
-    ab[kd] = 4.0 * (kd + 1) + rng.uniform(0.0, 1.0, n)
-    c, info = lapack.dpbtrf(ab, lower=0)
-    if info != 0:  # pragma: no cover - diagonally dominant by construction
-        raise NumericalError("load check: test matrix not positive definite")
-    return ab, c
-
-
 def _newmark_check(fns) -> float:
-    """The compiled banded solves (four lanes, one vector, a short system) against LAPACK
-    ``dpbtrs``, the structural-damping remainder by diagonals against scipy's CSR product; the
-    largest relative difference."""
+    """The compiled banded solves against LAPACK (:func:`~linecheck.core.banded.band_solve_pairs`) and the
+    structural-damping remainder by diagonals (``fns.rest_product``) against scipy's CSR product
+    (:class:`_RestProduct`'s numpy form); the largest relative difference."""
     rng = np.random.default_rng(20)
     pairs = []
     for n in (60, 4):
-        ab, c = _band_check_system(rng, n)
-        B = rng.standard_normal((4, n))
-        ref = lapack.dpbtrs(c, np.asfortranarray(B.T), lower=0)[0]
-        X = np.ascontiguousarray(B.T)[None]  # one group of four lanes
-        fns.band_solve(c, X)
-        pairs.append((ref, X[0]))
-        for q in range(4):
-            x = B[q].copy()
-            fns.band_solve_1(c, x)
-            pairs.append((ref[:, q], x))
-        cols = np.array(B.T)
-        fns.solve_columns(c, cols)
-        pairs.append((ref, cols))
+        ab = rng.uniform(-1.0, 1.0, (BANDWIDTH + 1, n))
         ab[BANDWIDTH] = 0.0  # an off-diagonal remainder, with some exact zeros
         ab[rng.random(ab.shape) < 0.2] = 0.0
         rest = band_to_csr(ab)
@@ -642,7 +659,7 @@ def _newmark_check(fns) -> float:
         t = np.empty((4, n))
         fns.rest_product(rest.band, np.pad(W, ((0, 0), (BANDWIDTH, BANDWIDTH))), t)
         pairs.append(((rest.tocsr() @ W.T).T, t))
-    return kernel.worst_difference(pairs)
+    return kernel.worst_difference(band_solve_pairs(fns, BANDWIDTH) + pairs)
 
 
 def _rotate_check(fns) -> float:

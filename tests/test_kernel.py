@@ -483,8 +483,8 @@ def test_wind_spectrum_agrees(monkeypatch, name):
 @needs_kernel
 @pytest.mark.parametrize("name, drag", [("paper/case09-six", "linear"), ("paper/case05-six", "quadratic")])
 def test_drag_loads_agree(monkeypatch, name, drag):
-    """The fluctuating drag on the free nodes (paper Eq. 5, and the quadratic drag's v² term of
-    issue 16) compiled in one pass (kernel.drag_loads) against the numpy loop."""
+    """The fluctuating drag on the free nodes (paper Eq. 5, and the quadratic drag's v² term)
+    compiled in one pass (kernel.drag_loads) against the numpy loop."""
     from linecheck.core.model import build_model
     from linecheck.core.wind.turbulence import fluctuating_velocity
 

@@ -24,7 +24,7 @@ def phasors(phases, xr, xi):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, nogil=True)
 def coherent_spectrum(xr_, xi_, rho_rows, s_rows, row_of_gap, amp, scale, spec):  # pragma: no cover - compiled
-    """The wind synthesis' spectrum of ordered nodes in one pass (issue 20): from the unit phasors
+    """The wind synthesis' spectrum of ordered nodes in one pass: from the unit phasors
     xi = exp(i phi) (:func:`phasors`: xr_ + i xi_), the Markov (equal gaps: KMS) recursion
     y_0 = xi_0, y_j = rho y_(j-1) + s xi_j along the nodes with the coefficient row of gap j - 1,
     and spec[j, k + 1] = scale (amp_k y_jk), as numpy's form (turbulence.synthesize): a real
@@ -59,7 +59,7 @@ def coherent_spectrum(xr_, xi_, rho_rows, s_rows, row_of_gap, amp, scale, spec):
 def drag_loads(pv, pq, s2, v, s0, quad, loads):  # pragma: no cover - compiled
     """The fluctuating drag on the free nodes (service.fluctuating_loads), as the numpy form:
     loads[t, i, f] = pv[t, f] v[i, t, s0 + f] (paper Eq. 5), plus ((v^2 - s2) pq) with the
-    quadratic drag (issue 16), each product and sum rounded by itself.  pv, pq, s2 (n_steps,
+    quadratic drag, each product and sum rounded by itself.  pv, pq, s2 (n_steps,
     n_free); v (n_real, n_steps, n_nodes), the free nodes s0 .. s0 + n_free - 1; loads
     (n_steps, n_real, n_free)."""
     n_real, n_steps = v.shape[0], v.shape[1]

@@ -6,7 +6,7 @@ and C(t) taken from the step-1 mean state in force at each time step.  Step 3
 (paper Eq. 14): K(t) u = F_w(t) gives the background B; the resonant part is
 R = F - B.
 
-Structure exploited (issue 4): K, C and M are banded (half-bandwidth 5, 3x3 node
+Structure exploited: K, C and M are banded (half-bandwidth 5, 3x3 node
 blocks); the recurrence is stepped in per-node bases in which M and the aerodynamic C
 are diagonal (:func:`node_bases`), so that the per-step products are elementwise;
 K_hat = K + 2/dt C + 4/dt^2 M is factorised once per mean state (banded Cholesky,
@@ -64,7 +64,7 @@ class Newmark:
 #: reads it (512 KB: it stays in the core's L2 cache between the steps and the second-order pass)
 SECOND_ORDER_HISTORY = 65536
 #: above this many DOFs step 3 solves the banded stiffness every step instead of applying the
-#: dense static transfer matrix (O(n) instead of O(n^2) per step; issue 20); the two agree to
+#: dense static transfer matrix (O(n) instead of O(n^2) per step); the two agree to
 #: rounding (tests), and smaller systems keep the transfer matrix (bit-identical to before)
 BACKGROUND_SOLVE_DOF = 600
 
@@ -525,7 +525,7 @@ class _Stepper:
               load_dirs: np.ndarray | None = None) -> list[_Stepper]:
         """The operators of many mean states of one system from their node bases T and rotated
         bands K~, C~ (:func:`_rotated_stack`, each with a leading axis of n_k), in vectorised passes
-        over the states (issue 20: ≈ 0.7 ms per state built one by one, 250 states in a downburst
+        over the states (≈ 0.7 ms per state built one by one, 250 states in a downburst
         run) and one ``dpbtrf`` per state; elementwise along the states, so a state's operator
         does not depend on the others (tested)."""
         n_k = len(models)
@@ -574,7 +574,7 @@ class _RestProduct:
     The same arithmetic as ``(rest @ (a1 * U + V).T).T`` -- scipy's CSR kernel ``csr_matvecs``
     on the same C-ordered copy of the transposed vectors into a zeroed result -- so the same
     bits (tested), without the ≈ 25 µs of Python dispatch per call that made it the costliest
-    line of the loop with quasi-steady damping (issue 20).  Falls back to the public product."""
+    line of the loop with quasi-steady damping.  Falls back to the public product."""
 
     def __init__(self, rest, a1: float, shape: tuple[int, int]):
         self.rest, self.a1 = rest, a1
@@ -624,7 +624,7 @@ def _sparse_reactions(U: np.ndarray, nz: np.ndarray, GT: np.ndarray, cols: np.nd
     """[N] G u for vectors U (..., n_dof) -> (..., n_r), accumulated coordinate by coordinate in
     a fixed order: elementwise only, so every realization's reactions are bit-identical whatever
     else shares the array (no BLAS blocking).  Each coordinate updates only the columns where
-    its row is non-zero (issue 20: O(n) instead of O(n^2) on a long line); the skipped terms are
+    its row is non-zero (O(n) instead of O(n^2) on a long line); the skipped terms are
     exact zeros, so the sums are the same bits as over every column."""
     out = np.zeros(U.shape[:-1] + (GT.shape[1],))
     for d, g, (a, b) in zip(nz, GT, cols):

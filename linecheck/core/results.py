@@ -3,7 +3,7 @@
 Every statistic is computed per realization on the wind-induced response
 (total minus still air) and kept as an array of shape (n_real, n_towers, 3),
 last axis (R_x, R_y, R_z); :meth:`Statistics.mean` / :meth:`Statistics.std`
-summarise over realizations.  Definitions (issue 4):
+summarise over realizations.  Definitions (paper Eqs 15-17):
 
 - mean_max = max_t |M(t)|  (M: step-1 mean reaction, wind-induced)
 - rms_background = sqrt(mean_t B^2), rms_resonant = sqrt(mean_t R^2),
@@ -52,7 +52,7 @@ STATISTICS = (
     "peak_normalised_total",
 )
 ZERO_MEAN_RTOL = 0.01
-#: Peak statistics: summarised with a Gumbel fit and a design value (issue 18).
+#: Peak statistics: summarised with a Gumbel fit and a design value.
 PEAK_STATISTICS = (
     "peak_quasi_static",
     "peak_dynamic",
@@ -61,14 +61,14 @@ PEAK_STATISTICS = (
     "peak_normalised",
     "peak_normalised_total",
 )
-#: Statistics reported with a 95 % confidence interval of their mean (issue 18).
+#: Statistics reported with a 95 % confidence interval of their mean.
 CI_STATISTICS = ("GF_Dy", "GF_QS", "Cont_R")
 
 
 @dataclass(frozen=True)
 class Statistics:
     """Per-realization statistics; every field has shape (n_samples, n_towers, 3), n_samples =
-    n_real x n_windows (realization-major) when peaks are taken per window (issue 18).
+    n_real x n_windows (realization-major) when peaks are taken per window.
 
     Forces in [N]; GF and Cont are ratios (Cont as fractions, 0.042 = 4.2 %).
     """
@@ -128,7 +128,7 @@ def compute_statistics(
 ) -> Statistics:
     """Statistics of Eqs 15-17 from response histories.
 
-    With ``window`` (samples, issue 18 ``analysis.peak_window``) the record is cut into
+    With ``window`` (samples, ``analysis.peak_window``) the record is cut into
     n_w = (n_t - 1) // window consecutive windows of ``window`` samples (a remainder shorter
     than a window at the end is dropped) and every statistic is taken per window: the result
     has n_real x n_w samples, realization-major.  ``window`` None or >= n_t - 1 steps: the
@@ -172,7 +172,7 @@ def compute_statistics(
         cont_bg = np.where(pk_dy > 0, (pk_qs - mean_max) / pk_dy, np.nan)
         cont_r = np.where(pk_dy > 0, (pk_dy - pk_qs) / pk_dy, np.nan)
         g = np.asarray(g_yp_L, dtype=float)
-        gL = g[:, None] if g.ndim else g_yp_L  # per tower (a section's L_x differs, issue 17)
+        gL = g[:, None] if g.ndim else g_yp_L  # per tower (a section's L_x differs)
         norm = pk_dy / gL if np.all(g > 0) else np.full_like(pk_dy, np.nan)
         norm_t = pk_dy_t / gL if np.all(g > 0) else np.full_like(pk_dy, np.nan)
     return Statistics(
@@ -229,7 +229,7 @@ class StatisticSummary:
 
 @dataclass(frozen=True)
 class ResultSummary:
-    """Every statistic summarised (issue 18) and the three-state Cont_R flag.
+    """Every statistic summarised and the three-state Cont_R flag.
 
     Attributes:
         statistics: name -> :class:`StatisticSummary` for every name of :data:`STATISTICS`.
@@ -245,7 +245,7 @@ class ResultSummary:
 
 
 def summarise_statistics(stats: Statistics, still_air: np.ndarray, design_fractile: float = 0.5) -> ResultSummary:
-    """Summaries, Gumbel fits of the peaks, 95 % intervals and the Cont_R flag (issue 18).
+    """Summaries, Gumbel fits of the peaks, 95 % intervals and the Cont_R flag.
 
     Args:
         stats: per-sample statistics, fields (n_samples, n_towers, 3).

@@ -1,4 +1,4 @@
-"""Second-order tension: the reaction increment quadratic in the linear motion (issue 16).
+"""Second-order tension: the reaction increment quadratic in the linear motion.
 
 The linear model (paper Eq. 7) keeps the element forces to first order in the nodal
 displacements.  A cable element (or insulator) of chord c = L_e e, tension N and axial
@@ -118,7 +118,7 @@ def second_order_operator(model: LinearModel, state: StaticState) -> SecondOrder
     e_el = seg / Le[:, None]
     c_el = (line.ea - state.element_tension) / Le**2  # (EA - N)/L_e^2, k L_e = EA (Eq. 7)
     sus = np.flatnonzero(system.suspension)
-    v = system.insulator_lengths[sus]  # per tower (issue 17)
+    v = system.insulator_lengths[sus]  # per tower
     k_ax = INSULATOR_AXIAL_FACTOR * line.ea / float(system.element_unstretched_lengths.min())  # as model.py
     c_in = (k_ax * v - state.insulator_force[sus]) / v**2
     n_el, n_s = e_el.shape[0], sus.size

@@ -26,7 +26,7 @@ C_jm = rho^|j-m| with rho = exp(-C f dx / V) (Kac-Murdock-Szego matrix), whose
 Cholesky factor is closed form (L_j0 = rho^j, L_jm = rho^(j-m) sqrt(1 - rho^2)): applying
 it is the AR(1) recursion y_j = rho y_(j-1) + sqrt(1 - rho^2) xi_j, O(N) per frequency
 and vectorised over frequencies.  Ordered points at any spacing (a line section of unequal
-spans, issue 17) use the same recursion with a coefficient per gap, rho_j = exp(-C f ds_j / V)
+spans) use the same recursion with a coefficient per gap, rho_j = exp(-C f ds_j / V)
 (:func:`markov_apply`): exponential coherence along ordered points is Markov, so the
 coherence of nodes j < m is the product of the gap coefficients, exp(-C f (x_m - x_j) / V),
 exactly the Davenport coherence at the separation measured along the line.  The dense
@@ -394,7 +394,7 @@ def synthesize(x: np.ndarray, grid: SpectralGrid, phases: np.ndarray | UnitPhase
     if spec is None:
         spec = fft_input(y, grid.amplitude, m)
     # one contiguous transform per node (pocketfft gives each 1-D transform the same bits whatever
-    # the layout; along the contiguous axis it is ~25 % faster than along axis 0; issue 20)
+    # the layout; along the contiguous axis it is ~25 % faster than along axis 0)
     return np.ascontiguousarray(sfft.irfft(spec, n=m, axis=1)[:, : grid.n_steps].T)
 
 
@@ -405,7 +405,7 @@ def unit_field(case: Case, system: LineSystem, n_steps: int, dt: float, realizat
     n_steps samples at dt [s]; realization: 0-based index.  Returns shape (n_steps, n_nodes).
     Bit-identical for the same case, seed, n_steps, dt and realization.
     Points: the nodes' still-air x (equal-span form) or stations, the distance along the line
-    (section form, issue 17: the Markov path; see :func:`markov_apply`).  The coherence uses
+    (section form: the Markov path; see :func:`markov_apply`).  The coherence uses
     the one speed V_ref whatever the profile (docs/wind.md, "Sections").
     """
     x = system.node_station if system.is_section else system.node_x0
@@ -426,7 +426,7 @@ def unit_phases(seed: int, realization: int, n_nodes: int, n_freq: int) -> UnitP
     per process like the unit fields (:data:`UNIT_FIELD_MEMO_BYTES`, least recently used first
     out).  They depend on the seed, the realization, the node count and the grid only: the
     positions of a one-storm scan, whose unit fields differ (V_ref at p changes the spectrum and
-    coherence), share them (issue 20: the sines and cosines were ≈ 0.1 s of a ten-realization
+    coherence), share them (the sines and cosines were ≈ 0.1 s of a ten-realization
     position), and so do cases of a batch with the same seed, nodes and record.  The same bits
     as computing them afresh (deterministic)."""
     key = (int(seed), int(realization), int(n_nodes), int(n_freq))
@@ -491,7 +491,7 @@ def fluctuating_velocity(case: Case, system: LineSystem, time: np.ndarray, reali
     return out
 
 
-#: [bytes] unit fields kept per process for reuse (issue 20: scans); the environment variable
+#: [bytes] unit fields kept per process for reuse (scans); the environment variable
 #: LINECHECK_UNIT_FIELD_MEMO overrides it (0: off; the bench scripts time fresh runs with it)
 UNIT_FIELD_MEMO_BYTES = float(os.environ.get("LINECHECK_UNIT_FIELD_MEMO", "256e6"))
 _memo: dict[tuple, np.ndarray] = {}
@@ -502,7 +502,7 @@ def _unit_field_memo(case: Case, system: LineSystem, n_steps: int, dt: float, re
     """:func:`unit_field`, remembered per process (read-only, least recently used first out,
     at most :data:`UNIT_FIELD_MEMO_BYTES`).  The unit field depends only on the node positions,
     V_ref, L_u, the coherence decay, the seed, the realization and the record grid, not on the
-    running mean: a critical-downburst scan's positions share it (issue 20), and a repeated
+    running mean: a critical-downburst scan's positions share it, and a repeated
     run reuses it.  The same bits as computing it afresh (it is deterministic)."""
     x = system.node_station if system.is_section else system.node_x0
     key = (x.tobytes(), bool(system.is_section), float(case.wind.v_ref), float(length_scale(case)),

@@ -53,6 +53,37 @@ def with_provenance(doc: dict[str, Any]) -> dict[str, Any]:
     return {**doc, "provenance": provenance().to_json()}
 
 
+def _static_tower(case: Any, system: Any, m: Any, R: np.ndarray, R0: np.ndarray, j: int, pick: Any) -> dict[str, Any]:
+    """Tower ``j`` (0-based) of the step-1 JSON: support, section metadata, reactions [N] in its own
+    frame (total, wind-induced, still air), displacements [m] and on a section the global frame."""
+    still = m.still_air
+    t: dict[str, Any] = {"index": j + 1, "support": case.line.supports[j]}
+    if system.is_section:
+        tw = case.line.towers[j]
+        t.update(name=tw.name, station=_num(system.stations[j]), ground=tw.ground, height=tw.height,
+                 angle=tw.angle, heading=_num(np.degrees(system.tower_headings[j])))
+    t.update({
+        "Rx": pick(R[:, j, 0]),
+        "Ry": pick(R[:, j, 1]),
+        "Rz": pick(R[:, j, 2]),
+        "Rx_wind": pick(R[:, j, 0] - R0[j, 0]),
+        "Ry_wind": pick(R[:, j, 1] - R0[j, 1]),
+        "Rz_wind": pick(R[:, j, 2] - R0[j, 2]),
+        "Rx_still_air": _num(R0[j, 0]),
+        "Ry_still_air": _num(R0[j, 1]),
+        "Rz_still_air": _num(R0[j, 2]),
+        "dx": pick(m.displacement[:, j, 0]),
+        "dy": pick(m.displacement[:, j, 1]),
+        "dz": pick(m.displacement[:, j, 2]),
+    })
+    if system.is_section:  # the global frame too (x along the first span, y to its left, z down)
+        t["global"] = {"Rx": pick(m.reactions[:, j, 0]), "Ry": pick(m.reactions[:, j, 1]),
+                       "Rz": pick(m.reactions[:, j, 2]),
+                       "Rx_still_air": _num(still.reactions[j, 0]), "Ry_still_air": _num(still.reactions[j, 1]),
+                       "Rz_still_air": _num(still.reactions[j, 2])}
+    return t
+
+
 def static_to_dict(res: StaticResult) -> dict[str, Any]:
     """Step-1 JSON: ``{"case", "units", "tower_of_interest", "towers": [...], "spans": [...],
     "provenance"}``.
@@ -70,33 +101,7 @@ def static_to_dict(res: StaticResult) -> dict[str, Any]:
     # every tower's reactions in its own frame (the equal-span form: the global frame)
     R = system.to_tower_frames(m.reactions)
     R0 = system.to_tower_frames(still.reactions)
-    towers = []
-    for j in range(system.n_towers):
-        t: dict[str, Any] = {"index": j + 1, "support": case.line.supports[j]}
-        if system.is_section:
-            tw = case.line.towers[j]
-            t.update(name=tw.name, station=_num(system.stations[j]), ground=tw.ground, height=tw.height,
-                     angle=tw.angle, heading=_num(np.degrees(system.tower_headings[j])))
-        t.update({
-            "Rx": pick(R[:, j, 0]),
-            "Ry": pick(R[:, j, 1]),
-            "Rz": pick(R[:, j, 2]),
-            "Rx_wind": pick(R[:, j, 0] - R0[j, 0]),
-            "Ry_wind": pick(R[:, j, 1] - R0[j, 1]),
-            "Rz_wind": pick(R[:, j, 2] - R0[j, 2]),
-            "Rx_still_air": _num(R0[j, 0]),
-            "Ry_still_air": _num(R0[j, 1]),
-            "Rz_still_air": _num(R0[j, 2]),
-            "dx": pick(m.displacement[:, j, 0]),
-            "dy": pick(m.displacement[:, j, 1]),
-            "dz": pick(m.displacement[:, j, 2]),
-        })
-        if system.is_section:  # the global frame too (x along the first span, y to its left, z down)
-            t["global"] = {"Rx": pick(m.reactions[:, j, 0]), "Ry": pick(m.reactions[:, j, 1]),
-                           "Rz": pick(m.reactions[:, j, 2]),
-                           "Rx_still_air": _num(still.reactions[j, 0]), "Ry_still_air": _num(still.reactions[j, 1]),
-                           "Rz_still_air": _num(still.reactions[j, 2])}
-        towers.append(t)
+    towers = [_static_tower(case, system, m, R, R0, j, pick) for j in range(system.n_towers)]
     spans = []
     for n in range(system.n_spans):
         sp = {

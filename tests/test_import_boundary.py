@@ -28,6 +28,8 @@ CORE_MODULES = [
     "linecheck.core.modes",
     "linecheck.core.budget",
     "linecheck.core.spectral",
+    "linecheck.core.complex_modes",
+    "linecheck.core.gust_factor",
     "linecheck.core.codes",
     "linecheck.core.kernel",
     "linecheck.core.second_order",

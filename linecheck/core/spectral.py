@@ -1,7 +1,7 @@
-"""Frequency-domain check of synoptic cases (issue 5).
+"""Frequency-domain check of synoptic cases: estimate 1, exact linear random vibration.
 
-Estimate 1 -- exact linear random vibration of the same linearised model as the time
-domain (step-1 mean state K, lumped M, the case's damping C):
+Exact linear random vibration of the same linearised model as the time domain (step-1
+mean state K, lumped M, the case's damping C):
 
     S_r(n) = S_v(n) * w(n)^H Coh(n) w(n),   w_i = t_i(n) a_i,
 
@@ -14,23 +14,17 @@ t_i(n) the reaction per unit load at node i:
     t_R    = t_F - t_B                                       (resonant, R = F - B)
 
 (G, D: reaction maps of :mod:`linecheck.core.model`; P: y-DOF loading), evaluated by
-complex modal superposition (:class:`ModalTransfer`) or, for large systems and as the
-cross-check, by direct block-tridiagonal solves (:func:`dynamic_solve`).  The
-variances integrate S_r over the band that the time-domain synthesis contains
-(1/T_record .. 1/(2 dt)), on a logarithmic grid refined around every lightly damped
-complex pole (tan-spaced points, exact for Lorentzian peaks).  Expected peaks use
-Davenport's (1964) peak factor g = sqrt(2 ln nu T) + 0.5772 / sqrt(2 ln nu T),
+complex modal superposition (:class:`ModalTransfer`, over the modes of
+:mod:`linecheck.core.complex_modes`) or, for large systems and as the cross-check, by direct
+block-tridiagonal solves (:func:`dynamic_solve`).  The variances integrate S_r over the band
+that the time-domain synthesis contains (1/T_record .. 1/(2 dt)), on a logarithmic grid refined
+around every lightly damped complex pole (tan-spaced points, exact for Lorentzian peaks).
+Expected peaks use Davenport's (1964) peak factor g = sqrt(2 ln nu T) + 0.5772 / sqrt(2 ln nu T),
 nu = sqrt(m2/m0) from the spectral moments of the response.
 
-Estimate 2 -- closed-form Davenport / Castanheta gust response factor for the
-transverse reaction (Davenport 1979; Castanheta 1971 via Matheson & Holmes 1981):
-
-    GF = 1 + 2 g I sqrt(B + R),
-    B = int S_v(n)/sigma^2 |J(n)|^2 dn,  |J|^2 = 2/eta - 2 (1 - e^-eta)/eta^2,  eta = C n L / V,
-    R = pi f1 S_v(f1) / (4 zeta_a sigma^2) |J(f1)|^2,  zeta_a = rho C_d D V / (4 pi f1 m),
-
-and the ASCE Manual 74 (2010) wire gust response factor for comparison.
-Formulas and sources are collected in docs/method.md.
+Estimate 2, the closed-form Davenport / Castanheta gust response factor, is
+:mod:`linecheck.core.gust_factor`; this module re-exports it, the spectrum, the peak factor
+and the complex modes for its callers.  Formulas and sources are collected in docs/method.md.
 """
 
 from __future__ import annotations
@@ -38,157 +32,21 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import eig, lapack, solve_banded
+from scipy.linalg import lapack, solve_banded
 
+from .complex_modes import LARGE_SYSTEM_DOF as LARGE_SYSTEM_DOF
+from .complex_modes import ComplexModes as ComplexModes
+from .complex_modes import StateEigen as StateEigen
+from .complex_modes import complex_modes as complex_modes
 from .errors import NumericalError
-from .model import BANDWIDTH, LinearModel, band_blocks, blocks_to_band, condensed, reaction_matrix_direct
-from .wind.turbulence import von_karman_cumulative, von_karman_psd
-
-EULER_GAMMA = 0.5772156649
-
-
-# --------------------------------------------------------------------------- wind spectrum
-def von_karman(n: np.ndarray, sigma: float, length_scale: float, v_mean: float) -> np.ndarray:
-    """One-sided von Karman spectrum S_v(n) [m^2/s^2/Hz] (von Karman 1948; the same
-    function the time-domain synthesis uses, :func:`~linecheck.core.wind.turbulence.von_karman_psd`)."""
-    return sigma**2 * von_karman_psd(n, length_scale, v_mean)
-
-
-def peak_factor(nu: np.ndarray | float, duration: float) -> np.ndarray:
-    """Davenport (1964) expected peak factor g = sqrt(2 ln nu T) + 0.5772/sqrt(2 ln nu T)."""
-    a = np.sqrt(2.0 * np.log(np.maximum(np.asarray(nu, dtype=float) * duration, 1.0 + 1e-12)))
-    return a + EULER_GAMMA / a
-
-
-# --------------------------------------------------------------------------- complex modes
-@dataclass(frozen=True)
-class ComplexModes:
-    """Damped modes of M u'' + C u' + K u = 0 (state-space eigenproblem), Im(lambda) > 0.
-
-    Attributes:
-        frequencies_hz: [Hz] undamped-equivalent natural frequency |lambda|/(2 pi), (n,).
-        damping_ratio: [-] zeta = -Re(lambda)/|lambda|, (n,).
-        poles: complex eigenvalues lambda, (n,).
-        right: displacement half of the state eigenvectors psi_k (psi = [phi; lambda phi]),
-            (n_t, n), or None, in the condensed coordinates t of
-            :func:`~linecheck.core.model.condensed` (u = S t).
-        left: velocity half of the left state eigenvectors chi_k (chi^H A = lambda chi^H,
-            chi = conj([(lambda M + C) phi; M phi])), (n_t, n), or None.
-        norm: chi_k^H psi_k, (n,), or None (the modal projections divide by it).
-        S: [-] condensed-to-full DOF map (n_dof, n_t), or None.
-        mass: [kg] condensed (diagonal) mass, (n_t,), or None.
-        expansion: every eigenpair of the state matrix, unfiltered (for the modal
-            superposition of :func:`modal_transfer`), or None.
-    """
-
-    frequencies_hz: np.ndarray
-    damping_ratio: np.ndarray
-    poles: np.ndarray
-    right: np.ndarray | None = None
-    left: np.ndarray | None = None
-    S: np.ndarray | None = None
-    mass: np.ndarray | None = None
-    expansion: StateEigen | None = None
-    norm: np.ndarray | None = None
-
-
-@dataclass(frozen=True)
-class StateEigen:
-    """All 2 n_t eigenpairs of the state matrix A (complex modes with Im(lambda) >= 0 and,
-    implicitly, their conjugates).
-
-    Attributes:
-        poles: eigenvalues lambda with Im(lambda) >= 0, (n_e,).
-        right, left: psi_k, chi_k as columns (A psi = lambda psi, chi^H A = lambda chi^H),
-            (2 n_t, n_e).
-        norm: chi_k^H psi_k, (n_e,).
-        condition: [-] eigenvalue condition numbers ||psi|| ||chi|| / |chi^H psi|, (n_e,).
-    """
-
-    poles: np.ndarray
-    right: np.ndarray
-    left: np.ndarray
-    norm: np.ndarray
-    condition: np.ndarray
-
-
-def complex_modes(model: LinearModel, damping: np.ndarray, max_hz: float | None = None,
-                  vectors: bool = False) -> ComplexModes:
-    """Eigenvalues (and eigenvectors) of [[0, I], [-M^-1 K, -M^-1 C]], sorted by frequency.
-
-    Args:
-        damping: [N s/m] damping matrix in upper band storage (BANDWIDTH + 1, n_dof).
-        max_hz: keep only modes below this frequency [Hz].
-        vectors: also return right and left eigenvectors.
-    """
-    cd = condensed(model, damping)  # insulator-axial directions condensed out (exact)
-    n = cd.K.shape[0]
-    if n > LARGE_SYSTEM_DOF:
-        return _approximate_complex_modes(cd, max_hz, vectors)
-    minv = 1.0 / np.diag(cd.M)  # diagonal lumped mass in condensed coordinates
-    A = np.zeros((2 * n, 2 * n))
-    A[:n, n:] = np.eye(n)
-    A[n:, :n] = -minv[:, None] * cd.K
-    A[n:, n:] = -minv[:, None] * cd.C
-    if vectors:
-        lam, vr = eig(A, right=True, overwrite_a=True, check_finite=False)  # A is ours and finite (K, C checked)
-        # left eigenvectors from the right ones (symmetric K, M, C): A^T w = lambda w with
-        # w = [(lambda M + C) phi; M phi], phi the displacement part of psi (Tisseur &
-        # Meerbergen 2001, section 3.4); chi = conj(w) so that chi^H A = lambda chi^H
-        phi = vr[:n]
-        w_top = lam[None, :] * (cd.M @ phi) + cd.C @ phi
-        vl = np.conj(np.vstack([w_top, cd.M @ phi]))
-    else:
-        lam, vl, vr = eig(A, right=False, overwrite_a=True, check_finite=False), None, None
-    expansion = nrm = None
-    if vectors:
-        nrm = np.einsum("ik,ik->k", vl.conj(), vr)  # chi^H psi
-        upper = lam.imag >= 0.0  # LAPACK returns exact conjugate pairs for a real matrix
-        cond = np.linalg.norm(vr[:, upper], axis=0) * np.linalg.norm(vl[:, upper], axis=0) / np.abs(nrm[upper])
-        expansion = StateEigen(lam[upper], vr[:, upper], vl[:, upper], nrm[upper], cond)
-    keep = lam.imag > 1e-12
-    if max_hz is not None:
-        keep &= np.abs(lam) / (2 * np.pi) <= max_hz
-    idx = np.flatnonzero(keep)
-    idx = idx[np.argsort(np.abs(lam[idx]))]
-    lam = lam[idx]
-    w = np.abs(lam)
-    if not vectors:
-        return ComplexModes(w / (2 * np.pi), -lam.real / w, lam)
-    return ComplexModes(w / (2 * np.pi), -lam.real / w, lam, vr[:n, idx], vl[n:, idx],
-                        cd.S, np.diag(cd.M).copy(), expansion, nrm[idx])
-
-
-LARGE_SYSTEM_DOF = 600  # above this the dense state-space eigenproblem (O((2n)^3)) is too slow
-
-
-def _approximate_complex_modes(cd, max_hz: float | None, vectors: bool) -> ComplexModes:
-    """Complex modes of large systems from the undamped modes and their modal damping
-    zeta_k = phi^T C phi / (2 omega_k) (classical-damping approximation, Clough & Penzien
-    2003 section 12-5): lambda = -zeta omega + i omega sqrt(1 - zeta^2).  It cannot see the
-    near-degenerate pairs that non-proportional damping splits (docs/method.md)."""
-    from scipy.linalg import eigh as _eigh
-
-    m = np.diag(cd.M)
-    s = 1.0 / np.sqrt(m)
-    A = cd.K * s[:, None] * s[None, :]
-    if max_hz is None:
-        w2, psi = _eigh(A)
-    else:
-        w2, psi = _eigh(A, subset_by_value=[-np.inf, (2 * np.pi * max_hz) ** 2])
-    phi = psi * s[:, None]  # mass-normalised
-    w = np.sqrt(np.clip(w2, 1e-30, None))
-    Cphi = cd.C @ phi
-    zeta = np.sum(phi * Cphi, axis=0) / (2 * w)  # phi_k^T C phi_k / (2 omega_k)
-    zc = np.clip(zeta, 0.0, 0.999999)
-    lam = -zc * w + 1j * w * np.sqrt(1 - zc**2)
-    if not vectors:
-        return ComplexModes(w / (2 * np.pi), zc, lam)
-    # psi = [phi; lambda phi], chi = conj([(lambda M + C) phi; M phi]) with real phi:
-    # chi^H psi = 2 lambda phi^T M phi + phi^T C phi = 2 lambda + 2 zeta omega (mass-normalised)
-    return ComplexModes(w / (2 * np.pi), zc, lam, phi, m[:, None] * phi, cd.S, m.copy(), None,
-                        2 * lam + 2 * zc * w)
-
+from .gust_factor import EULER_GAMMA as EULER_GAMMA
+from .gust_factor import DavenportEstimate as DavenportEstimate
+from .gust_factor import davenport_gust_factor as davenport_gust_factor
+from .gust_factor import joint_acceptance_uniform as joint_acceptance_uniform
+from .gust_factor import peak_factor as peak_factor
+from .gust_factor import von_karman as von_karman
+from .model import BANDWIDTH, LinearModel, band_blocks, blocks_to_band, reaction_matrix_direct
+from .wind.turbulence import von_karman_cumulative
 
 GRID_SIGNIFICANCE = 1e-3  # direct path: refine poles whose single-mode r.m.s. exceeds this x the background's
 EXCLUSION_RATIO = 1e3  # a coarse point may over-count an unrefined pole by at most this x its own variance
@@ -248,7 +106,7 @@ def _quad_kms(w: np.ndarray, rho: np.ndarray) -> np.ndarray:
 
     Args: w (n_f, ..., N) complex; rho (n_f,) in [0, 1), or per gap (n_f, N-1) for unequally
         spaced points (Markov coherence Coh_ij = prod of the gaps' rho between i and j,
-        issue 17).  Returns (n_f, ...) real.
+        the section form).  Returns (n_f, ...) real.
     """
     gap = rho.ndim == 2
     shape = (-1,) + (1,) * (w.ndim - 2)
@@ -279,7 +137,7 @@ def markov_rho(system, f: np.ndarray, coherence_decay: float, v_mean: float) -> 
 
 def tower_rows(model: LinearModel, A: np.ndarray, tower: int) -> np.ndarray:
     """The three reaction rows of ``tower`` of A (3 n_towers, ...) in the tower's own frame
-    (issue 17: x along its mean heading, y turned +90 deg, z down; a straight line: as is)."""
+    (x along its mean heading, y turned +90 deg, z down; a straight line: as is)."""
     rows = A[3 * tower:3 * tower + 3]
     system = model.system
     if system.straight_in_plan:
@@ -538,6 +396,95 @@ class SpectralEstimate:
     psd_fluctuating: np.ndarray | None = None  # [N^2/Hz] (n_f, 3)
 
 
+def _background_transfer(model: LinearModel, Gt: np.ndarray, Dt: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Quasi-static transfer t_B = G K^-1 P + D at one tower (K symmetric: solved with G^T).
+
+    Args: Gt [N/m] the tower's rows of G (3, n_dof); Dt [-] its rows of D (3, n_nodes).
+    Returns: x_B = K^-1 G^T [m/N] (n_dof, 3) and t_B [-] (3, n_nodes) complex.
+    """
+    K_gen = _general_band(model.K_band)
+    xB = solve_banded((BANDWIDTH, BANDWIDTH), K_gen, Gt.T)  # (n_dof, 3)
+    tB = Dt.astype(complex).copy()
+    tB[:, model.dofs.free_nodes] += load_rows(model, xB).T
+    return xB, tB
+
+
+def _direct_transfer(model: LinearModel, damping: np.ndarray, Gt: np.ndarray):
+    """Reaction transfer by direct solves: ``omega`` [rad/s] (n_f,) -> (3, n_free_nodes, n_f) complex,
+    the tower's reactions per unit load along every free node's load direction."""
+    system = model.system
+    free = model.dofs.free_nodes
+    blocks = [band_blocks(m) for m in (model.K_band, damping, model.M_band)]
+    rhs = Gt.T.reshape(-1, 3, 3)  # (n_free_nodes, 3 dofs, 3 reactions): K symmetric, solve with G^T
+
+    def direct(omega: np.ndarray) -> np.ndarray:  # (3, n_free, n_f)
+        X = dynamic_solve(blocks, omega, rhs)  # (n_free, 3 dofs, 3 reactions, n_f)
+        if system.straight_in_plan:
+            return X[:, 1].transpose(1, 0, 2)  # y DOF of every free node
+        b = system.node_normals[free]  # along every node's load direction (section form)
+        return np.einsum("ncrf,nc->rnf", X, b)
+
+    return direct
+
+
+def _reaction_spectra(model: LinearModel, transfer, Dt: np.ndarray, tB: np.ndarray, load_per_v: np.ndarray,
+                      f: np.ndarray, Sv: np.ndarray, rho: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One-sided spectra [N^2/Hz] of the background, total fluctuating and resonant reactions,
+    S_r = S_v w^H Coh w with w_i = t_i a_i (module docstring), each (n_f, 3), in blocks of frequencies.
+
+    Args: transfer: omega [rad/s] -> (3, n_free_nodes, n_f); Dt, tB [-] (3, n_nodes); load_per_v
+        [N s/m] (n_nodes,); f [Hz] (n_f,); Sv [m^2/s^2/Hz] (n_f,); rho: neighbour coherence (n_f,)
+        or per gap (n_f, n_nodes - 1).
+    """
+    system = model.system
+    free = model.dofs.free_nodes
+    SB = np.empty((f.size, 3))
+    SF = np.empty((f.size, 3))
+    SR = np.empty((f.size, 3))
+    aT = load_per_v[None, :, None]
+    tBaT = (tB * load_per_v[None, :])[..., None]
+    chunk = max(64, 60_000 // max(system.n_nodes, 1))  # frequencies per block: memory, cache
+    for c0 in range(0, f.size, chunk):
+        fc = f[c0:c0 + chunk]
+        tF = np.empty((3, system.n_nodes, fc.size), dtype=complex)  # reaction, node, frequency
+        tF[:] = Dt[..., None]
+        tF[:, free] += transfer(2 * np.pi * fc)
+        sl = slice(c0, c0 + fc.size)
+        tFa = tF * aT
+        q = _quad_kms_nodes(np.concatenate([np.broadcast_to(tBaT, tF.shape), tFa, tFa - tBaT]), rho[sl].T if rho.ndim == 2 else rho[sl])
+        SB[sl], SF[sl], SR[sl] = (Sv[sl, None] * q[3 * i:3 * i + 3].T for i in range(3))
+    return SB, SF, SR
+
+
+def _estimate(f: np.ndarray, SB: np.ndarray, SF: np.ndarray, SR: np.ndarray, mean_reaction: np.ndarray,
+              duration: float, band: tuple[float, float], zero_mean_tol: float, method: str) -> SpectralEstimate:
+    """Spectral moments, Davenport (1964) expected peaks and gust factors from the reaction spectra
+    (n_f, 3) on the grid f [Hz] (module docstring); mean_reaction [N] (3,), duration [s]."""
+
+    def integ(y: np.ndarray) -> np.ndarray:
+        return np.trapezoid(y, f, axis=0)
+
+    m0B, m0F, m0R = integ(SB), integ(SF), integ(SR)
+    nuB = np.sqrt(integ(SB * f[:, None] ** 2) / np.maximum(m0B, 1e-300))
+    nuF = np.sqrt(integ(SF * f[:, None] ** 2) / np.maximum(m0F, 1e-300))
+    sB, sF, sR = np.sqrt(m0B), np.sqrt(m0F), np.sqrt(m0R)
+    mabs = np.abs(mean_reaction)
+    pk_qs = mabs + peak_factor(nuB, duration) * sB
+    pk_dy = mabs + peak_factor(nuF, duration) * sF
+    defined = mabs > zero_mean_tol
+    with np.errstate(divide="ignore", invalid="ignore"):
+        gf_dy = np.where(defined, pk_dy / mabs, np.nan)
+        gf_qs = np.where(defined, pk_qs / mabs, np.nan)
+        # Cont_R undefined (NaN, shown "**") where the peak is zero, e.g. turbulence_intensity = 0
+        cont_r = np.where(pk_dy > 0, (pk_dy - pk_qs) / np.where(pk_dy > 0, pk_dy, 1.0), np.nan)
+    return SpectralEstimate(
+        mean=np.asarray(mean_reaction, dtype=float), rms_background=sB, rms_resonant=sR, rms_fluctuating=sF,
+        nu_background=nuB, nu_fluctuating=nuF, peak_quasi_static=pk_qs, peak_dynamic=pk_dy,
+        GF_Dy=gf_dy, GF_QS=gf_qs, Cont_R=cont_r, duration=duration, band=band, n_frequencies=int(f.size),
+        method=method, frequencies=f, psd_background=SB, psd_fluctuating=SF,
+    )
+
+
 def random_vibration(
     model: LinearModel,
     damping: np.ndarray,
@@ -571,16 +518,9 @@ def random_vibration(
             place the refined frequency points.
     """
     system = model.system
-    free = model.dofs.free_nodes
     Gt = tower_rows(model, model.G, tower)  # (3, n_dof), in the tower's frame
     Dt = tower_rows(model, reaction_matrix_direct(system), tower)  # (3, n_nodes)
-
-    # background transfer t_B = G K^-1 P + D (K symmetric: solve with G^T)
-    K_gen = _general_band(model.K_band)
-    xB = solve_banded((BANDWIDTH, BANDWIDTH), K_gen, Gt.T)  # (n_dof, 3)
-    tB = Dt.astype(complex).copy()
-    tB[:, free] += load_rows(model, xB).T
-
+    xB, tB = _background_transfer(model, Gt, Dt)
     if modes is None:
         modes = complex_modes(model, damping, max_hz=band[1] * 1.5)
     modal_ok = modes.expansion is not None and modes.expansion.condition.max() < MODAL_CONDITION_LIMIT
@@ -595,21 +535,7 @@ def random_vibration(
     # (linecheck.core.wind.turbulence.spectral_grid); do the same here
     Sv = von_karman(f, sigma, length_scale, v_mean) / float(von_karman_cumulative(band[1], length_scale, v_mean))
     rho = markov_rho(system, f, coherence_decay, v_mean)  # Davenport coherence between neighbours
-    SB = np.empty((f.size, 3))
-    SF = np.empty((f.size, 3))
-    SR = np.empty((f.size, 3))
-    aT = load_per_v[None, :, None]
-    tBaT = (tB * load_per_v[None, :])[..., None]
-    blocks = [band_blocks(m) for m in (model.K_band, damping, model.M_band)]
-    rhs = Gt.T.reshape(-1, 3, 3)  # (n_free_nodes, 3 dofs, 3 reactions): K symmetric, solve with G^T
-
-    def direct(omega: np.ndarray) -> np.ndarray:  # (3, n_free, n_f)
-        X = dynamic_solve(blocks, omega, rhs)  # (n_free, 3 dofs, 3 reactions, n_f)
-        if system.straight_in_plan:
-            return X[:, 1].transpose(1, 0, 2)  # y DOF of every free node
-        b = system.node_normals[free]  # along every node's load direction (issue 17)
-        return np.einsum("ncrf,nc->rnf", X, b)
-
+    direct = _direct_transfer(model, damping, Gt)
     transfer, method = direct, "direct"
     if modal_ok:
         modal = ModalTransfer(model, modes, tower, load_rows(model, xB).T)
@@ -617,111 +543,8 @@ def random_vibration(
         ref = direct(check)
         if np.abs(modal(check) - ref).max() <= MODAL_CHECK_RTOL * np.abs(ref).max():
             transfer, method = modal, "modal"
-    chunk = max(64, 60_000 // max(system.n_nodes, 1))  # frequencies per block: memory, cache
-    for c0 in range(0, f.size, chunk):
-        fc = f[c0:c0 + chunk]
-        tF = np.empty((3, system.n_nodes, fc.size), dtype=complex)  # reaction, node, frequency
-        tF[:] = Dt[..., None]
-        tF[:, free] += transfer(2 * np.pi * fc)
-        sl = slice(c0, c0 + fc.size)
-        tFa = tF * aT
-        q = _quad_kms_nodes(np.concatenate([np.broadcast_to(tBaT, tF.shape), tFa, tFa - tBaT]), rho[sl].T if rho.ndim == 2 else rho[sl])
-        SB[sl], SF[sl], SR[sl] = (Sv[sl, None] * q[3 * i:3 * i + 3].T for i in range(3))
-
-    def integ(y: np.ndarray) -> np.ndarray:
-        return np.trapezoid(y, f, axis=0)
-
-    m0B, m0F, m0R = integ(SB), integ(SF), integ(SR)
-    nuB = np.sqrt(integ(SB * f[:, None] ** 2) / np.maximum(m0B, 1e-300))
-    nuF = np.sqrt(integ(SF * f[:, None] ** 2) / np.maximum(m0F, 1e-300))
-    sB, sF, sR = np.sqrt(m0B), np.sqrt(m0F), np.sqrt(m0R)
-    mabs = np.abs(mean_reaction)
-    pk_qs = mabs + peak_factor(nuB, duration) * sB
-    pk_dy = mabs + peak_factor(nuF, duration) * sF
-    defined = mabs > zero_mean_tol
-    with np.errstate(divide="ignore", invalid="ignore"):
-        gf_dy = np.where(defined, pk_dy / mabs, np.nan)
-        gf_qs = np.where(defined, pk_qs / mabs, np.nan)
-        # Cont_R undefined (NaN, shown "**") where the peak is zero, e.g. turbulence_intensity = 0
-        cont_r = np.where(pk_dy > 0, (pk_dy - pk_qs) / np.where(pk_dy > 0, pk_dy, 1.0), np.nan)
-    return SpectralEstimate(
-        mean=np.asarray(mean_reaction, dtype=float), rms_background=sB, rms_resonant=sR, rms_fluctuating=sF,
-        nu_background=nuB, nu_fluctuating=nuF, peak_quasi_static=pk_qs, peak_dynamic=pk_dy,
-        GF_Dy=gf_dy, GF_QS=gf_qs, Cont_R=cont_r, duration=duration, band=band, n_frequencies=int(f.size),
-        method=method, frequencies=f, psd_background=SB, psd_fluctuating=SF,
-    )
-
-
-# --------------------------------------------------------------------------- estimate 2
-def joint_acceptance_uniform(eta: np.ndarray) -> np.ndarray:
-    """|J|^2 = 2/eta - 2 (1 - e^-eta)/eta^2 for exponential coherence over a uniform span
-    (Davenport 1962; eta = C n L / V); limit 1 as eta -> 0."""
-    eta = np.asarray(eta, dtype=float)
-    small = eta < 1e-6
-    e = np.where(small, 1.0, eta)
-    out = 2.0 / e - 2.0 * (1.0 - np.exp(-e)) / e**2
-    return np.where(small, 1.0 - eta / 3.0, out)
-
-
-@dataclass(frozen=True)
-class DavenportEstimate:
-    """Estimate 2 for the transverse reaction: closed-form gust response factors.
-
-    Attributes:
-        background: B [-]; resonant: R [-]; peak_factor: g [-]; f1 [Hz]; zeta_a [-];
-        GF_Dy = 1 + 2 g I sqrt(B + R); GF_QS = 1 + 2 g I sqrt(B); Cont_R [-];
-        GF_ASCE: ASCE Manual 74 (2010) wire gust factor on the mean pressure, 1 + 2.7 E_w sqrt(B_w)
-        (:func:`linecheck.core.codes.asce74_wire_gust`, exposure C).
-    """
-
-    background: float
-    resonant: float
-    peak_factor: float
-    f1: float
-    zeta_a: float
-    GF_Dy: float
-    GF_QS: float
-    Cont_R: float
-    GF_ASCE: float
-
-
-def davenport_gust_factor(
-    *,
-    span: float,
-    v_mean: float,
-    intensity: float,
-    length_scale: float,
-    coherence_decay: float,
-    f1: float,
-    mass_per_length: float,
-    air_density: float,
-    drag_coefficient: float,
-    diameter: float,
-    duration: float,
-    height: float,
-) -> DavenportEstimate:
-    """Estimate 2 (see module docstring); all inputs SI ([m], [m/s], [Hz], [kg/m], [s])."""
-    n = np.geomspace(1e-5, 10.0, 4000)
-    Sn = von_karman(n, 1.0, length_scale, v_mean)  # S/sigma^2
-    J2 = joint_acceptance_uniform(coherence_decay * n * span / v_mean)
-    B = float(np.trapezoid(Sn * J2, n))
-    zeta = air_density * drag_coefficient * diameter * v_mean / (4 * np.pi * f1 * mass_per_length)  # Davenport 1962
-    R = float(np.pi * f1 * von_karman(f1, 1.0, length_scale, v_mean) / (4 * zeta)
-              * joint_acceptance_uniform(coherence_decay * f1 * span / v_mean))
-    # cycling rate of the response (Davenport 1964): nu^2 = (f1^2 R + nu_B^2 B) / (B + R)
-    nuB2 = float(np.trapezoid(n**2 * Sn * J2, n) / max(B, 1e-300))
-    nu = np.sqrt((f1**2 * R + nuB2 * B) / (B + R))
-    g = float(peak_factor(nu, duration))
-    gB = float(peak_factor(np.sqrt(nuB2), duration))
-    gf_dy = 1 + 2 * g * intensity * np.sqrt(B + R)
-    gf_qs = 1 + 2 * gB * intensity * np.sqrt(B)
-    # ASCE 74 (2010) section 2.1.5, exposure C: the wire gust factor on the 10-min mean pressure,
-    # 1 + 2.7 E_w sqrt(B_w) (implemented once, in linecheck.core.codes)
-    from .codes import asce74_wire_gust
-
-    gf_asce = asce74_wire_gust(height, span, "C").mean_gust_factor
-    return DavenportEstimate(B, R, g, f1, float(zeta), float(gf_dy), float(gf_qs),
-                             float((gf_dy - gf_qs) / gf_dy), float(gf_asce))
+    SB, SF, SR = _reaction_spectra(model, transfer, Dt, tB, load_per_v, f, Sv, rho)
+    return _estimate(f, SB, SF, SR, mean_reaction, duration, band, zero_mean_tol, method)
 
 
 # --------------------------------------------------------------------------- modal significance
@@ -772,7 +595,7 @@ def modal_contributions(
 
     A mode that neither moves transversely nor is damped transversely is still finite
     (its excitation and its damping vanish together), which is why near-degenerate,
-    almost undamped modes can matter however small their damping (issue 10).
+    almost undamped modes can matter however small their damping.
 
     Args:
         modes: complex modes of ``model`` with its damping, computed with ``vectors=True``.
@@ -785,7 +608,7 @@ def modal_contributions(
     lam, vl, vr = modes.poles[sel], modes.left[:, sel], modes.right[:, sel]
     f = modes.frequencies_hz[sel]
     free = model.dofs.free_nodes
-    Gt = tower_rows(model, model.G, tower)  # in the tower's frame (issue 17)
+    Gt = tower_rows(model, model.G, tower)  # in the tower's frame
     norm = np.abs(modes.norm[sel])  # |chi^H psi|
     r = (Gt @ S) @ vr  # (3, n_modes) reaction per unit modal amplitude
     L = load_rows(model, S).T / modes.mass[:, None]  # M*^-1 S^T maps a y-load at free node i to b

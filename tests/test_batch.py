@@ -1,4 +1,4 @@
-"""Batch runs: executors, merging, bit-identity, failures, resume (issue 8)."""
+"""Batch runs: executors, merging, bit-identity, failures, resume."""
 
 from __future__ import annotations
 
@@ -146,7 +146,8 @@ def test_dask_missing_is_a_clear_case_error(monkeypatch):
 def test_batch_package_imports_no_ui_libraries():
     code = (
         "import sys, linecheck.batch, linecheck.batch.tasks, linecheck.batch.executors, "
-        "linecheck.batch.runner, linecheck.batch.scan, linecheck.batch.merge\n"
+        "linecheck.batch.runner, linecheck.batch.scan, linecheck.batch.merge, linecheck.batch.scheduler, "
+        "linecheck.batch.plan, linecheck.batch.recovery, linecheck.batch.saving, linecheck.batch.report\n"
         "print(','.join(n for n in ('textual', 'rich', 'typer', 'distributed') if n in sys.modules))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
@@ -344,7 +345,7 @@ def test_paper_batch_pool_equals_sequential(tmp_path):
         assert (tmp_path / "a" / f"{p.stem}.json").read_bytes() == (tmp_path / "b" / f"{p.stem}.json").read_bytes()
 
 
-# --------------------------------------------------------------------------- faults (issue 14)
+# --------------------------------------------------------------------------- faults (killed workers)
 def test_killed_worker_fails_only_the_case_it_held(short_cases, tmp_path, monkeypatch):
     """An out-of-memory kill of one pool worker (SIGKILL, here by the test hook in the worker
     running case09-single): the pool is replaced, the other cases -- running or pending --
@@ -367,6 +368,47 @@ def test_killed_worker_fails_only_the_case_it_held(short_cases, tmp_path, monkey
     for p in short_cases[:1]:  # re-run on the new pool (or finished before the kill): the same bytes
         assert (out / f"{p.stem}.json").read_bytes() == (tmp_path / "ref" / f"{p.stem}.json").read_bytes()
 
+
+
+def test_recovery_policy_fails_the_tasks_of_dead_workers_and_reruns_the_others():
+    """The worker-recovery policy alone: a task held by a worker that died on its own fails its
+    case (once per case); a task finished before the pool broke is kept; the rest run again."""
+    from linecheck.batch.recovery import HeldTask, WorkerRecovery
+
+    policy = WorkerRecovery()
+    held = [HeldTask(0, 0, 101), HeldTask(1, 0, 102), HeldTask(2, 1, 102, finished=True), HeldTask(3, 1, None),
+            HeldTask(4, 2, 102)]
+    plan = policy.after_restart(held, {101: -9})
+    assert [(t.index, why) for t, why in plan.failed] == [(0, "killed by signal 9, SIGKILL: out of memory?")]
+    assert [t.index for t in plan.rerun] == [3, 4]  # case 0 failed: its task 1 is dropped; task 2 is in
+    assert policy.failure("killed by signal 9", "A").message == "worker died (killed by signal 9) while running A"
+
+
+def test_recovery_policy_suspects_running_tasks_when_the_dead_worker_is_unknown():
+    from linecheck.batch.recovery import HeldTask, WorkerRecovery
+
+    policy = WorkerRecovery()
+    held = [HeldTask(0, 0, 101), HeldTask(1, 1, None)]
+    first = policy.after_restart(held, {})
+    assert first.failed == [] and [t.index for t in first.rerun] == [0, 1]
+    policy.progressed()
+    second = policy.after_restart([HeldTask(0, 0, 103), HeldTask(1, 1, 104)], {})
+    assert [(t.index, why) for t, why in second.failed] == [(0, "ended abruptly, twice")]
+    assert [t.index for t in second.rerun] == [1]  # suspected once only
+
+
+def test_recovery_policy_gives_up_after_restarts_without_progress():
+    from linecheck.batch.recovery import MAX_IDLE_RESTARTS, HeldTask, WorkerRecovery
+
+    policy = WorkerRecovery()
+    held = [HeldTask(0, 0, None), HeldTask(1, 1, None)]
+    for _ in range(MAX_IDLE_RESTARTS):
+        assert policy.after_restart(held, {999: 1}).failed == []
+    plan = policy.after_restart(held, {999: 1})
+    assert [why for _, why in plan.failed] == [f"ended abruptly {MAX_IDLE_RESTARTS + 1} times in a row"] * 2
+    assert plan.rerun == []
+    policy.progressed()  # a task finished: the count starts again
+    assert policy.after_restart(held, {999: 1}).failed == []
 
 COORDINATOR = """
 import sys, time
@@ -585,7 +627,7 @@ def test_summary_flags_cont_r_and_failed_sanity_check(short_cases):
     flagged.name = "flagged"
     d = flagged.doc.to_json()  # edit the JSON, read it back typed (as a saved result would be)
     d["reactions"]["Ry"]["Cont_R"]["mean"] = 0.25
-    d["reactions"]["Ry"]["dynamic_analysis"] = "recommended"  # interval above 10 % (issue 18)
+    d["reactions"]["Ry"]["dynamic_analysis"] = "recommended"  # interval above 10 % (the adaptive-count rule)
     d["spectral"]["sanity_check"][0].update(reaction="Rz", quantity="rms_fluctuating", time_domain=176.0,
                                             frequency_domain=212.0, allowed_difference=20.0, ok=False)
     flagged.doc = RunDocument.from_json(d)

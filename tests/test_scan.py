@@ -1,4 +1,4 @@
-"""Critical-downburst scan (issue 8): grid parsing, executors, the paper's Db_x / Db_y."""
+"""Critical-downburst scan: grid parsing, executors, the paper's Db_x / Db_y."""
 
 from __future__ import annotations
 
@@ -234,7 +234,7 @@ def test_scan_paper_line_full_grid(tmp_path):
 
 def test_scan_positions_share_the_unit_turbulence_bit_for_bit(monkeypatch):
     """The unit turbulence depends on the nodes, V_ref, L_u, the seed and the record, not on where
-    the downburst is: a scan's positions reuse it from the per-process memo (issue 20), and the
+    the downburst is: a scan's positions reuse it from the per-process memo (scans with dynamic peaks), and the
     velocity is the same bits as computed afresh with the memo off."""
     from linecheck.batch.tasks import apply_changes, scan_changes
     from linecheck.core.system import LineSystem
@@ -262,7 +262,7 @@ def test_scan_positions_share_the_unit_turbulence_bit_for_bit(monkeypatch):
 def test_one_storm_scan_positions_share_the_phases_bit_for_bit(monkeypatch):
     """A one-storm scan (``--hold jet``) gives each position its own V_ref at p, hence its own unit
     field; the random phases and their compiled phasors are shared (turbulence.unit_phases,
-    issue 20), and the fields are the same bits as computed with every memo off."""
+    for scans with dynamic peaks), and the fields are the same bits as computed with every memo off."""
     from linecheck.batch.tasks import apply_changes, fixed_jet_case, scan_changes
     from linecheck.core import kernel
     from linecheck.core.system import LineSystem

@@ -13,6 +13,7 @@ import pytest
 from typer.testing import CliRunner
 
 from linecheck import service
+from linecheck.analysis import run as run_module
 from linecheck.cli.app import app
 from linecheck.core import budget
 from linecheck.core.case import MAX_CASE_BYTES, load_case, read_regular_file, with_values
@@ -177,8 +178,8 @@ def test_huge_realization_override_exits_2_with_the_estimate_before_computing(mo
     def fail(*a, **k):
         raise AssertionError("the run started")
 
-    monkeypatch.setattr(service, "_static_analysis", fail)
-    monkeypatch.setattr(service, "integrate", fail)
+    monkeypatch.setattr(run_module, "static_result", fail)
+    monkeypatch.setattr(run_module, "integrate", fail)
     r = cli("run", str(PAPER / "case01-single.toml"), "-n", "1000000000")
     out = " ".join(r.output.split())
     assert r.exit_code == 2, out

@@ -16,6 +16,7 @@ import pytest
 from typer.testing import CliRunner
 
 from linecheck import service
+from linecheck.analysis import spectral_check, windows
 from linecheck.cli.app import app
 from linecheck.core import dynamics, spectral
 from linecheck.core.case import load_case
@@ -124,8 +125,8 @@ def test_window_of_a_strain_section_is_exact(monkeypatch, tower):
     st = service.static_analysis(case)
     whole = service.spectral_analysis(case, static=st)
     assert whole.window is None
-    monkeypatch.setattr(service, "CHECK_WINDOW_MIN_SPANS", 6)
-    monkeypatch.setattr(service, "CHECK_WINDOW_HALVES", (2, 3, 4, 6))
+    monkeypatch.setattr(windows, "CHECK_WINDOW_MIN_SPANS", 6)
+    monkeypatch.setattr(spectral_check, "CHECK_WINDOW_HALVES", (2, 3, 4, 6))
     win = service.spectral_analysis(case, static=st)
     assert win.window is not None and np.all(win.window.estimated_error == 0.0)
     assert win.window.spans == (4 if tower == 2 else 8)
@@ -141,17 +142,17 @@ def test_window_on_a_section_with_an_angle_tower_converges(monkeypatch):
     case = load_case(CASES / "examples/section-12span.toml")
     st = service.static_analysis(case)
     whole = service.spectral_analysis(case, static=st).exact
-    monkeypatch.setattr(service, "CHECK_WINDOW_MIN_SPANS", 6)
-    monkeypatch.setattr(service, "CHECK_WINDOW_RTOL", 0.0)
+    monkeypatch.setattr(windows, "CHECK_WINDOW_MIN_SPANS", 6)
+    monkeypatch.setattr(spectral_check, "CHECK_WINDOW_RTOL", 0.0)
     errs = []
     for half in (1, 3, 5):
-        monkeypatch.setattr(service, "CHECK_WINDOW_HALVES", (half,))
+        monkeypatch.setattr(spectral_check, "CHECK_WINDOW_HALVES", (half,))
         w = service.spectral_analysis(case, static=st)
         errs.append(np.abs(w.exact.peak_dynamic / whole.peak_dynamic - 1).max())
     # measured: 39 % (one span each side, from T6 with its 18 deg heading), 0.9 %, 1.0 %;
     # the transverse peak within 0.1 % from three spans each side
     assert errs[0] > 0.2 and errs[1] < 0.02 and errs[2] < 0.02
-    monkeypatch.setattr(service, "CHECK_WINDOW_HALVES", (3,))
+    monkeypatch.setattr(spectral_check, "CHECK_WINDOW_HALVES", (3,))
     w = service.spectral_analysis(case, static=st).exact
     assert w.peak_dynamic[1] == pytest.approx(whole.peak_dynamic[1], rel=1e-3)
 
@@ -165,7 +166,7 @@ def test_long_line_check_on_windows_agrees_with_the_whole_line(monkeypatch):
     st = service.static_analysis(case)
     whole = service.spectral_analysis(case, static=st)
     assert whole.window is None
-    monkeypatch.setattr(service, "CHECK_WINDOW_MIN_SPANS", 12)
+    monkeypatch.setattr(windows, "CHECK_WINDOW_MIN_SPANS", 12)
     win = service.spectral_analysis(case, static=st)
     w = win.window
     assert w is not None and w.windows == (12, 16) and w.spans == 16 and w.first_tower == 2

@@ -10,6 +10,7 @@ import pytest
 from scipy.linalg import lapack, solve
 
 from linecheck import service
+from linecheck.analysis import run as run_module
 from linecheck.core.case import load_case
 from linecheck.core.model import build_model
 from linecheck.core.second_order import second_order_of_loads, second_order_operator, second_order_reactions
@@ -266,13 +267,13 @@ def test_exported_field_round_trips(tmp_path, monkeypatch, name, changes):
 
     case = paper(name, **changes)
     captured = {}
-    real = service.integrate
+    real = run_module.integrate
 
     def spy(models, damping, state_of_step, loads, dt, **kw):
         captured["loads"], captured["direct"] = loads.copy(), kw["direct"].copy()
         return real(models, damping, state_of_step, loads, dt, **kw)
 
-    monkeypatch.setattr(service, "integrate", spy)
+    monkeypatch.setattr(run_module, "integrate", spy)
     res = service.run_case(case, realizations=[1], spectral_check=False)
     fld = service.wind_field(case, realization=1)
     path = tmp_path / "field.npz"

@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from linecheck import service
+from linecheck.analysis import run as run_module
 from linecheck.core import budget, kernel
 from linecheck.core.case import load_case
 from linecheck.core.errors import Cancelled
@@ -34,15 +35,16 @@ def _short(path, **analysis):
 
 
 def _threads_of(monkeypatch, name: str) -> list[str]:
-    """Record the thread that calls ``service.<name>`` each time (so a test knows where it ran)."""
+    """Record the thread that calls ``<name>`` in a run (:mod:`linecheck.analysis.run`, where the
+    run looks it up) each time (so a test knows where it ran)."""
     names: list[str] = []
-    real = getattr(service, name)
+    real = getattr(run_module, name)
 
     def spy(*a, **kw):
         names.append(threading.current_thread().name)
         return real(*a, **kw)
 
-    monkeypatch.setattr(service, name, spy)
+    monkeypatch.setattr(run_module, name, spy)
     return names
 
 
@@ -74,7 +76,7 @@ def test_threads_give_the_bits_of_one_thread(monkeypatch, name, reals):
 def test_a_failed_chunk_raises_its_own_error_and_stops_the_others(monkeypatch):
     monkeypatch.setenv("LINECHECK_KERNEL", "numba")
     case = _short(CASES / "paper" / "case09-six.toml", duration=30.0, burn_in=5.0)
-    real = service.integrate
+    real = run_module.integrate
     calls: list[int] = []
 
     def failing(models, damping, state_of_step, loads, *a, **kw):
@@ -83,7 +85,7 @@ def test_a_failed_chunk_raises_its_own_error_and_stops_the_others(monkeypatch):
             raise ValueError("boom in chunk 3")
         return real(models, damping, state_of_step, loads, *a, **kw)
 
-    monkeypatch.setattr(service, "integrate", failing)
+    monkeypatch.setattr(run_module, "integrate", failing)
     monkeypatch.setattr(budget, "realization_chunk", lambda case, n, threads=1: 2)  # chunks [0, 1], [2, 3], [4]
     with pytest.raises(ValueError, match="boom in chunk 3"):
         service.run_case(case, realizations=[0, 1, 2, 3, 4], spectral_check=False, threads=2)

@@ -1,0 +1,70 @@
+"""Step 1 of the method: the non-linear static analysis of the line under the running-mean wind
+(the mean loads of paper Eq. 1), from the still-air state to the mean states at the instants of
+:func:`mean_state_times`.  Nothing here prints.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.case import Case
+from ..core.loads import mean_loads
+from ..core.static import MeanStates, solve_mean_states
+from ..core.system import LineSystem
+from ..core.wind.mean import MeanWind, mean_wind
+from .guard import Warn, check_budget, warn_case
+
+Progress = Callable[[str, int, int], None]
+
+
+@dataclass(frozen=True)
+class StaticResult:
+    """Step-1 result of a case: the mean wind used and the mean states."""
+
+    case: Case
+    system: LineSystem
+    wind: MeanWind
+    mean: MeanStates
+
+
+def mean_state_times(case: Case) -> np.ndarray:
+    """Instants of the step-1 mean states [s] (synoptic: one state at t = 0)."""
+    if case.wind.type == "synoptic":
+        return np.zeros(1)
+    from ..core.wind.mean import event_window  # downburst only
+
+    t0, t1 = event_window(case)
+    return np.linspace(t0, t1, case.analysis.mean_states)
+
+
+def static_analysis(
+    case: Case,
+    *,
+    progress: Progress | None = None,
+    cancel: threading.Event | None = None,
+    warn: Warn | None = None,
+) -> StaticResult:
+    """Step 1 of the method: non-linear static analysis under the running-mean wind.
+
+    ``warn(message)`` receives the case's warnings (:func:`~linecheck.analysis.guard.warn_case`)
+    and resource warnings (:func:`~linecheck.analysis.guard.check_budget`)."""
+    warn_case(case, warn)
+    check_budget(case, "static", warn=warn)
+    return static_result(case, progress=progress, cancel=cancel)
+
+
+def static_result(case: Case, *, progress: Progress | None = None,
+                  cancel: threading.Event | None = None) -> StaticResult:
+    """:func:`static_analysis` without the case's warnings and the resource guard: for jobs that
+    ran the guard themselves.  ``progress(stage, done, total)`` over the mean states; a set
+    ``cancel`` stops with :class:`~linecheck.core.errors.Cancelled`."""
+    system = LineSystem(case.line)
+    wind = mean_wind(case, system, mean_state_times(case))
+    gy = mean_loads(case, wind)  # paper Eq. 1
+    cb = None if progress is None else (lambda d, n: progress("step 1: mean states", d, n))
+    mean = solve_mean_states(system, wind.time, gy, progress=cb, cancel=cancel)
+    return StaticResult(case, system, wind, mean)

@@ -5,7 +5,8 @@ numerical core, the service layer and :mod:`linecheck.io` -- never a UI library
 (``textual``, ``rich``, ``typer``) -- and Dask only when a scheduler is used.
 
 - :func:`run_batch` -- many cases, split by case x realization chunk, results saved
-  per case as they complete, ``resume``, progress events, cancellation.
+  per case as they complete, ``resume``, progress events, cancellation (:mod:`.runner`;
+  its parts: :mod:`.plan`, :mod:`.scheduler`, :mod:`.recovery`, :mod:`.saving`, :mod:`.report`).
 - :func:`merge_runs` -- join runs of disjoint realization subsets of one case.
 - :func:`make_executor`, :class:`SequentialExecutor`, :class:`ProcessPool`,
   :class:`DaskExecutor` -- where the tasks run.

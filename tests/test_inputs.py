@@ -86,7 +86,7 @@ def test_read_regular_file_reads_at_most_the_cap(tmp_path):
 
 
 def test_oversize_field_file_is_refused_before_reading(tmp_path, monkeypatch):
-    import linecheck.core.wind.mean as mean
+    import linecheck.core.wind.field_table as mean
 
     src = (CASES / "fields" / "example-field.csv").read_bytes()
     p = tmp_path / "field.csv"

@@ -194,7 +194,7 @@ PROBE_HEIGHTS = (5.0, 10.0, 20.0, 25.0, 40.0, 80.0, 150.0)  # m, D_j = 1000 m
 def _required_jet_speeds(model):
     """The issue's probe: v_ref = 40 m/s fixed at p (D_j = 1000 m, R = 1.2 D_j) at each height;
     the jet speed V_j the model needs there (as `linecheck wind --json` reports it)."""
-    return np.array([M._ring_scale(_ring_case(model, **{"wind.reference_height": h})).jet_velocity
+    return np.array([M.ring_scale(_ring_case(model, **{"wind.reference_height": h})).jet_velocity
                      for h in PROBE_HEIGHTS])
 
 

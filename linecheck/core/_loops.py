@@ -154,43 +154,44 @@ def background(c, L, dirs, straight, nz, GT, cols, R):  # pragma: no cover - com
         reactions_into(x[r // 4, :, r % 4], nz, GT, cols, R[r])
 
 
-@numba.njit(cache=True, nogil=True, fastmath={"contract"})
-def band_solve_1(c, x):  # pragma: no cover - compiled
-    """:func:`band_solve` for one vector x (n,) (one realization: no lanes).
-
-    With the core's half-bandwidth (5) the five unknowns a row reads stay in registers (rolled
-    along the rows) instead of being stored and loaded again at every row: the same operations
-    in the same order (the same bits), without the store-to-load latency on the dependent chain
-    (measured ≈ 6 → 3.5 µs for 177 DOFs)."""
+@numba.njit(cache=True, nogil=True, fastmath={"contract"}, inline="always")
+def _band_solve_1_rows(c, x):  # pragma: no cover - compiled
+    """:func:`band_solve_1` of any half-bandwidth kd = c.shape[0] - 1, x (n,) in place: a dot
+    product per row forward, an axpy per column back (:func:`band_solve`'s loops, one lane)."""
     kd = c.shape[0] - 1
     n = c.shape[1]
-    if kd != 5 or n < 6:
-        for j in range(n):
-            k = min(j, kd)
-            s0 = 0.0
-            for t in range(k):
-                i = j - k + t
-                s0 += c[kd + i - j, j] * x[i]
-            x[j] = (x[j] - s0) / c[kd, j]
-        for j in range(n - 1, -1, -1):
-            x0 = x[j] / c[kd, j]
-            x[j] = x0
-            k = min(j, kd)
-            for t in range(k):
-                i = j - k + t
-                x[i] += -x0 * c[kd + i - j, j]
-        return
-    for j in range(5):  # U^T y = b: the first rows read fewer than five unknowns
+    for j in range(n):
+        k = min(j, kd)
+        s0 = 0.0
+        for t in range(k):
+            i = j - k + t
+            s0 += c[kd + i - j, j] * x[i]
+        x[j] = (x[j] - s0) / c[kd, j]
+    for j in range(n - 1, -1, -1):
+        x0 = x[j] / c[kd, j]
+        x[j] = x0
+        k = min(j, kd)
+        for t in range(k):
+            i = j - k + t
+            x[i] += -x0 * c[kd + i - j, j]
+
+
+@numba.njit(cache=True, nogil=True, fastmath={"contract"}, inline="always")
+def _forward_5(c, x):  # pragma: no cover - compiled
+    """U^T y = b in place, x (n,) with n >= 6, half-bandwidth 5: the first five rows read fewer
+    unknowns; then r_m = y[j - m] rolled along the rows in registers."""
+    n = c.shape[1]
+    for j in range(5):
         s0 = 0.0
         for t in range(j):
-            s0 += c[kd + t - j, j] * x[t]
-        x[j] = (x[j] - s0) / c[kd, j]
+            s0 += c[5 + t - j, j] * x[t]
+        x[j] = (x[j] - s0) / c[5, j]
     r1 = x[4]
     r2 = x[3]
     r3 = x[2]
     r4 = x[1]
     r5 = x[0]
-    for j in range(5, n):  # r_m = y[j - m]
+    for j in range(5, n):
         s0 = 0.0
         s0 += c[0, j] * r5
         s0 += c[1, j] * r4
@@ -204,7 +205,14 @@ def band_solve_1(c, x):  # pragma: no cover - compiled
         r3 = r2
         r2 = r1
         r1 = yj
-    # U x = y: q_m holds y[j - m] with the updates of the columns after j (in the same order)
+
+
+@numba.njit(cache=True, nogil=True, fastmath={"contract"}, inline="always")
+def _back_5(c, x):  # pragma: no cover - compiled
+    """U x = y in place, x (n,) with n >= 6, half-bandwidth 5: q_m holds y[j - m] with the
+    updates of the columns after j (in the same order), rolled in registers; the first five
+    rows as in :func:`_band_solve_1_rows`."""
+    n = c.shape[1]
     q0 = x[n - 1]
     q1 = x[n - 2]
     q2 = x[n - 3]
@@ -230,10 +238,25 @@ def band_solve_1(c, x):  # pragma: no cover - compiled
     x[1] = q3
     x[0] = q4
     for j in range(4, -1, -1):
-        x0 = x[j] / c[kd, j]
+        x0 = x[j] / c[5, j]
         x[j] = x0
         for t in range(j):
-            x[t] += -x0 * c[kd + t - j, j]
+            x[t] += -x0 * c[5 + t - j, j]
+
+
+@numba.njit(cache=True, nogil=True, fastmath={"contract"})
+def band_solve_1(c, x):  # pragma: no cover - compiled
+    """:func:`band_solve` for one vector x (n,) (one realization: no lanes).
+
+    With the core's half-bandwidth (5) the five unknowns a row reads stay in registers (rolled
+    along the rows: :func:`_forward_5`, :func:`_back_5`) instead of being stored and loaded again
+    at every row: the same operations in the same order (the same bits), without the
+    store-to-load latency on the dependent chain (measured ≈ 6 → 3.5 µs for 177 DOFs)."""
+    if c.shape[0] != 6 or c.shape[1] < 6:
+        _band_solve_1_rows(c, x)
+        return
+    _forward_5(c, x)
+    _back_5(c, x)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -295,6 +318,56 @@ def steps_1(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, band, a1,
 
 
 @numba.njit(cache=True, nogil=True)
+def _newmark_rhs(loads_k, g, ycoef, cu, cv, dm, ug, vg, ag, bg, f, has_rest, band, a1, w, t):  # pragma: no cover - compiled
+    """The right-hand side bg (n_dof, 4) [N] of group g's four lanes for one step: (cu u + cv v)
+    + dm a + F, F = load x ycoef (the numpy loop's Fb; loads_k (n_real, n_free) [N], lanes past
+    n_real load-free), plus C~_off (a1 u + v) with ``has_rest`` (csr_matvecs' bits:
+    :func:`rest_product`).  ug, vg, ag (n_dof, 4) the lanes' state; f (4,), w (4, n_dof + 2 h),
+    t (4, n_dof): scratch."""
+    m, n_free = loads_k.shape
+    n = ug.shape[0]
+    h = (band.shape[0] - 1) // 2
+    for i in range(n_free):
+        for l in range(4):
+            r = 4 * g + l
+            f[l] = loads_k[r, i] if r < m else 0.0
+        for q in range(3):
+            d = 3 * i + q
+            yc = ycoef[i, q]
+            for l in range(4):
+                bg[d, l] = ((cu[d] * ug[d, l] + cv[d] * vg[d, l]) + dm[d] * ag[d, l]) + f[l] * yc
+    if has_rest:
+        for d in range(n):
+            for l in range(4):
+                w[l, h + d] = a1 * ug[d, l] + vg[d, l]
+        rest_product(band, w, t)
+        for d in range(n):
+            for l in range(4):
+                bg[d, l] += t[l, d]
+
+
+@numba.njit(cache=True, nogil=True)
+def _newmark_update(ug, vg, ag, bg, r2):  # pragma: no cover - compiled
+    """The new state of four lanes (n_dof, 4) in place from the solved u' = bg [m]:
+    v' = (u' - u) 2/dt - v, a' = (v' - v) 2/dt - a (r2 = 2/dt [1/s])."""
+    for d in range(ug.shape[0]):
+        for l in range(4):
+            vn = (bg[d, l] - ug[d, l]) * r2 - vg[d, l]
+            ag[d, l] = (vn - vg[d, l]) * r2 - ag[d, l]
+            vg[d, l] = vn
+            ug[d, l] = bg[d, l]
+
+
+@numba.njit(cache=True, nogil=True)
+def _keep_states(u, c0, m, out):  # pragma: no cover - compiled
+    """u of the m realizations (lanes (n_groups, n_dof, 4)) into out[:, c0:c0 + m] (dof-major: a
+    row's m values at once)."""
+    for d in range(u.shape[1]):
+        for r in range(m):
+            out[d, c0 + r] = u[r // 4, d, r % 4]
+
+
+@numba.njit(cache=True, nogil=True)
 def steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, band, a1,
           out, nz, GT, cols, R):  # pragma: no cover - compiled
     """Newmark steps of one block; U, V, A updated in place.
@@ -305,7 +378,7 @@ def steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, band, a1,
     second-order tension reads it, second_order_reactions(transposed=True)); R (n_b, n_real, n_r)
     the reactions G u, summed coordinate by coordinate from zero over the columns
     [cols[i, 0], cols[i, 1]) of GT's row i (the order of dynamics._sparse_reactions)."""
-    n_b, m, n_free = loads.shape
+    n_b, m = loads.shape[:2]
     keep = out.shape[1] > 0  # the states after every step, for the second-order tension
     n = U.shape[1]
     u = to_lanes(U)  # lane l of group g is realization 4 g + l (padding lanes stay 0)
@@ -319,38 +392,12 @@ def steps(U, V, A, loads, ycoef, cu, cv, dm, r2, chat, has_rest, band, a1,
     f = np.zeros(4)
     for k in range(n_b):
         for g in range(G):
-            ug, vg, ag, bg = u[g], v[g], a[g], b[g]
-            for i in range(n_free):  # F = load x ycoef (the numpy loop's Fb)
-                for l in range(4):
-                    r = 4 * g + l
-                    f[l] = loads[k, r, i] if r < m else 0.0
-                for q in range(3):
-                    d = 3 * i + q
-                    yc = ycoef[i, q]
-                    for l in range(4):
-                        bg[d, l] = ((cu[d] * ug[d, l] + cv[d] * vg[d, l]) + dm[d] * ag[d, l]) + f[l] * yc
-            if has_rest:  # C~_off (a1 u + v): csr_matvecs' bits (rest_product)
-                for d in range(n):
-                    for l in range(4):
-                        w[l, h + d] = a1 * ug[d, l] + vg[d, l]
-                rest_product(band, w, t)
-                for d in range(n):
-                    for l in range(4):
-                        bg[d, l] += t[l, d]
+            _newmark_rhs(loads[k], g, ycoef, cu, cv, dm, u[g], v[g], a[g], b[g], f, has_rest, band, a1, w, t)
         band_solve(chat, b)
         for g in range(G):
-            ug, vg, ag, bg = u[g], v[g], a[g], b[g]
-            for d in range(n):  # v' = (u' - u) 2/dt - v, a' = (v' - v) 2/dt - a
-                for l in range(4):
-                    vn = (bg[d, l] - ug[d, l]) * r2 - vg[d, l]
-                    ag[d, l] = (vn - vg[d, l]) * r2 - ag[d, l]
-                    vg[d, l] = vn
-                    ug[d, l] = bg[d, l]
-        if keep:  # dof-major: column k m + r is realization r after step k (a row's m values at once)
-            c0 = k * m
-            for d in range(n):
-                for r in range(m):
-                    out[d, c0 + r] = u[r // 4, d, r % 4]
+            _newmark_update(u[g], v[g], a[g], b[g], r2)
+        if keep:  # dof-major: column k m + r is realization r after step k
+            _keep_states(u, k * m, m, out)
         for r in range(m):
             reactions_into(u[r // 4, :, r % 4], nz, GT, cols, R[k, r])
     from_lanes(u, U)

@@ -154,34 +154,27 @@ def _rhs(Lt, dirs, straight, j, y):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, nogil=True)
-def so_solve(c, inv, L, dirs, straight, i0, r, y, xr, s, Lt):  # pragma: no cover - compiled
-    """The quasi-static displacements of the load rows i0 <= i < i0 + r of L (m, n_free), lane
-    j = row i0 + j (lanes >= r solve zeros): the right-hand sides (global y, or along ``dirs``
-    (n_free, 3) when not ``straight``), then U^T U x = b by rows of lanes (c the upper band of
-    dpbtrf, inv = 1 / its diagonal); x returned in xr (n_dof, nb) in reversed row order,
-    xr[n - 1 - j] = x_j (the algorithm of LAPACK dpbtrs, which the numpy form calls; no
-    contraction).  y (n_dof, nb), s (nb,), Lt (n_free, nb): scratch.
-
-    Speed (measured when written): the rows with the core's full half-bandwidth (5) in
-    one pass, the band's sum in a register and the load placed in the same pass (no zeroed
-    right-hand side), 2-D indexing (row views kept LLVM's overlap checks: 3x slower), loop bounds
-    rather than a flag around the loop (it did not vectorise: 2.8x), and the back substitution
-    written upward into xr (reading the rows just written below the one written; reading the rows
-    above it in place ran 2x slower)."""
-    kd = c.shape[0] - 1
-    n = c.shape[1]
-    nb = y.shape[1]
+def _loads_to_lanes(L, i0, r, Lt):  # pragma: no cover - compiled
+    """Lt[i, j] (n_free, nb) = L[i0 + j, i] [N] for the lanes j < r, zero for j >= r (row by
+    row: 1.6x faster than in tiles, measured)."""
+    nb = Lt.shape[1]
     nf = L.shape[1]
     Lb = L[i0:i0 + r]
-    for j in range(r):  # L's rows into lanes (row by row: 1.6x faster than in tiles, measured)
+    for j in range(r):
         for i in range(nf):
             Lt[i, j] = Lb[j, i]
     for i in range(nf):
         for j in range(r, nb):
             Lt[i, j] = 0.0
-    # the rows in the register form: j >= j5 forward, n - 1 - j >= jb5 back
-    j5 = 5 if kd == 5 and n > 5 else n
-    for j in range(j5):  # U^T y = b
+
+
+@numba.njit(cache=True, nogil=True)
+def _forward_rows(c, inv, Lt, dirs, straight, j5, y, s):  # pragma: no cover - compiled
+    """U^T y = b for the rows j < j5 (n_dof, nb): each row's right-hand side placed by
+    :func:`_rhs`, the band's sum over its k = min(j, kd) earlier rows accumulated in s (nb,)."""
+    kd = c.shape[0] - 1
+    nb = y.shape[1]
+    for j in range(j5):
         _rhs(Lt, dirs, straight, j, y)
         k = min(j, kd)
         w = inv[j]
@@ -198,6 +191,15 @@ def so_solve(c, inv, L, dirs, straight, i0, r, y, xr, s, Lt):  # pragma: no cove
         else:
             for l in range(nb):
                 y[j, l] = y[j, l] * w
+
+
+@numba.njit(cache=True, nogil=True)
+def _forward_rows_5(c, inv, Lt, dirs, straight, j5, y):  # pragma: no cover - compiled
+    """U^T y = b for the rows j >= j5 of a half-bandwidth 5 (y (n_dof, nb)): the band's sum in a
+    register, the load of row j (:func:`_rhs`'s) placed in the same pass (no zeroed right-hand
+    side)."""
+    n = c.shape[1]
+    nb = y.shape[1]
     for j in range(j5, n):
         c0 = c[0, j]
         c1 = c[1, j]
@@ -220,8 +222,16 @@ def so_solve(c, inv, L, dirs, straight, i0, r, y, xr, s, Lt):  # pragma: no cove
             for l in range(nb):
                 y[j, l] = (0.0 - (c0 * y[j - 5, l] + c1 * y[j - 4, l] + c2 * y[j - 3, l] + c3 * y[j - 2, l]
                                   + c4 * y[j - 1, l])) * w
-    jb5 = 5 if j5 < n else n
-    for jr in range(jb5):  # U x = y, x_j = xr[jr], j = n - 1 - jr
+
+
+@numba.njit(cache=True, nogil=True)
+def _back_rows(c, inv, y, jb5, xr, s):  # pragma: no cover - compiled
+    """U x = y for the last rows j = n - 1 - jr, jr < jb5, into xr[jr] (n_dof, nb): the band's
+    sum over the k = min(jr, kd) rows below accumulated in s (nb,)."""
+    kd = c.shape[0] - 1
+    n = c.shape[1]
+    nb = y.shape[1]
+    for jr in range(jb5):
         j = n - 1 - jr
         k = min(jr, kd)
         w = inv[j]
@@ -238,6 +248,15 @@ def so_solve(c, inv, L, dirs, straight, i0, r, y, xr, s, Lt):  # pragma: no cove
         else:
             for l in range(nb):
                 xr[jr, l] = y[j, l] * w
+
+
+@numba.njit(cache=True, nogil=True)
+def _back_rows_5(c, inv, y, jb5, xr):  # pragma: no cover - compiled
+    """U x = y for the rows j = n - 1 - jr, jr >= jb5, of a half-bandwidth 5, into xr[jr]
+    (n_dof, nb), the band's sum in a register: written upward, reading the rows of xr just
+    written below (reading the rows above in place ran 2x slower, measured)."""
+    n = c.shape[1]
+    nb = y.shape[1]
     for jr in range(jb5, n):
         j = n - 1 - jr
         c0 = c[4, j + 1]
@@ -249,6 +268,30 @@ def so_solve(c, inv, L, dirs, straight, i0, r, y, xr, s, Lt):  # pragma: no cove
         for l in range(nb):
             xr[jr, l] = (y[j, l] - (c0 * xr[jr - 1, l] + c1 * xr[jr - 2, l] + c2 * xr[jr - 3, l] + c3 * xr[jr - 4, l]
                                     + c4 * xr[jr - 5, l])) * w
+
+
+@numba.njit(cache=True, nogil=True)
+def so_solve(c, inv, L, dirs, straight, i0, r, y, xr, s, Lt):  # pragma: no cover - compiled
+    """The quasi-static displacements [m] of the load rows i0 <= i < i0 + r of L [N]
+    (m, n_free), lane j = row i0 + j (lanes >= r solve zeros): the right-hand sides (global y,
+    or along ``dirs`` (n_free, 3) when not ``straight``), then U^T U x = b by rows of lanes (c the
+    upper band of dpbtrf, inv = 1 / its diagonal); x returned in xr (n_dof, nb) in reversed row
+    order, xr[n - 1 - j] = x_j (the algorithm of LAPACK dpbtrs, which the numpy form calls; no
+    contraction).  y (n_dof, nb), s (nb,), Lt (n_free, nb): scratch.
+
+    Speed (measured when written): with the core's half-bandwidth (5) the rows past the first
+    five take the register form (:func:`_forward_rows_5`, :func:`_back_rows_5`), split off by loop
+    bounds rather than a flag around the loop (it did not vectorise: 2.8x); 2-D indexing (row
+    views kept LLVM's overlap checks: 3x slower)."""
+    kd = c.shape[0] - 1
+    n = c.shape[1]
+    _loads_to_lanes(L, i0, r, Lt)
+    j5 = 5 if kd == 5 and n > 5 else n  # the rows j >= j5 forward, n - 1 - j >= jb5 back: register form
+    jb5 = 5 if j5 < n else n
+    _forward_rows(c, inv, Lt, dirs, straight, j5, y, s)
+    _forward_rows_5(c, inv, Lt, dirs, straight, j5, y)
+    _back_rows(c, inv, y, jb5, xr, s)
+    _back_rows_5(c, inv, y, jb5, xr)
 
 
 def scipy_dgemm() -> int | None:

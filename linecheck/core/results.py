@@ -128,11 +128,9 @@ def compute_statistics(
 ) -> Statistics:
     """Statistics of Eqs 15-17 from response histories.
 
-    With ``window`` (samples, ``analysis.peak_window``) the record is cut into
-    n_w = (n_t - 1) // window consecutive windows of ``window`` samples (a remainder shorter
-    than a window at the end is dropped) and every statistic is taken per window: the result
-    has n_real x n_w samples, realization-major.  ``window`` None or >= n_t - 1 steps: the
-    whole record.
+    With ``window`` (samples, ``analysis.peak_window``) every statistic is taken per window
+    (:func:`_peak_windows`): n_real x n_w samples, realization-major; ``window`` None or
+    >= n_t - 1 steps: the whole record.
 
     Args:
         mean: [N] wind-induced mean reaction M(t), shape (n_t, n_towers, 3).
@@ -147,9 +145,35 @@ def compute_statistics(
             ``mean`` holds some of its towers only).
     """
     scale = max(float(np.abs(mean).max()), 1e-300) if scale is None else scale
+    M, background, resonant, mean_max = _peak_windows(mean, background, resonant, window)
+    # one compiled pass over the histories with the kernel's piece ``reductions`` (checked at load)
+    red = kernel.history_reductions(M, background, resonant, still_air)
+    if red is None:  # the piece off: the numpy form
+        red = history_reductions(M, background, resonant, still_air)
+    rms_b, rms_r, rms_f, pk_qs, pk_dy, pk_qs_t, pk_dy_t = red
+    return Statistics(
+        mean_max=mean_max,
+        rms_background=rms_b,
+        rms_resonant=rms_r,
+        rms_fluctuating=rms_f,
+        peak_quasi_static=pk_qs,
+        peak_dynamic=pk_dy,
+        peak_quasi_static_total=pk_qs_t,
+        peak_dynamic_total=pk_dy_t,
+        **_ratios(mean_max, pk_qs, pk_dy, pk_dy_t, mean_max > ZERO_MEAN_RTOL * scale, g_yp_L),
+    )
+
+
+def _peak_windows(mean: np.ndarray, background: np.ndarray, resonant: np.ndarray,
+                  window: int | None) -> tuple[np.ndarray, ...]:
+    """The histories cut into peak windows: with 0 < ``window`` < n_t - 1, n_w = (n_t - 1) //
+    window consecutive windows of ``window`` samples (n_t samples span n_t - 1 steps; a shorter
+    remainder at the end is dropped), else the whole record as one.  Returns M [N] (n_samples or
+    1, n_s, n_towers, 3), B and R [N] (n_samples, n_s, n_towers, 3) and mean_max = max_t |M| [N]
+    (n_samples, n_towers, 3): n_s = window or n_t, n_samples = n_real x n_w, realization-major."""
     n_real, n_t = background.shape[:2]
     if window is not None and 0 < window < n_t - 1:
-        n_w = (n_t - 1) // window  # n_t samples span n_t - 1 steps
+        n_w = (n_t - 1) // window
         cut = n_w * window
         tail = background.shape[2:]
         background = background[:, :cut].reshape((n_real * n_w, window) + tail)
@@ -159,12 +183,15 @@ def compute_statistics(
     else:
         M = mean[None]
         mean_max = np.broadcast_to(np.abs(mean).max(axis=0), background.shape[:1] + mean.shape[1:]).copy()
-    # one compiled pass over the histories with the kernel's piece ``reductions`` (checked at load)
-    red = kernel.history_reductions(M, background, resonant, still_air)
-    if red is None:  # the piece off: the numpy form
-        red = history_reductions(M, background, resonant, still_air)
-    rms_b, rms_r, rms_f, pk_qs, pk_dy, pk_qs_t, pk_dy_t = red
-    defined = mean_max > ZERO_MEAN_RTOL * scale
+    return M, background, resonant, mean_max
+
+
+def _ratios(mean_max: np.ndarray, pk_qs: np.ndarray, pk_dy: np.ndarray, pk_dy_t: np.ndarray, defined: np.ndarray,
+            g_yp_L: float | np.ndarray) -> dict[str, np.ndarray]:
+    """The gust factors GF_Dy, GF_QS [-] (Eq. 15; NaN where not ``defined``), the contributions
+    Cont_M, Cont_BG, Cont_R [-] (Eq. 16, as fractions of the peak: NaN where it is 0) and the
+    normalised peaks peak_dynamic(_total) / g*_yp L_x [-] (Eq. 17; NaN unless every g_yp_L [N]
+    > 0), each (n_samples, n_towers, 3), from the peaks and mean_max [N] of that shape."""
     with np.errstate(divide="ignore", invalid="ignore"):
         gf_dy = np.where(defined, pk_dy / mean_max, np.nan)
         gf_qs = np.where(defined, pk_qs / mean_max, np.nan)
@@ -175,23 +202,8 @@ def compute_statistics(
         gL = g[:, None] if g.ndim else g_yp_L  # per tower (a section's L_x differs)
         norm = pk_dy / gL if np.all(g > 0) else np.full_like(pk_dy, np.nan)
         norm_t = pk_dy_t / gL if np.all(g > 0) else np.full_like(pk_dy, np.nan)
-    return Statistics(
-        mean_max=mean_max,
-        rms_background=rms_b,
-        rms_resonant=rms_r,
-        rms_fluctuating=rms_f,
-        peak_quasi_static=pk_qs,
-        peak_dynamic=pk_dy,
-        peak_quasi_static_total=pk_qs_t,
-        peak_dynamic_total=pk_dy_t,
-        GF_Dy=gf_dy,
-        GF_QS=gf_qs,
-        Cont_M=cont_m,
-        Cont_BG=cont_bg,
-        Cont_R=cont_r,
-        peak_normalised=norm,
-        peak_normalised_total=norm_t,
-    )
+    return {"GF_Dy": gf_dy, "GF_QS": gf_qs, "Cont_M": cont_m, "Cont_BG": cont_bg, "Cont_R": cont_r,
+            "peak_normalised": norm, "peak_normalised_total": norm_t}
 
 
 def history_reductions(M: np.ndarray, background: np.ndarray, resonant: np.ndarray,

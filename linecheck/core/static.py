@@ -29,13 +29,16 @@ import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.linalg import lapack
 
 from . import kernel
 from .errors import Cancelled, ConvergenceError
-from .system import LineSystem
+
+if TYPE_CHECKING:  # annotations only: the system solves its still-air state with this module
+    from .system import LineSystem
 
 MAX_STRAIN = 0.05  # conductor strain above this is not an admissible elastic state
 _dgtsv = lapack.dgtsv

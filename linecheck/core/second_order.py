@@ -257,22 +257,22 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
     ``transposed`` U is given as its transpose (n_dof, m) (the compiled Newmark loop's dof-major
     history): the same result, read along its rows.
 
-    R_2 = P W (:func:`reaction_form`), block by block of rows: the displacements go node-major
-    into a preallocated (n_nodes, 3, rows) array (rotated by one batched 3x3 product per node),
-    the members' second-order terms into P (transposed, (3 n_el + 3 n_s, rows)), and P W by
-    BLAS: a dozen numpy calls per block with ``out=`` instead of the ~45 elementwise passes of
-    building f2 and multiplying by A.  With the optional compiled kernel (``passes``: the kernel's
-    by default when its piece ``second_order`` is on, None for numpy) a block's elementwise work is
-    three compiled calls (:func:`linecheck.core._loops.so_nodes`, ``so_frame``, ``so_products``),
-    and with the piece ``second_order_loop`` (``dgemm``: scipy's dgemm address, the kernel's by
-    default) the whole block loop is one compiled call (:func:`_history`, no GIL).  The forms
-    agree within the kernel's tolerance (:data:`linecheck.core.kernel.RTOL`), not bit for bit.
+    R_2 = P W (:func:`reaction_form`), block by block of rows (:func:`_reactions`): the
+    displacements go node-major into a preallocated (n_nodes, 3, rows) array (rotated by one
+    batched 3x3 product per node), the members' second-order terms into P (transposed,
+    (3 n_el + 3 n_s, rows)), and P W by BLAS.  With the optional compiled kernel (``passes``: the
+    kernel's by default when its piece ``second_order`` is on, None for numpy) a block's
+    elementwise work is three compiled calls (:func:`linecheck.core._loops.so_nodes`,
+    ``so_frame``, ``so_products``), and with the piece ``second_order_loop`` (``dgemm``: scipy's
+    dgemm address, the kernel's by default) the whole block loop is one compiled call
+    (:func:`_history`, no GIL).  The forms agree within the kernel's tolerance
+    (:data:`linecheck.core.kernel.RTOL`), not bit for bit.
 
     Rows are processed in blocks of a fixed size that depends on the operator only (the last
     block padded with zeros), so every BLAS product always has the same shape: a row's result
     does not depend on how many other rows (realizations) share the call, and results stay
-    bit-identical (on one machine and code path) whatever the batch chunking.  The products are small enough for OpenBLAS to
-    run on one thread (no thread start-up on a shared machine).
+    bit-identical (on one machine and code path) whatever the batch chunking.  The products are
+    small enough for OpenBLAS to run on one thread (no thread start-up on a shared machine).
     """
     fns = _passes(passes)
     fp = _dgemm(dgemm, fns)
@@ -280,18 +280,32 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
     if fp is not None:
         return _history(op, fns, fp, m, U=np.ascontiguousarray(U, dtype=float), T=T, transposed=transposed)
     if fns is not None:
-        Uc = np.ascontiguousarray(U, dtype=float)
-        Tc = np.zeros((1, 3, 3)) if T is None else np.ascontiguousarray(T, dtype=float)
-
-        def fill(u: np.ndarray, i0: int, r: int) -> None:
-            if transposed:
-                fns.so_nodes_t(Uc, i0, r, Tc, op.node_of_free, T is not None, u)
-            else:
-                fns.so_nodes(Uc[i0:i0 + r], r, Tc, op.node_of_free, T is not None, u)
-
-        return _reactions(op, m, fill, fns=fns)
+        return _reactions(op, m, _compiled_fill(op, fns, U, T, transposed), fns=fns)
     if transposed:
         U = U.T
+    return _reactions(op, U.shape[0], _numpy_fill(op, U, T))
+
+
+def _compiled_fill(op: SecondOrder, fns, U: np.ndarray, T: np.ndarray | None, transposed: bool):
+    """The ``fill(u, i0, r)`` of :func:`_reactions` for U [m] (m, n_dof) (or (n_dof, m) when
+    ``transposed``) in the node bases T (n_free_nodes, 3, 3) or global (None): the compiled
+    ``so_nodes`` (``so_nodes_t``)."""
+    Uc = np.ascontiguousarray(U, dtype=float)
+    Tc = np.zeros((1, 3, 3)) if T is None else np.ascontiguousarray(T, dtype=float)
+
+    def fill(u: np.ndarray, i0: int, r: int) -> None:
+        if transposed:
+            fns.so_nodes_t(Uc, i0, r, Tc, op.node_of_free, T is not None, u)
+        else:
+            fns.so_nodes(Uc[i0:i0 + r], r, Tc, op.node_of_free, T is not None, u)
+
+    return fill
+
+
+def _numpy_fill(op: SecondOrder, U: np.ndarray, T: np.ndarray | None):
+    """The ``fill(u, i0, r)`` of :func:`_reactions` for U [m] (m, n_dof) in the node bases T
+    (n_free_nodes, 3, 3) (u = T u~ node by node, one batched product per run of free nodes on a
+    block padded with zero rows: the product keeps its shape) or global (None), numpy form."""
     n_f = U.shape[1] // 3
     pad = None
 
@@ -314,7 +328,7 @@ def second_order_reactions(op: SecondOrder, U: np.ndarray, T: np.ndarray | None 
         if T is None and r < nb:
             u[:, :, r:] = 0.0
 
-    return _reactions(op, U.shape[0], fill)
+    return fill
 
 
 def second_order_of_loads(op: SecondOrder, L: np.ndarray, c: np.ndarray, dirs: np.ndarray | None = None, *,
@@ -362,30 +376,18 @@ def second_order_of_loads(op: SecondOrder, L: np.ndarray, c: np.ndarray, dirs: n
 
 
 def _reactions(op: SecondOrder, m: int, fill, fns=None) -> np.ndarray:
-    """R_2 (m, n_r) of m rows of displacements that ``fill(u, i0, r)`` writes node-major into
-    u[:, :, :r] (global x, y, z; (n_nodes, 3, nb)), zeroing u[:, :, r:] (docstrings above);
-    ``fns`` the compiled passes or None (numpy)."""
-    W, chunk, nb, ec = op.Wp, op.chunk, op.nb, op.ec
-    n_el = op.n_nodes - 1
-    n_s = op.c.size - n_el
+    """R_2 [N] (m, n_r) of m rows of displacements [m] that ``fill(u, i0, r)`` writes node-major
+    into u[:, :, :r] (global x, y, z; (n_nodes, 3, nb)), zeroing u[:, :, r:] (docstrings above);
+    ``fns`` the compiled passes or None (numpy: :func:`_products`).  Per block of nb rows the
+    members' second-order terms go into P (3 n_el + 3 n_s, nb), then P W (W (3 n_el + 3 n_s,
+    n_r)) in products of always ``chunk`` rows."""
+    W, chunk, nb = op.Wp, op.chunk, op.nb
+    n_s = op.c.size - (op.n_nodes - 1)
     u = np.zeros((op.n_nodes, 3, nb))  # pinned nodes stay zero
     P = np.zeros((W.shape[0], nb), dtype=W.dtype)  # padding columns stay zero
     li = np.empty((n_s, 3, nb))
     tmp = np.empty((chunk, W.shape[1]), dtype=W.dtype)
-    if fns is None:
-        d = np.empty((n_el, 3, nb))
-        a = np.empty((n_el, nb))
-        q = np.empty((n_el, nb))
-        t = np.empty((n_el, nb))
-        v = np.empty((n_el, nb))
-        E = [ec[:, k, None] for k in range(3)]  # (n_el, 1) each
-        Pq = P[:3 * n_el].reshape(n_el, 3, nb)  # cable elements: a du + q e
-        Pi = P[3 * n_el:].reshape(n_s, 3, nb)  # insulators: a s, a w, s^2 + w^2
-        di = np.empty((n_s, 3, nb))
-        sq = np.empty((n_s, 2, nb))
-        pi = np.empty((n_s, 3, nb))
-    else:
-        d = np.empty((5, nb))
+    work = _Work(op, P) if fns is None else np.empty((5, nb))
     out = np.empty((m, W.shape[1]))
     for i0 in range(0, m, nb):
         i1 = min(i0 + nb, m)
@@ -393,38 +395,70 @@ def _reactions(op: SecondOrder, m: int, fill, fns=None) -> np.ndarray:
         fill(u, i0, r)
         if fns is not None:  # the same operations, compiled (_loops.so_frame, so_products)
             fns.so_frame(u, op.ins_nodes, op.ins_frame, li)
-            fns.so_products(u, ec, li, P, d)
-        else:  # cable elements (reaction_form), as _loops.so_products
-            np.subtract(u[1:], u[:-1], out=d)  # du = u_b - u_a
-            np.multiply(d[:, 0], E[0], out=a)  # a = e.du
-            np.multiply(d[:, 1], E[1], out=t)
-            a += t
-            np.multiply(d[:, 2], E[2], out=t)
-            a += t
-            np.multiply(d[:, 0], d[:, 0], out=q)  # q = |du|^2/2 - 3 a^2/2
-            np.multiply(d[:, 1], d[:, 1], out=t)
-            q += t
-            np.multiply(d[:, 2], d[:, 2], out=t)
-            q += t
-            q *= 0.5
-            np.multiply(a, a, out=t)
-            t *= 1.5
-            q -= t
-            for k in range(3):  # a du + q e
-                np.multiply(a, d[:, k], out=v)
-                np.multiply(q, E[k], out=t)
-                v += t
-                Pq[:, k] = v
-            np.take(u, op.ins_nodes, axis=0, out=di)  # insulators: the fixed point does not move
-            np.matmul(op.ins_frame, di, out=li)  # (a, s, w) in the insulator's frame
-            np.multiply(li[:, :1], li[:, 1:], out=pi[:, :2])  # a s, a w
-            np.multiply(li[:, 1:], li[:, 1:], out=sq)
-            np.add(sq[:, 0], sq[:, 1], out=pi[:, 2])  # s^2 + w^2
-            Pi[...] = pi
+            fns.so_products(u, op.ec, li, P, work)
+        else:
+            _products(op, u, li, work)
         for j0 in range(0, r, chunk):  # P W in products of always chunk rows (a row's bits its own)
             np.matmul(P[:, j0:j0 + chunk].T, W, out=tmp)
             out[i0 + j0:min(i0 + j0 + chunk, i1)] = tmp[:min(chunk, r - j0)]
     return out
+
+
+class _Work:
+    """The numpy form's scratch for one block of nb rows (:func:`_products`): du (n_el, 3, nb),
+    a, q, t, v (n_el, nb), the unit chords E[k] (n_el, 1), P's views Pq (n_el, 3, nb) (cable
+    elements) and Pi (n_s, 3, nb) (insulators), and di, pi (n_s, 3, nb), sq (n_s, 2, nb)."""
+
+    def __init__(self, op: SecondOrder, P: np.ndarray) -> None:
+        nb = P.shape[1]
+        n_el = op.n_nodes - 1
+        n_s = op.c.size - n_el
+        self.d = np.empty((n_el, 3, nb))
+        self.a = np.empty((n_el, nb))
+        self.q = np.empty((n_el, nb))
+        self.t = np.empty((n_el, nb))
+        self.v = np.empty((n_el, nb))
+        self.E = [op.ec[:, k, None] for k in range(3)]  # (n_el, 1) each
+        self.Pq = P[:3 * n_el].reshape(n_el, 3, nb)  # cable elements: a du + q e
+        self.Pi = P[3 * n_el:].reshape(n_s, 3, nb)  # insulators: a s, a w, s^2 + w^2
+        self.di = np.empty((n_s, 3, nb))
+        self.sq = np.empty((n_s, 2, nb))
+        self.pi = np.empty((n_s, 3, nb))
+
+
+def _products(op: SecondOrder, u: np.ndarray, li: np.ndarray, w: _Work) -> None:
+    """The members' second-order terms (:func:`reaction_form`) of one block of displacements u
+    [m] (n_nodes, 3, nb) into P's views w.Pq, w.Pi, numpy form (as _loops.so_products): every
+    cable element's a du + q e (du = u_b - u_a, a = e.du, q = |du|^2/2 - 3 a^2/2), every
+    insulator's a s, a w, s^2 + w^2 of li = (a, s, w) (n_s, 3, nb), its end's displacement in
+    its frame (the fixed point does not move)."""
+    d, a, q, t, v, E = w.d, w.a, w.q, w.t, w.v, w.E
+    np.subtract(u[1:], u[:-1], out=d)  # du = u_b - u_a
+    np.multiply(d[:, 0], E[0], out=a)  # a = e.du
+    np.multiply(d[:, 1], E[1], out=t)
+    a += t
+    np.multiply(d[:, 2], E[2], out=t)
+    a += t
+    np.multiply(d[:, 0], d[:, 0], out=q)  # q = |du|^2/2 - 3 a^2/2
+    np.multiply(d[:, 1], d[:, 1], out=t)
+    q += t
+    np.multiply(d[:, 2], d[:, 2], out=t)
+    q += t
+    q *= 0.5
+    np.multiply(a, a, out=t)
+    t *= 1.5
+    q -= t
+    for k in range(3):  # a du + q e
+        np.multiply(a, d[:, k], out=v)
+        np.multiply(q, E[k], out=t)
+        v += t
+        w.Pq[:, k] = v
+    np.take(u, op.ins_nodes, axis=0, out=w.di)  # insulators: the fixed point does not move
+    np.matmul(op.ins_frame, w.di, out=li)  # (a, s, w) in the insulator's frame
+    np.multiply(li[:, :1], li[:, 1:], out=w.pi[:, :2])  # a s, a w
+    np.multiply(li[:, 1:], li[:, 1:], out=w.sq)
+    np.add(w.sq[:, 0], w.sq[:, 1], out=w.pi[:, 2])  # s^2 + w^2
+    w.Pi[...] = w.pi
 
 
 # ---- the compiled kernel's pieces ``second_order`` and ``second_order_loop``

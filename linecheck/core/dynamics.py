@@ -114,25 +114,22 @@ def integrate(
         dt: [s] time step.
         direct: [N] reactions caused directly by loads applied at pinned nodes,
             shape (n_steps, n_real, n_towers * 3) (added to both F and B).
-        model_at: optional ``model_at(n) -> (model, damping band)`` giving the linear model of
-            step n itself (reference scheme: the step-1 state interpolated in time and the
-            model rebuilt and factorised at every step); default: ``models[state_of_step[n]]``
-            held piecewise constant.
+        model_at: optional ``model_at(n) -> (model, damping band)``, the linear model of step n
+            itself (reference scheme: the step-1 state interpolated in time, the model rebuilt
+            and factorised every step); default: ``models[state_of_step[n]]``, piecewise constant.
         second_order: optional :class:`~linecheck.core.second_order.SecondOrder` operator of
             every mean state (same length as ``models``): the reactions of F and of B then
             include the second-order tension increment of their own displacement histories
-            (with ``model_at`` the operator of the nearest state is used), from step
-            ``second_order_start`` on (the steps before it, a burn-in the caller discards, keep
-            the linear reactions).
+            (with ``model_at`` the nearest state's operator), from step ``second_order_start``
+            on (the steps before it, a burn-in the caller discards, keep the linear reactions).
         progress: ``progress(done, total)`` about every 1 % of the steps (per block).
         cancel: stop early (raises :class:`Cancelled`).
         load_dirs: [-] unit direction of every free node's transverse load, shape (n_free, 3)
             (a section: its span normals); None = the global y axis (a straight line).
 
     Returns:
-        :class:`DynamicResponse` with tower reactions.  The record starts from the
-        quasi-static solution at t = 0 (u0 = K^-1 F0, u'0 = 0), so no background
-        transient is created.
+        :class:`DynamicResponse` with tower reactions.  The record starts from the quasi-static
+        solution at t = 0 (u0 = K^-1 F0, u'0 = 0): no background transient.
     """
     if not np.all(np.isfinite(loads)):
         raise NumericalError("non-finite fluctuating wind load")
@@ -140,6 +137,13 @@ def integrate(
                second_order_start, kernel.use("newmark"))
     R_B = _background(run)  # step 3
     R_F = _newmark(run, progress, cancel)  # step 2
+    return _response(run, R_F, R_B, direct, progress)
+
+
+def _response(run: _Run, R_F: np.ndarray, R_B: np.ndarray, direct: np.ndarray | None,
+              progress: Callable[[int, int], None] | None) -> DynamicResponse:
+    """R_F, R_B [N] (n_steps, n_real, n_r) checked finite, ``direct`` added to both, as the
+    :class:`DynamicResponse` ((n_real, n_steps, n_towers, 3)); the last ``progress`` report."""
     if not (np.all(np.isfinite(R_F)) and np.all(np.isfinite(R_B))):
         raise NumericalError("non-finite response in the time integration")
     if direct is not None:

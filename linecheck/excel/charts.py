@@ -93,73 +93,99 @@ def case_charts(ws: Worksheet, doc: Any, chart_points: int, contrib_rows: tuple[
     ``contrib_rows``: first and last row of the sheet's contributions table (reaction in
     column A, Cont_M/Cont_BG/Cont_R in C-E, headers on the row above).
     """
-    charts = []
+    charts: list = []
     col = DATA_COL
     ws.cell(row=1, column=col, value="Chart data (from the JSON result; time histories thinned keeping "
                                      "each block's extremes unless saved with --full-histories)").style = "lc_note"
+    col = _history_charts(ws, doc, chart_points, col, charts)
+    col = _tension_chart(ws, doc, col, charts)
+    charts.append(_contributions_chart(ws, contrib_rows))
+    return charts
+
+
+def _history_series(doc: Any) -> tuple[np.ndarray, dict[str, dict[str, np.ndarray]]]:
+    """The time and, per reaction Rx/Ry with complete components, M, M+B and M+B+R in kN."""
     th = doc.time_histories
-    if th is not None and th.time:
-        t = as_array(th.time)
-        series: dict[str, dict[str, np.ndarray]] = {}
-        for r in ("Rx", "Ry"):
-            comp = th.series[r]
-            m, b, rr = as_array(comp["M"]), as_array(comp["B"]), as_array(comp["R"])
-            if m.size == t.size and b.size == t.size and rr.size == t.size:
-                series[r] = {"M": kn(m), "M+B": kn(m + b), "M+B+R": kn(m + b + rr)}
-        if series:
-            full = th.decimated is False
-            idx = np.arange(t.size) if full else chart_indices(
-                [s[k] for s in series.values() for k in ("M+B+R", "M+B")], chart_points)
-            row0 = 3
-            _write_column(ws, col, row0, "t (s)", t[idx])
-            xcol = col
+    t = as_array(th.time)
+    series: dict[str, dict[str, np.ndarray]] = {}
+    for r in ("Rx", "Ry"):
+        comp = th.series[r]
+        m, b, rr = as_array(comp["M"]), as_array(comp["B"]), as_array(comp["R"])
+        if m.size == t.size and b.size == t.size and rr.size == t.size:
+            series[r] = {"M": kn(m), "M+B": kn(m + b), "M+B+R": kn(m + b + rr)}
+    return t, series
+
+
+def _history_charts(ws: Worksheet, doc: Any, chart_points: int, col: int, charts: list) -> int:
+    """Paper Figs B1-B12: M, M+B, M+B+R of Rx and Ry over time; returns the next free data column."""
+    th = doc.time_histories
+    if th is None or not th.time:
+        return col
+    t, series = _history_series(doc)
+    if not series:
+        return col
+    full = th.decimated is False
+    idx = np.arange(t.size) if full else chart_indices(
+        [s[k] for s in series.values() for k in ("M+B+R", "M+B")], chart_points)
+    row0 = 3
+    _write_column(ws, col, row0, "t (s)", t[idx])
+    xcol = col
+    col += 1
+    real = th.realization
+    for r, s in series.items():
+        ch = _scatter(f"{r} at tower {doc.tower_of_interest}: M, M+B, M+B+R (realization {real})",
+                      "time (s)", f"{r} (kN)", "0.0")
+        cols = {}
+        for key in ("M", "M+B", "M+B+R"):
+            _write_column(ws, col, row0, f"{r} {key} (kN)", s[key][idx])
+            cols[key] = col
             col += 1
-            real = th.realization
-            for r, s in series.items():
-                ch = _scatter(f"{r} at tower {doc.tower_of_interest}: M, M+B, M+B+R (realization {real})",
-                              "time (s)", f"{r} (kN)", "0.0")
-                cols = {}
-                for key in ("M", "M+B", "M+B+R"):
-                    _write_column(ws, col, row0, f"{r} {key} (kN)", s[key][idx])
-                    cols[key] = col
-                    col += 1
-                for key, color, width in (("M+B+R", "C55A11", 9525), ("M+B", "2E75B6", 9525),
-                                          ("M", "000000", 22225)):
-                    ch.series.append(_line_series(ws, xcol, cols[key], row0, idx.size, color, width))
-                if t.size:
-                    ch.x_axis.scaling.min = float(np.nanmin(t))
-                    ch.x_axis.scaling.max = float(np.nanmax(t))
-                charts.append(ch)
-            col += 1
-    # ---- Fig. 7: running-mean tension / T0 of the spans next to the tower of interest
+        for key, color, width in (("M+B+R", "C55A11", 9525), ("M+B", "2E75B6", 9525),
+                                  ("M", "000000", 22225)):
+            ch.series.append(_line_series(ws, xcol, cols[key], row0, idx.size, color, width))
+        if t.size:
+            ch.x_axis.scaling.min = float(np.nanmin(t))
+            ch.x_axis.scaling.max = float(np.nanmax(t))
+        charts.append(ch)
+    return col + 1
+
+
+def _tension_chart(ws: Worksheet, doc: Any, col: int, charts: list) -> int:
+    """Fig. 7: running-mean tension / T0 of the spans next to the tower of interest; returns the
+    next free data column."""
     static = doc.static
     t0 = doc.still_air.tension_nominal if doc.still_air is not None else None
-    if static is not None and static.tension and is_num(t0) and t0 > 0:
-        times = as_array(static.time)
-        h = np.asarray([[np.nan if v is None else v for v in row] for row in static.tension], dtype=float)
-        toi = doc.tower_of_interest
-        spans = [s for s in (toi - 1, toi) if 1 <= s <= h.shape[1]]
-        if times.size == 1:  # synoptic: constant over the record
-            dur = doc.duration if is_num(doc.duration) else 600.0
-            times = np.array([0.0, float(dur)])
-            h = np.repeat(h, 2, axis=0)
-        if times.size == h.shape[0] and spans:
-            row0 = 3
-            _write_column(ws, col, row0, "t (s)", times)
-            xcol = col
-            col += 1
-            ch = _scatter(f"Running-mean span tension H / T0 (Fig. 7), T0 = {kn(t0):.1f} kN",
-                          "time (s)", "H / T0", "0.00")
-            for s, color in zip(spans, ("2E75B6", "C55A11")):
-                side = "left" if s == toi - 1 else "right"
-                _write_column(ws, col, row0, f"span {s} ({side})", h[:, s - 1] / t0)
-                ch.series.append(_line_series(ws, xcol, col, row0, times.size, color, 19050))
-                col += 1
-            ch.x_axis.scaling.min = float(times.min())
-            ch.x_axis.scaling.max = float(times.max())
-            charts.append(ch)
-            col += 1
-    # ---- Fig. 12: contributions, stacked bars from the visible contributions table
+    if not (static is not None and static.tension and is_num(t0) and t0 > 0):
+        return col
+    times = as_array(static.time)
+    h = np.asarray([[np.nan if v is None else v for v in row] for row in static.tension], dtype=float)
+    toi = doc.tower_of_interest
+    spans = [s for s in (toi - 1, toi) if 1 <= s <= h.shape[1]]
+    if times.size == 1:  # synoptic: constant over the record
+        dur = doc.duration if is_num(doc.duration) else 600.0
+        times = np.array([0.0, float(dur)])
+        h = np.repeat(h, 2, axis=0)
+    if not (times.size == h.shape[0] and spans):
+        return col
+    row0 = 3
+    _write_column(ws, col, row0, "t (s)", times)
+    xcol = col
+    col += 1
+    ch = _scatter(f"Running-mean span tension H / T0 (Fig. 7), T0 = {kn(t0):.1f} kN",
+                  "time (s)", "H / T0", "0.00")
+    for s, color in zip(spans, ("2E75B6", "C55A11")):
+        side = "left" if s == toi - 1 else "right"
+        _write_column(ws, col, row0, f"span {s} ({side})", h[:, s - 1] / t0)
+        ch.series.append(_line_series(ws, xcol, col, row0, times.size, color, 19050))
+        col += 1
+    ch.x_axis.scaling.min = float(times.min())
+    ch.x_axis.scaling.max = float(times.max())
+    charts.append(ch)
+    return col + 1
+
+
+def _contributions_chart(ws: Worksheet, contrib_rows: tuple[int, int]) -> BarChart:
+    """Fig. 12: contributions, stacked bars from the visible contributions table."""
     first, last = contrib_rows
     bar = BarChart()
     bar.type = "col"
@@ -180,10 +206,7 @@ def case_charts(ws: Worksheet, doc: Any, chart_points: int, contrib_rows: tuple[
     bar.gapWidth = 80
     bar.legend.position = "b"
     bar.width, bar.height = CHART_W, CHART_H
-    charts.append(bar)
-    return charts
-
-
+    return bar
 
 
 def _marker_series(ws: Worksheet, xcol: int, ycol: int, row0: int, n: int, color: str, symbol: str,

@@ -48,6 +48,22 @@ from .charts import CHART_COL, CHART_ROWS, CHART_W, case_charts, section_charts
 def write_case(ws: Worksheet, doc: RunDocument, threshold: float, chart_points: int, summary: Worksheet,
                project: str, flagged: Sequence[str] = SUMMARY_REACTIONS) -> None:
     """Fill ``ws`` with the sheet of one result document (tables in A-H, charts from J)."""
+    cur = _sheet_head(ws, doc, summary)
+    section = line_from_parameters(doc.parameters, doc.towers)  # None: the paper's equal-span form
+    contrib_rows = _case_tables(cur, doc, section, threshold, flagged)
+    last_table_row = cur.row
+    bottom = _place_charts(ws, doc, chart_points, contrib_rows, section)
+    ws.freeze_panes = "A4"
+    right = get_column_letter(CHART_COL + int(CHART_W / 1.75) + 1)
+    ws.print_area = f"A1:{right}{max(last_table_row, bottom)}"
+    page_setup(ws, summary)
+    ws.oddHeader.left.text = header_text(project)
+    ws.oddHeader.right.text = header_text(doc.case)
+
+
+def _sheet_head(ws: Worksheet, doc: RunDocument, summary: Worksheet) -> Cursor:
+    """Column widths, the title, subtitle, link back to the Summary and the run's settings (rows 1-3);
+    returns the cursor on row 4."""
     widths = {"A": 30, "B": 8, "C": 12, "D": 12, "E": 12, "F": 12, "G": 12, "H": 12, "I": 2}
     for col, w in widths.items():
         ws.column_dimensions[col].width = w
@@ -65,7 +81,12 @@ def write_case(ws: Worksheet, doc: RunDocument, threshold: float, chart_points: 
     info.append(f"dt = {doc.time_step:g} s")
     cur.put(3, 3, ", ".join(info), "lc_subtitle")
     cur.row = 4
-    section = line_from_parameters(doc.parameters, doc.towers)  # None: the paper's equal-span form
+    return cur
+
+
+def _case_tables(cur: Cursor, doc: RunDocument, section: Line | None, threshold: float,
+                 flagged: Sequence[str]) -> tuple[int, int]:
+    """The tables of the sheet in order, ending with the notes; returns the contributions table's rows."""
     if doc.parameters is not None:
         _inputs_table(cur, doc, doc.parameters)
     if section is not None:
@@ -88,9 +109,12 @@ def write_case(ws: Worksheet, doc: RunDocument, threshold: float, chart_points: 
     cur.row += 1
     cur.note("Reactions are wind-induced (still air excluded) unless marked total; "
              "M: step-1 mean, B: background, R: resonant (steps 2-3).")
-    last_table_row = cur.row
+    return contrib_rows
 
-    # ---- charts (data outside the print area)
+
+def _place_charts(ws: Worksheet, doc: RunDocument, chart_points: int, contrib_rows: tuple[int, int],
+                  section: Line | None) -> int:
+    """The charts (data outside the print area) in column J, one under the other; returns the row below them."""
     bottom = 2
     charts = case_charts(ws, doc, chart_points, contrib_rows)
     if section is not None:  # plan and profile first: they describe the sheet's line
@@ -100,12 +124,7 @@ def write_case(ws: Worksheet, doc: RunDocument, threshold: float, chart_points: 
     for k, ch in enumerate(charts):
         ws.add_chart(ch, f"{get_column_letter(CHART_COL)}{2 + k * CHART_ROWS}")
         bottom = 2 + (k + 1) * CHART_ROWS
-    ws.freeze_panes = "A4"
-    right = get_column_letter(CHART_COL + int(CHART_W / 1.75) + 1)
-    ws.print_area = f"A1:{right}{max(last_table_row, bottom)}"
-    page_setup(ws, summary)
-    ws.oddHeader.left.text = header_text(project)
-    ws.oddHeader.right.text = header_text(doc.case)
+    return bottom
 
 
 def _inputs_table(cur: Cursor, doc: RunDocument, params: dict) -> None:
@@ -219,32 +238,47 @@ def _argmax_abs(values: list) -> tuple[Any, int | None]:
 
 
 def _still_air_and_step1(cur: Cursor, doc: RunDocument) -> None:
-    still, static = doc.still_air, doc.static
-    toi = doc.tower_of_interest
-    if still is not None:
-        cur.section(f"Still-air state (tower {toi})")
-        cur.header(["Quantity", "Unit", "Value"])
-        for r in REACTIONS:
-            cur.put(cur.row, 1, f"{r} still air", "lc_text")
-            cur.put(cur.row, 2, "kN", "lc_text")
-            cur.put(cur.row, 3, kn(still.reactions[r]), fmt=KN3)
-            cur.row += 1
-        rows = (("sag S", still.sag, "m", "0.00"),
-                ("nominal tension T0 = W Lx² / 8S", kn(still.tension_nominal), "kN", KN3))
-        if _is_section_doc(doc):  # a section: H0 at clipping-in, the parabolic sag of Eq. 17's L_x
-            rows = (("sag W Lx² / 8 H0 (span Lx of Eq. 17)", still.sag, "m", "0.00"),
-                    ("tension H0 at clipping-in", kn(still.tension_nominal), "kN", KN3))
-        for label, v, unit, fmt in rows:
-            cur.put(cur.row, 1, label, "lc_text")
-            cur.put(cur.row, 2, unit, "lc_text")
-            cur.put(cur.row, 3, v, fmt=fmt)
-            cur.row += 1
+    if doc.still_air is not None:
+        _still_air_table(cur, doc)
+    static = doc.static
     if static is None:
         return
-    times = static.time
-    series = len(times) > 1
-    cur.section(f"Step 1: mean state (tower {toi})" + (", extreme over the event" if series else ""))
+    series = len(static.time) > 1
+    cur.section(f"Step 1: mean state (tower {doc.tower_of_interest})" +
+                (", extreme over the event" if series else ""))
     cur.header(["Quantity", "Unit", "Value", "at t (s)" if series else ""])
+    _step1_extremes(cur, static, series)
+    tension = static.tension
+    if tension and isinstance(tension[0], list):
+        _span_tensions(cur, doc, series)
+
+
+def _still_air_table(cur: Cursor, doc: RunDocument) -> None:
+    """Still-air reactions, sag and nominal tension (H0 at clipping-in for a section)."""
+    still = doc.still_air
+    cur.section(f"Still-air state (tower {doc.tower_of_interest})")
+    cur.header(["Quantity", "Unit", "Value"])
+    for r in REACTIONS:
+        cur.put(cur.row, 1, f"{r} still air", "lc_text")
+        cur.put(cur.row, 2, "kN", "lc_text")
+        cur.put(cur.row, 3, kn(still.reactions[r]), fmt=KN3)
+        cur.row += 1
+    rows = (("sag S", still.sag, "m", "0.00"),
+            ("nominal tension T0 = W Lx² / 8S", kn(still.tension_nominal), "kN", KN3))
+    if _is_section_doc(doc):  # a section: H0 at clipping-in, the parabolic sag of Eq. 17's L_x
+        rows = (("sag W Lx² / 8 H0 (span Lx of Eq. 17)", still.sag, "m", "0.00"),
+                ("tension H0 at clipping-in", kn(still.tension_nominal), "kN", KN3))
+    for label, v, unit, fmt in rows:
+        cur.put(cur.row, 1, label, "lc_text")
+        cur.put(cur.row, 2, unit, "lc_text")
+        cur.put(cur.row, 3, v, fmt=fmt)
+        cur.row += 1
+
+
+def _step1_extremes(cur: Cursor, static: Any, series: bool) -> None:
+    """Step 1's wind-induced mean reactions and insulator-end displacements, largest magnitude
+    (and its time over a downburst event)."""
+    times = static.time
     for r in REACTIONS:
         v, k = _argmax_abs(static.reactions_wind[r])
         cur.put(cur.row, 1, f"{r} mean, wind-induced M" + (" at max |M|" if series else ""), "lc_text")
@@ -263,28 +297,33 @@ def _still_air_and_step1(cur: Cursor, doc: RunDocument) -> None:
         if series and k is not None:
             cur.put(cur.row, 4, times[k], fmt=SEC)
         cur.row += 1
-    tension = static.tension
-    if tension and isinstance(tension[0], list):
-        t0 = still.tension_nominal if still is not None else None
-        still_h = still.tension if still is not None else None
+
+
+def _span_tensions(cur: Cursor, doc: RunDocument, series: bool) -> None:
+    """Per span: still-air tension, the largest mean tension (and when), and its ratio to T0."""
+    still, static = doc.still_air, doc.static
+    times = static.time
+    toi = doc.tower_of_interest
+    t0 = still.tension_nominal if still is not None else None
+    still_h = still.tension if still is not None else None
+    cur.row += 1
+    cur.header(["Span tension H", "Unit", "still air", "mean max", "at t (s)" if series else "", "max / T0"])
+    arr = np.asarray([[np.nan if v is None else v for v in row] for row in static.tension], dtype=float)
+    for s in range(arr.shape[1]):
+        col = arr[:, s]
+        k = int(np.nanargmax(col)) if np.isfinite(col).any() else None
+        mark = "  (adjacent)" if s + 1 in (toi - 1, toi) else ""
+        cur.put(cur.row, 1, f"span {s + 1}{mark}", "lc_text")
+        cur.put(cur.row, 2, "kN", "lc_text")
+        if still_h is not None and s < len(still_h):
+            cur.put(cur.row, 3, kn(still_h[s]), fmt=KN3)
+        if k is not None:
+            cur.put(cur.row, 4, kn(float(col[k])), fmt=KN3)
+            if series:
+                cur.put(cur.row, 5, times[k], fmt=SEC)
+            if is_num(t0) and t0 > 0:
+                cur.put(cur.row, 6, float(col[k]) / t0, fmt="0.000")
         cur.row += 1
-        cur.header(["Span tension H", "Unit", "still air", "mean max", "at t (s)" if series else "", "max / T0"])
-        arr = np.asarray([[np.nan if v is None else v for v in row] for row in tension], dtype=float)
-        for s in range(arr.shape[1]):
-            col = arr[:, s]
-            k = int(np.nanargmax(col)) if np.isfinite(col).any() else None
-            mark = "  (adjacent)" if s + 1 in (toi - 1, toi) else ""
-            cur.put(cur.row, 1, f"span {s + 1}{mark}", "lc_text")
-            cur.put(cur.row, 2, "kN", "lc_text")
-            if still_h is not None and s < len(still_h):
-                cur.put(cur.row, 3, kn(still_h[s]), fmt=KN3)
-            if k is not None:
-                cur.put(cur.row, 4, kn(float(col[k])), fmt=KN3)
-                if series:
-                    cur.put(cur.row, 5, times[k], fmt=SEC)
-                if is_num(t0) and t0 > 0:
-                    cur.put(cur.row, 6, float(col[k]) / t0, fmt="0.000")
-            cur.row += 1
 
 
 def _stats_table(cur: Cursor, doc: RunDocument) -> None:

@@ -41,6 +41,22 @@ def write_design_block(ws: Worksheet, docs: list, top: int, left: int = 1) -> in
     cur = Cursor(ws, top)
     if not ok:
         return top
+    _design_header(cur, ok, top, left)
+    row = cur.row + 1
+    notes: list[str] = []
+    for doc in ok:
+        row = _design_rows(cur, doc, row, left)
+        for line in how_to_read(doc):
+            if line not in notes:
+                notes.append(line)
+    cur.row = row + 1
+    _design_notes(cur, notes, left)
+    return cur.row
+
+
+def _design_header(cur: Cursor, ok: list[RunDocument], top: int, left: int) -> None:
+    """The block's title (row ``top``) and column headers (the row below, the cursor left on it)."""
+    ws = cur.ws
     p = {d.design_fractile for d in ok}
     ptxt = ", ".join(f"{x:g}" for x in sorted(p))
     cur.put(top, left, f"Design values at the tower of interest (Gumbel fractile {ptxt} of the peak; "
@@ -52,41 +68,50 @@ def write_design_block(ws: Worksheet, docs: list, top: int, left: int = 1) -> in
         dim = ws.column_dimensions[get_column_letter(left + k)]
         dim.width = max(width, dim.width or 0)  # wide enough for its header and numbers in print too
     ws.row_dimensions[cur.row].height = 30
-    row = cur.row + 1
-    notes: list[str] = []
-    for doc in ok:
-        still = doc.still_air.reactions if doc.still_air is not None else {}
-        pk_def, tot_def = STAT_BY_NAME["peak_dynamic"], STAT_BY_NAME["peak_dynamic_total"]
-        for r in REACTIONS:
-            e = doc.reactions[r]
-            pk, tot = e[pk_def.name].gumbel, e[tot_def.name].gumbel
-            sa = still.get(r)
-            vals: list[tuple[Any, str | None]] = [
-                (doc.case, None), (r, None),
-                (kn(sa), KN),
-                (stat_cell(pk_def, pk.design if pk else None), KN),
-                (stat_cell(tot_def, tot.design if tot else None), KN),
-                (pk.ppcc if pk and is_num(pk.ppcc) else None, "0.000"),
-            ]
-            for key in ("GF_Dy", "GF_QS", "Cont_R"):
-                st = STAT_BY_NAME[key]
-                vals.append((stat_cell(st, e[key].mean), excel_format(st)))
-                vals.extend((v, excel_format(st)) for v in _ci(e[key]))
-            state = e.dynamic_analysis
-            vals.append((flag_text(state), None))
-            for k, (v, fmt) in enumerate(vals):
-                style = "lc_text" if k in (0, 1, len(vals) - 1) else "lc_number"
-                cell = cur.put(row, left + k, v, style, fmt)
-                if k == 1:
-                    align(cell, horizontal="center")
-            if state is not None:
-                ws.cell(row=row, column=left + len(vals) - 1).font = Font(
-                    name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT if state == "recommended" else "9C5700")
-            row += 1
-        for line in how_to_read(doc):
-            if line not in notes:
-                notes.append(line)
-    cur.row = row + 1
+
+
+def _design_values(doc: RunDocument, r: str, still: dict) -> list[tuple[Any, str | None]]:
+    """The cells (value, number format) of one case and reaction, in the order of :data:`HEADERS`."""
+    e = doc.reactions[r]
+    pk_def, tot_def = STAT_BY_NAME["peak_dynamic"], STAT_BY_NAME["peak_dynamic_total"]
+    pk, tot = e[pk_def.name].gumbel, e[tot_def.name].gumbel
+    sa = still.get(r)
+    vals: list[tuple[Any, str | None]] = [
+        (doc.case, None), (r, None),
+        (kn(sa), KN),
+        (stat_cell(pk_def, pk.design if pk else None), KN),
+        (stat_cell(tot_def, tot.design if tot else None), KN),
+        (pk.ppcc if pk and is_num(pk.ppcc) else None, "0.000"),
+    ]
+    for key in ("GF_Dy", "GF_QS", "Cont_R"):
+        st = STAT_BY_NAME[key]
+        vals.append((stat_cell(st, e[key].mean), excel_format(st)))
+        vals.extend((v, excel_format(st)) for v in _ci(e[key]))
+    vals.append((flag_text(e.dynamic_analysis), None))
+    return vals
+
+
+def _design_rows(cur: Cursor, doc: RunDocument, row: int, left: int) -> int:
+    """One row per reaction of ``doc`` from ``row``, the flag in its colour; returns the next row."""
+    ws = cur.ws
+    still = doc.still_air.reactions if doc.still_air is not None else {}
+    for r in REACTIONS:
+        vals = _design_values(doc, r, still)
+        state = doc.reactions[r].dynamic_analysis
+        for k, (v, fmt) in enumerate(vals):
+            style = "lc_text" if k in (0, 1, len(vals) - 1) else "lc_number"
+            cell = cur.put(row, left + k, v, style, fmt)
+            if k == 1:
+                align(cell, horizontal="center")
+        if state is not None:
+            ws.cell(row=row, column=left + len(vals) - 1).font = Font(
+                name="Calibri", size=10, bold=True, color=tpl.FLAG_FONT if state == "recommended" else "9C5700")
+        row += 1
+    return row
+
+
+def _design_notes(cur: Cursor, notes: list[str], left: int) -> None:
+    """How the design peak and the flag are defined, then the cases' "how to read" lines."""
     cur.note("Design peak: Gumbel (EV-I) fit of the realization peaks by moments, value at the design fractile "
              "([analysis] design_fractile, default 0.5 = median peak); ppcc: probability-plot correlation of the fit. "
              "Design total: the same for still air + wind.")
@@ -96,8 +121,7 @@ def write_design_block(ws: Worksheet, docs: list, top: int, left: int = 1) -> in
     if notes:
         cur.row += 1
         cur.put(cur.row, left, "How to read", "lc_text")
-        ws.cell(row=cur.row, column=left).font = Font(name="Calibri", size=11, bold=True)
+        cur.ws.cell(row=cur.row, column=left).font = Font(name="Calibri", size=11, bold=True)
         cur.row += 1
         for line in notes:
             cur.note(line)
-    return cur.row

@@ -276,18 +276,42 @@ def write_peaks(ws: Worksheet, cases: list[tuple[RunDocument, str]], like: Works
     cur.put(2, 1, "g*yp = ½ ρ C_d V_ref² D (Eq. 17); reactions at the tower of interest; mean over realizations.",
             "lc_subtitle")
     cur.row = 4
-    with_std = any(d.realizations > 1 for d in docs)
-    norm = STAT_BY_NAME["peak_normalised"]
+    ncols = _peaks_header(cur, docs, reactions)
+    first = cur.row
+    _peaks_rows(cur, cases, reactions, any(d.realizations > 1 for d in docs))
+    last = cur.row - 1
+    ch = _peaks_chart(ws, first, last, len(reactions), len(docs))
+    anchor_col = ncols + 2
+    ws.column_dimensions[get_column_letter(anchor_col - 1)].width = 3
+    ws.add_chart(ch, f"{get_column_letter(anchor_col)}4")
+    ws.freeze_panes = f"B{first}"
+    ws.print_title_rows = f"{first - 1}:{first - 1}"
+    right_col = anchor_col + int(ch.width / 1.7) + 1
+    ws.print_area = f"A1:{get_column_letter(right_col)}{max(last, 4 + int(ch.height / 0.53) + 1)}"
+    page_setup(ws, like)
+    ws.sheet_view.showGridLines = False
+
+
+def _peaks_header(cur: Cursor, docs: list[RunDocument], reactions: Sequence[str]) -> int:
+    """The table's header row and column widths; returns the number of columns."""
+    ws = cur.ws
     nr = len(reactions)
     labels = ["Case", "Wind", "Spans", "L_x\n(m)", "V_ref\n(m/s)", *reactions]
-    if with_std:
+    if any(d.realizations > 1 for d in docs):
         labels += [f"± {r}" for r in reactions]
     cur.header(labels)
     ws.row_dimensions[cur.row - 1].height = 30
     widths = [18, 14, 6, 8, 9] + [8] * nr + [7] * nr
     for k, w in enumerate(widths[: len(labels)]):
         ws.column_dimensions[get_column_letter(k + 1)].width = w
-    first = cur.row
+    return len(labels)
+
+
+def _peaks_rows(cur: Cursor, cases: list[tuple[RunDocument, str]], reactions: Sequence[str],
+                with_std: bool) -> None:
+    """One row per case: its link, wind, line and normalised peaks (± std where several realizations)."""
+    norm = STAT_BY_NAME["peak_normalised"]
+    nr = len(reactions)
     for doc, name in cases:
         r = cur.row
         cell = cur.put(r, 1, doc.case, "lc_text")
@@ -303,7 +327,10 @@ def write_peaks(ws: Worksheet, cases: list[tuple[RunDocument, str]], like: Works
                 cur.put(r, 6 + nr + k, stat_cell(norm, e.std) if doc.realizations > 1 else None,
                         fmt=excel_format(norm))
         cur.row += 1
-    last = cur.row - 1
+
+
+def _peaks_chart(ws: Worksheet, first: int, last: int, nr: int, ndocs: int) -> BarChart:
+    """Fig. 13: clustered bars of the table's rows ``first``-``last`` (``nr`` reactions)."""
     ch = BarChart()
     ch.type = "col"
     ch.grouping = "clustered"
@@ -319,16 +346,6 @@ def write_peaks(ws: Worksheet, cases: list[tuple[RunDocument, str]], like: Works
         s.graphicalProperties.solidFill = color
         s.graphicalProperties.line.solidFill = color
     ch.legend.position = "b"
-    ch.width = max(16.0, min(34.0, 1.3 * len(docs) + 8))
+    ch.width = max(16.0, min(34.0, 1.3 * ndocs + 8))
     ch.height = 9.0
-    anchor_col = len(labels) + 2
-    ws.column_dimensions[get_column_letter(anchor_col - 1)].width = 3
-    ws.add_chart(ch, f"{get_column_letter(anchor_col)}4")
-    ws.freeze_panes = f"B{first}"
-    ws.print_title_rows = f"{first - 1}:{first - 1}"
-    right_col = anchor_col + int(ch.width / 1.7) + 1
-    ws.print_area = f"A1:{get_column_letter(right_col)}{max(last, 4 + int(ch.height / 0.53) + 1)}"
-    page_setup(ws, like)
-    ws.sheet_view.showGridLines = False
-
-
+    return ch

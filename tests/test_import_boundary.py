@@ -20,6 +20,7 @@ CORE_MODULES = [
     "linecheck.core.names",
     "linecheck.core.system",
     "linecheck.core.static",
+    "linecheck.core.span_operators",
     "linecheck.core.model",
     "linecheck.core.dynamics",
     "linecheck.core.damping",

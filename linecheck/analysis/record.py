@@ -6,6 +6,7 @@ Nothing here prints.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -28,11 +29,19 @@ def record_time(case: Case) -> np.ndarray:
     return record_times(case)
 
 
-def with_burn_in(case: Case, t: np.ndarray, burn_in: float) -> np.ndarray:
-    """The record ``t`` [s] lengthened at its start by ``burn_in`` [s] (a whole number of time
-    steps), shape (n_steps + round(burn_in / dt),)."""
+def burn_in_steps(case: Case, burn_in: float) -> int:
+    """Time steps of a burn-in of ``burn_in`` [s]: the whole number that covers it."""
     dt = case.analysis.time_step
-    return t[0] - dt * np.round(burn_in / dt) + dt * np.arange(t.size + int(np.round(burn_in / dt)))
+    return max(0, math.ceil(burn_in / dt - 1e-9))
+
+
+def with_burn_in(case: Case, t: np.ndarray, burn_in: float) -> np.ndarray:
+    """The record ``t`` [s] lengthened at its start by at least ``burn_in`` [s] (a whole number of
+    time steps, :func:`burn_in_steps`), shape (n_steps + burn_in_steps,); the analysed record is
+    its last n_steps instants, exactly ``t``'s."""
+    dt = case.analysis.time_step
+    n = burn_in_steps(case, burn_in)
+    return t[0] - dt * n + dt * np.arange(t.size + n)
 
 
 def peak_window_steps(case: Case) -> int | None:

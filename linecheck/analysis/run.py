@@ -295,11 +295,11 @@ def plan_run(case: Case, *, realizations, interpolate_states: bool, spectral_che
     st = static_result(case, progress=progress, cancel=cancel)
     system, mean = st.system, st.mean
     models, damping, sm, burn, windows = _linearise(case, st)
-    t = record_time(case)
+    t = analysed = record_time(case)
     if burn.seconds > 0:  # the derived burn-in lengthens the record: check the budget again
         threads = _guard(case, int(real.size), threads, spectral_check, None if warned else warn, burn.seconds)
         t = with_burn_in(case, t, burn.seconds)
-    keep = t >= t[0] + burn.seconds - 1e-9  # the analysed record (after the burn-in)
+    keep = np.arange(t.size) >= t.size - analysed.size  # the analysed record (after the burn-in)
     nearest, bracket, weights = state_of_step(mean.time, t)
     if cancel is not None and cancel.is_set():
         raise Cancelled("run cancelled")
@@ -369,7 +369,9 @@ def run_chunk(plan: RunPlan, ci: int, stop: AnyEvent, reports: _ChunkProgress):
     case, system, t, towers = plan.case, plan.static.system, plan.time, plan.towers
     rc = plan.realizations[ci * plan.chunk:(ci + 1) * plan.chunk]
     reports.report("wind", reports.winds_done, plan.n_chunks)
-    v = fluctuating_velocity(case, system, t, list(rc), plan.a_turb)  # (n_real, n_steps, n_nodes), along-wind
+    # (n_real, n_steps, n_nodes), along-wind; the burn-in's steps lead the analysed record (common
+    # random numbers: the analysed turbulence does not depend on the burn-in's length)
+    v = fluctuating_velocity(case, system, t, list(rc), plan.a_turb, lead=int(np.argmax(plan.keep)))
     loads, direct = fluctuating_loads(case, system, plan.models[0], t, v, plan.vn, plan.vl)
     direct = direct.reshape(direct.shape[:2] + (-1, 3))[:, :, towers].reshape(direct.shape[:2] + (-1,))
     reports.wind_done()

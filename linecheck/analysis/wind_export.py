@@ -87,12 +87,13 @@ def wind_field(case: Case, *, realization: int = 0) -> WindField:
                         "(analysis.realizations)")
     st = static_analysis(case)
     t, burn = record_grid(case, st)
+    lead = t.size - record_time(case).size  # the burn-in's steps, as run_case keeps them
     if _wind_vectors(case, st.system):
-        v = fluctuating_velocity(case, st.system, t, [realization])[0]
+        v = fluctuating_velocity(case, st.system, t, [realization], lead=lead)[0]
         u_mean, u_turb, x_node = _vector_field(case, st.system, t, v)
     else:
         vn, vl = record_mean_wind(case, st, t)
-        v = fluctuating_velocity(case, st.system, t, [realization])[0]
+        v = fluctuating_velocity(case, st.system, t, [realization], lead=lead)[0]
         u_mean, u_turb = _normal_field(vn, vl, v)
         x_node = st.mean.still_air.nodes.copy()
     return WindField(case, t, burn, x_node, u_mean, u_turb, v, realization + 1, case.analysis.seed)

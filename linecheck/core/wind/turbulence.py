@@ -352,14 +352,17 @@ class UnitPhases:
 
 
 def synthesize(x: np.ndarray, grid: SpectralGrid, phases: np.ndarray | UnitPhases, decay: float,
-               v_mean: float, method: str = "auto") -> np.ndarray:
-    """Unit-variance field at points x [m] for given phases [rad]: shape (n_steps, n_nodes).
+               v_mean: float, method: str = "auto", lead: int = 0) -> np.ndarray:
+    """Unit-variance field at points x [m] for given phases [rad]: shape (lead + n_steps, n_nodes).
 
     phases shape (n_nodes, n_freq) (or :class:`UnitPhases` with their phasors computed).
     ``method``: "kms" (equal spacing required), "markov" (ordered x at any spacing), "general"
     (dense factor per frequency) or "auto" (KMS when x is equally spaced, else Markov when x is
     non-decreasing, else general).
     u_j(t_n) = sum_k A_k Re[(L_k e^(i phi_k))_j e^(i 2 pi f_k t_n)] (Deodatis 1996), by inverse FFT.
+    ``lead`` samples before t_0 are the synthesis' periodic continuation (the sum is periodic
+    with the transform's length n_fft dt): samples n_fft - lead .. n_fft - 1, wrapped as often as
+    needed -- so the record from t_0 on is the same whatever the lead (common random numbers).
     """
     given = phases
     if isinstance(phases, UnitPhases):
@@ -395,15 +398,20 @@ def synthesize(x: np.ndarray, grid: SpectralGrid, phases: np.ndarray | UnitPhase
         spec = fft_input(y, grid.amplitude, m)
     # one contiguous transform per node (pocketfft gives each 1-D transform the same bits whatever
     # the layout; along the contiguous axis it is ~25 % faster than along axis 0)
-    return np.ascontiguousarray(sfft.irfft(spec, n=m, axis=1)[:, : grid.n_steps].T)
+    full = sfft.irfft(spec, n=m, axis=1)
+    if lead == 0:
+        return np.ascontiguousarray(full[:, : grid.n_steps].T)
+    return np.ascontiguousarray(np.take(full, np.arange(-lead, grid.n_steps), axis=1, mode="wrap").T)
 
 
 # ------------------------------------------------------------------------- case-level API
-def unit_field(case: Case, system: LineSystem, n_steps: int, dt: float, realization: int) -> np.ndarray:
+def unit_field(case: Case, system: LineSystem, n_steps: int, dt: float, realization: int, lead: int = 0) -> np.ndarray:
     """Zero-mean, unit-variance turbulence u(x, t) [-] at every global FE node.
 
-    n_steps samples at dt [s]; realization: 0-based index.  Returns shape (n_steps, n_nodes).
-    Bit-identical for the same case, seed, n_steps, dt and realization.
+    n_steps samples at dt [s] of the analysed record, after ``lead`` samples of lead-in (a
+    burn-in: the synthesis' periodic continuation, :func:`synthesize`); realization: 0-based
+    index.  Returns shape (lead + n_steps, n_nodes).  Bit-identical for the same case, seed,
+    n_steps, dt and realization; the analysed samples do not depend on ``lead``.
     Points: the nodes' still-air x (equal-span form) or stations, the distance along the line
     (section form: the Markov path; see :func:`markov_apply`).  The coherence uses
     the one speed V_ref whatever the profile (docs/wind.md, "Sections").
@@ -415,7 +423,7 @@ def unit_field(case: Case, system: LineSystem, n_steps: int, dt: float, realizat
                         file=str(case.source) if case.source else None, key="wind.v_ref")
     grid = spectral_grid(int(n_steps), float(dt), length_scale(case), v, case.wind.fft_length == "fast")
     return synthesize(x, grid, unit_phases(case.analysis.seed, realization, x.size, grid.n_freq),
-                      case.wind.coherence_decay, v)
+                      case.wind.coherence_decay, v, lead=lead)
 
 
 _phase_memo: dict[tuple, UnitPhases] = {}
@@ -473,20 +481,27 @@ def _record(time: np.ndarray) -> tuple[int, float]:
 
 
 def fluctuating_velocity(case: Case, system: LineSystem, time: np.ndarray, realizations: Sequence[int],
-                         a: np.ndarray | None = None) -> np.ndarray:
+                         a: np.ndarray | None = None, lead: int = 0) -> np.ndarray:
     """Fluctuating along-wind velocity a(x, t) u_r(x, t) [m/s] at the global FE nodes.
 
     time [s] equally spaced, shape (n_steps,); realizations: 0-based indices; ``a`` [m/s]: the
     :func:`modulation` over ``time`` when the caller has it already (a run's chunks share it).
+    ``lead``: the first samples of ``time`` that precede the analysed record (a burn-in); the
+    turbulence is synthesized on the analysed record and continued periodically into the lead,
+    so realization k's turbulence at a given time of the analysed record does not depend on the
+    burn-in's length, nor on anything else that does not define the turbulence: two runs that
+    differ in drag, tension or damping compare with common random numbers (docs/wind.md).
     Returns shape (n_real, n_steps, n_nodes).
     """
     n_steps, dt = _record(time)
+    if not 0 <= lead < n_steps - 3:
+        raise ValueError(f"lead of {lead} samples does not fit a record of {n_steps}")
     if a is None:
         a = modulation(case, system, np.asarray(time, dtype=float))
     reals = list(realizations)
     out = np.empty((len(reals), n_steps, system.n_nodes))
     for i, r in enumerate(reals):
-        out[i] = _unit_field_memo(case, system, n_steps, dt, int(r))
+        out[i] = _unit_field_memo(case, system, n_steps - lead, dt, int(r), int(lead))
         out[i] *= a
     return out
 
@@ -498,7 +513,8 @@ _memo: dict[tuple, np.ndarray] = {}
 _memo_lock = threading.Lock()
 
 
-def _unit_field_memo(case: Case, system: LineSystem, n_steps: int, dt: float, realization: int) -> np.ndarray:
+def _unit_field_memo(case: Case, system: LineSystem, n_steps: int, dt: float, realization: int,
+                     lead: int = 0) -> np.ndarray:
     """:func:`unit_field`, remembered per process (read-only, least recently used first out,
     at most :data:`UNIT_FIELD_MEMO_BYTES`).  The unit field depends only on the node positions,
     V_ref, L_u, the coherence decay, the seed, the realization and the record grid, not on the
@@ -506,11 +522,12 @@ def _unit_field_memo(case: Case, system: LineSystem, n_steps: int, dt: float, re
     run reuses it.  The same bits as computing it afresh (it is deterministic)."""
     x = system.node_station if system.is_section else system.node_x0
     key = (x.tobytes(), bool(system.is_section), float(case.wind.v_ref), float(length_scale(case)),
-           float(case.wind.coherence_decay), int(case.analysis.seed), realization, n_steps, dt, case.wind.fft_length)
+           float(case.wind.coherence_decay), int(case.analysis.seed), realization, n_steps, dt, case.wind.fft_length,
+           lead)
     got = _memo_get(_memo, key)
     if got is not None:
         return got
-    u = unit_field(case, system, n_steps, dt, realization)
+    u = unit_field(case, system, n_steps, dt, realization, lead)
     if u.nbytes <= UNIT_FIELD_MEMO_BYTES / 4:
         u.setflags(write=False)
         _memo_put(_memo, key, u, lambda v: v.nbytes, UNIT_FIELD_MEMO_BYTES)

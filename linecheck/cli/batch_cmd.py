@@ -393,15 +393,30 @@ def batch(
     max_realizations: MaxRealOpt = 1000,
 ) -> None:
     """Run many cases (all realizations) in parallel, saving each result as it completes."""
-    from ..batch import make_executor, run_batch
-    from ..io.provenance import kernel_warning
-    from .limits import warn as limits_warn
-
     apply_max_memory(max_memory)  # each task checks its memory estimate (workers inherit the limit)
 
     fields = title_block(project, line, engineer, revision, title, excel=excel)
     paths = expand_cases(cases)
     target = parse_until(until)
+    paths, plan, out_dir = _plan_batch(paths, models, excel, json_dir, template, force)
+    report = _run_batch(paths, out_dir, jobs=jobs, scheduler=scheduler, connect_timeout=connect_timeout,
+                        resume=resume, chunk=chunk, progress_interval=progress_interval,
+                        until=None if target is None else (target, max_realizations))
+    _print_batch_summary(report, out_dir)
+    docs = report.docs()
+    if plan is not None:
+        docs = _write_model_documents(report, plan, out_dir)
+    if excel is not None:
+        _write_excel(docs, excel, force, template, fields)
+        console.print(f"wrote {excel}")
+    _report_failures(report, scheduler, out_dir)
+    raise typer.Exit(report.exit_code)
+
+
+def _plan_batch(paths: list[Any], models: str | None, excel: Path | None, json_dir: Path | None,
+                template: Path | None, force: bool) -> tuple[list[Any], Any, Path]:
+    """The jobs (one per case file, or per case and model with --models, and the model plan) and
+    the JSON folder, after refusing (exit 2, before any work) outputs that would overwrite inputs."""
     plan = None
     if models is not None:
         from ..batch.models import model_jobs
@@ -410,15 +425,31 @@ def batch(
     out_dir = json_dir if json_dir is not None else ((excel.parent if excel is not None else Path.cwd()) / "results")
     _check_outputs(paths, plan, excel, template, out_dir)
     _check_excel(excel, force, template)
+    return paths, plan, out_dir
+
+
+def _run_batch(paths: list[Any], out_dir: Path, *, jobs: int | None, scheduler: str | None,
+               connect_timeout: float, resume: bool, chunk: int | None, progress_interval: float,
+               until: tuple[Any, int] | None) -> Any:
+    """The batch on its executor with the progress display; SIGTERM cancels it like Ctrl-C
+    (summary, results kept, 130).  The compiled-kernel warning comes first, one line."""
+    from ..batch import make_executor, run_batch
+    from ..io.provenance import kernel_warning
+    from .limits import warn as limits_warn
+
     kernel_off = kernel_warning()  # compiled pieces off (Numba installed): one line, before the batch
     if kernel_off:
         limits_warn(kernel_off)
     cancel = threading.Event()  # set by SIGTERM too: the batch stops like Ctrl-C (summary, results kept, 130)
     with (sigterm_cancels(cancel), make_executor(jobs, scheduler, connect_timeout) as executor,
           BatchDisplay(interval=progress_interval) as display):
-        report = run_batch(paths, executor=executor, json_dir=out_dir, resume=resume, chunk_size=chunk,
-                           progress=display, cancel=cancel,
-                           until=None if target is None else (target, max_realizations))
+        return run_batch(paths, executor=executor, json_dir=out_dir, resume=resume, chunk_size=chunk,
+                         progress=display, cancel=cancel, until=until)
+
+
+def _print_batch_summary(report: Any, out_dir: Path) -> None:
+    """The summary table, its notes and the counts; a full disk (exit 2) or an interruption (exit
+    130) stops here, with how to go on."""
     console.print(summary_table(report))
     for note in summary_notes(report):
         console.print(note, highlight=False, soft_wrap=True)
@@ -434,21 +465,26 @@ def batch(
         err_console.print(f"[bold red]interrupted[/]: finished cases are saved in {out_dir}; "
                           "run again with --resume to do the rest", highlight=False)
         raise typer.Exit(130)
-    docs = report.docs()
-    if plan is not None:
-        from ..batch.models import combined_documents
-        from ..io.jsonout import write_json
 
-        docs = combined_documents(report, plan)
-        spread = [(path, d) for path, d in zip(plan, docs) if isinstance(d, RunDocument) and d.models is not None]
-        for path, doc in spread:
-            write_json(out_dir / f"{path.stem}.json", doc)
-        console.print(f"model spread: {len(spread)} case document(s) with a \"models\" block "
-                      f"in {out_dir}",
-                      highlight=False)
-    if excel is not None:
-        _write_excel(docs, excel, force, template, fields)
-        console.print(f"wrote {excel}")
+
+def _write_model_documents(report: Any, plan: Any, out_dir: Path) -> list[Any]:
+    """--models: one document per case file with the "models" block, saved as <stem>.json; returns
+    the documents of the workbook."""
+    from ..batch.models import combined_documents
+    from ..io.jsonout import write_json
+
+    docs = combined_documents(report, plan)
+    spread = [(path, d) for path, d in zip(plan, docs) if isinstance(d, RunDocument) and d.models is not None]
+    for path, doc in spread:
+        write_json(out_dir / f"{path.stem}.json", doc)
+    console.print(f"model spread: {len(spread)} case document(s) with a \"models\" block "
+                  f"in {out_dir}",
+                  highlight=False)
+    return docs
+
+
+def _report_failures(report: Any, scheduler: str | None, out_dir: Path) -> None:
+    """One error line naming the failed cases (and, with a lost Dask scheduler, how to resume)."""
     if report.failed:
         from ..batch.executors import SCHEDULER_LOST
 
@@ -456,7 +492,7 @@ def batch(
         hint = (f"; the connection to the Dask scheduler at {scheduler} was lost ({lost} of them): start it again "
                 f"and run the same command with --resume (finished cases are saved in {out_dir})") if lost else ""
         error_line(f"{len(report.failed)} case(s) failed: " + ", ".join(o.name for o in report.failed) + hint)
-    raise typer.Exit(report.exit_code)
+
 
 
 # --------------------------------------------------------------------------- scan

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+from pathlib import Path
+from typing import Annotated, Any
 
 import typer
 from rich.markup import escape
@@ -196,14 +197,24 @@ def run(
     """Steps 1-3: mean, background and resonant reactions, gust factors and contributions."""
     from .. import service  # here, not at import: the service loads the numerical core (start-up time)
     from ..batch.executors import default_jobs
-    from ..io.jsonout import run_document, write_json
-    from ..io.provenance import kernel_warning
 
     fields = title_block(project, line, engineer, revision, title, excel=excel)
     apply_max_memory(max_memory)
     threads = default_jobs() if jobs is None else jobs
     case = override(read_case(case_file), realizations, seed)
     target = parse_until(until)
+    _check_run_outputs(case, json_out, excel, template, force)
+    names = service.parse_models(case, models) if models is not None else ()
+    res, spread = _analyse(case, names, target, max_realizations=max_realizations, no_check=no_check,
+                           threads=threads)
+    doc = _run_document(res, spread, names, full_histories)
+    _print_run(doc, case, names, no_check)
+    _write_run_outputs(doc, json_out, excel, template, force, fields)
+
+
+def _check_run_outputs(case: Case, json_out: Path | None, excel: Path | None, template: Path | None,
+                       force: bool) -> None:
+    """Refuse (exit 2, before any work) an output that would overwrite an input or an existing file."""
     check_outputs([("--json", json_out), ("--excel", excel)], [*case_inputs(case), ("template", template)])
     if json_out is not None:
         check_target(json_out, what="JSON")
@@ -211,11 +222,21 @@ def run(
         from ..excel.writer import check_excel_target
 
         check_excel_target(excel, force=force, template=template)
-    names = service.parse_models(case, models) if models is not None else ()
+
+
+def _analyse(case: Case, names: tuple[str, ...], target: Any, *, max_realizations: int, no_check: bool,
+             threads: int) -> tuple[Any, dict | None]:
+    """The analysis with a progress bar: under each model of ``names`` (the result of the case's own
+    model, or the first, and the spread), to the ``target`` accuracy (--until), or as the case says.
+    Warnings on the case and the compiled kernel come first, once."""
+    from .. import service
+    from ..io.provenance import kernel_warning
+
     service.warn_case(case, limits_warn)  # values probably mistyped (a weight in kg/m): once, before the work
     kernel_off = kernel_warning()  # compiled pieces off (Numba installed): one line, before the work
     if kernel_off:
         limits_warn(kernel_off)
+    spread = None
     with progress_bar() as cb:
         if names:
             spread = service.run_models(case, names, progress=cb, spectral_check=not no_check, warn=limits_warn,
@@ -228,11 +249,23 @@ def run(
         else:
             res = service.run_case(case, progress=cb, spectral_check=not no_check, warn=limits_warn,
                                    threads=threads)
+    return res, spread
+
+
+def _run_document(res: Any, spread: dict | None, names: tuple[str, ...], full_histories: bool) -> RunDocument:
+    """The result document, with the "models" block of a model spread."""
+    from ..io.jsonout import run_document
+
     doc = run_document(res, full_histories=full_histories)
     if names:
         from ..io.jsonout import model_reactions, with_models
 
         doc = with_models(doc, res.case.wind.downburst.model_name, model_reactions(spread))
+    return doc
+
+
+def _print_run(doc: RunDocument, case: Case, names: tuple[str, ...], no_check: bool) -> None:
+    """The console report: statistics, design values, notes, legend, model spread, burn-in and sanity check."""
     console.print(results_table(doc))
     console.print(design_table(doc))
     for note in stats_notes(doc):
@@ -246,7 +279,14 @@ def run(
     print_sanity(doc, explained=burn_in_note(doc) is not None)
     if no_check and case.wind.type == "synoptic":
         console.print("[dim]frequency-domain check skipped (--no-check): no \"spectral\" block, no sanity check.[/]")
+
+
+def _write_run_outputs(doc: RunDocument, json_out: Path | None, excel: Path | None, template: Path | None,
+                       force: bool, fields: dict[str, str]) -> None:
+    """Write the JSON result and the Excel workbook asked for, each with a "wrote" line."""
     if json_out is not None:
+        from ..io.jsonout import write_json
+
         write_json(json_out, doc)
         console.print(f"wrote {json_out}")
     if excel is not None:
@@ -254,6 +294,7 @@ def run(
 
         write_workbook([doc], excel, template=template, force=force, title=fields or None)
         console.print(f"wrote {excel}")
+
 
 
 @app.command()

@@ -147,6 +147,19 @@ def wind(
         check_target(field_out, what="NPZ")
     s = point_series(case, realization - 1)
     doc = series_summary(case, s)
+    console.print(_wind_table(case, s, doc, realization))
+    if csv_out is not None:
+        write_text_atomic(csv_out, series_csv(s), what="CSV")
+        console.print(f"wrote {csv_out}")
+    if json_out is not None:
+        write_json(json_out, with_provenance(doc))
+        console.print(f"wrote {json_out}")
+    if field_out is not None:
+        _write_field(case, realization, field_out)
+
+
+def _wind_table(case: Case, s: PointSeries, doc: dict[str, Any], realization: int) -> Table:
+    """The console table of the wind at point p (``doc``: :func:`series_summary` of ``s``)."""
     table = Table(title=f"{case.name}: wind at point p (x = {s.point_p:.1f} m), realization {realization}",
                   title_justify="left")
     table.add_column("quantity")
@@ -166,21 +179,20 @@ def wind(
                         f"{lp['speed']:.2f} = {lp['over_v_ref']:.3f} V_ref at {lp['station']:.0f} m, t = {lp['time']:.1f} s"))
     for q, v in rows:
         table.add_row(q, v)
-    console.print(table)
-    if csv_out is not None:
-        write_text_atomic(csv_out, series_csv(s), what="CSV")
-        console.print(f"wrote {csv_out}")
-    if json_out is not None:
-        write_json(json_out, with_provenance(doc))
-        console.print(f"wrote {json_out}")
-    if field_out is not None:
-        fld = service.wind_field(case, realization=realization - 1)
-        arrays = fld.to_npz_dict()
+    return table
 
-        def save(tmp: Path) -> None:
-            with open(tmp, "wb") as fh:  # a file object: numpy would append ".npz" to a name
-                np.savez(fh, **arrays)
 
-        write_atomic(field_out, save, what="NPZ")
-        console.print(f"wrote {field_out} ({fld.t.size} steps incl. {fld.burn_in:g} s burn-in, "
-                      f"{fld.x_node.shape[0]} nodes)")
+def _write_field(case: Case, realization: int, field_out: Path) -> None:
+    """--field: the run's full wind of the realization as an NPZ file, written atomically."""
+    from .. import service
+
+    fld = service.wind_field(case, realization=realization - 1)
+    arrays = fld.to_npz_dict()
+
+    def save(tmp: Path) -> None:
+        with open(tmp, "wb") as fh:  # a file object: numpy would append ".npz" to a name
+            np.savez(fh, **arrays)
+
+    write_atomic(field_out, save, what="NPZ")
+    console.print(f"wrote {field_out} ({fld.t.size} steps incl. {fld.burn_in:g} s burn-in, "
+                  f"{fld.x_node.shape[0]} nodes)")

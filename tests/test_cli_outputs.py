@@ -1,4 +1,4 @@
-"""CLI and Excel outputs (issue 14): no formula injection, ENOSPC is one line, sanity check surfaced,
+"""CLI and Excel outputs (output safety and clarity): no formula injection, ENOSPC is one line, sanity check surfaced,
 title-block options, help and usage texts, the run table at 120 columns."""
 
 from __future__ import annotations
@@ -383,7 +383,7 @@ def test_run_table_fits_120_columns_and_flags_cont_r(doc):
     d["reactions"]["Rx"]["Cont_R"]["mean"] = CONT_R_FLAG + 0.05
     d["reactions"]["Ry"]["Cont_R"]["mean"] = CONT_R_FLAG - 0.05
     d["reactions"]["Rz"]["Cont_R"]["mean"] = 0.999  # Rz is not flagged (as in the Excel Summary)
-    for r, state in (("Rx", "recommended"), ("Ry", None), ("Rz", "recommended")):  # issue 18 flag states
+    for r, state in (("Rx", "recommended"), ("Ry", None), ("Rz", "recommended")):  # the dynamic_analysis flag states
         d["reactions"][r]["dynamic_analysis"] = state
     con = Console(width=120, record=True, color_system="truecolor", force_terminal=True)
     con.print(results_table(RunDocument.from_json(d)))  # the console reads the typed document

@@ -146,7 +146,7 @@ def test_summary_values_equal_json(docs, book):
                 want = _conv(std, scale, "std") if doc["realizations"] > 1 else None
                 assert cells[k + 1] == want, (row["Case"], row["Reaction"], stat, "std")
             checked += 1
-        flagged = block["dynamic_analysis"] == "recommended"  # issue 18: the 95 % interval above 10 %
+        flagged = block["dynamic_analysis"] == "recommended"  # flagged where the 95 % interval of Cont_R lies above 10 %
         assert (row["Note"] == FLAG_NOTE) == flagged
     assert checked == len(docs) * len(SUMMARY_REACTIONS) * len(STAT_COLS)
     assert headers.count("±") == 8  # every statistic but mean_max (realizations > 1 present)

@@ -371,7 +371,7 @@ def run_chunk(plan: RunPlan, ci: int, stop: AnyEvent, reports: _ChunkProgress):
     reports.report("wind", reports.winds_done, plan.n_chunks)
     # (n_real, n_steps, n_nodes), along-wind; the burn-in's steps lead the analysed record (common
     # random numbers: the analysed turbulence does not depend on the burn-in's length)
-    v = fluctuating_velocity(case, system, t, list(rc), plan.a_turb, lead=int(np.argmax(plan.keep)))
+    v = fluctuating_velocity(case, system, t, list(rc), plan.a_turb, lead=int(np.argmax(plan.keep)), cancel=stop)
     loads, direct = fluctuating_loads(case, system, plan.models[0], t, v, plan.vn, plan.vl)
     direct = direct.reshape(direct.shape[:2] + (-1, 3))[:, :, towers].reshape(direct.shape[:2] + (-1,))
     reports.wind_done()

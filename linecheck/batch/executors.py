@@ -280,10 +280,10 @@ class ProcessPool(Executor):
         scan point); a worker still busy after :data:`ABORT_GRACE_S` is terminated.  Workers
         that stop on their own leave the pool's queues clean, so its shutdown cannot hang on
         a message cut off by a kill."""
+        processes = dict(getattr(self._pool, "_processes", None) or {})
         self._stop.set()
         self.cancel(handles)
         futures_wait([f for f in handles if not f.done()], timeout=ABORT_GRACE_S)
-        processes = dict(getattr(self._pool, "_processes", None) or {})
         self._pool.shutdown(wait=False, cancel_futures=True)
         for p in processes.values():  # a task that did not stop in time (Python < 3.14 has no API)
             if p.is_alive() and any(not f.done() for f in handles):

@@ -57,7 +57,7 @@ from scipy.special import betainc
 
 from .. import kernel
 from ..case import Case
-from ..errors import CaseError
+from ..errors import Cancelled, CaseError
 from ..system import LineSystem
 from .mean import mean_normal_at_nodes, mean_speed_at_nodes
 
@@ -481,7 +481,7 @@ def _record(time: np.ndarray) -> tuple[int, float]:
 
 
 def fluctuating_velocity(case: Case, system: LineSystem, time: np.ndarray, realizations: Sequence[int],
-                         a: np.ndarray | None = None, lead: int = 0) -> np.ndarray:
+                         a: np.ndarray | None = None, lead: int = 0, cancel=None) -> np.ndarray:
     """Fluctuating along-wind velocity a(x, t) u_r(x, t) [m/s] at the global FE nodes.
 
     time [s] equally spaced, shape (n_steps,); realizations: 0-based indices; ``a`` [m/s]: the
@@ -491,6 +491,7 @@ def fluctuating_velocity(case: Case, system: LineSystem, time: np.ndarray, reali
     so realization k's turbulence at a given time of the analysed record does not depend on the
     burn-in's length, nor on anything else that does not define the turbulence: two runs that
     differ in drag, tension or damping compare with common random numbers (docs/wind.md).
+    ``cancel``: an event (``is_set()``) checked before each realization (Cancelled when set).
     Returns shape (n_real, n_steps, n_nodes).
     """
     n_steps, dt = _record(time)
@@ -501,6 +502,8 @@ def fluctuating_velocity(case: Case, system: LineSystem, time: np.ndarray, reali
     reals = list(realizations)
     out = np.empty((len(reals), n_steps, system.n_nodes))
     for i, r in enumerate(reals):
+        if cancel is not None and cancel.is_set():
+            raise Cancelled("run cancelled")
         out[i] = _unit_field_memo(case, system, n_steps - lead, dt, int(r), int(lead))
         out[i] *= a
     return out

@@ -14,7 +14,7 @@ across the n_k mean states against the one-state-at-a-time code they replace:
 - realization: one full ``service.run_case(case, realizations=[0])`` with the one-by-one
   functions patched back in (before) vs as shipped (after).
 
-Both sides give bit-identical results (tests/test_build_models.py); the script checks the
+Both sides give bit-identical results (tests/core/test_build_models.py); the script checks the
 realization's reactions are equal.  With ``--baseline REV`` (default: fe644a7, the last commit
 with the one-state-at-a-time code) the package as it was at REV is also extracted
 (``git archive``) and imported under another name, and its ``run_case`` is timed in the same

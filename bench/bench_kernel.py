@@ -5,7 +5,7 @@
 Each row runs the same case twice in this process, the numpy loop (``LINECHECK_KERNEL=numpy``,
 the baseline) and the compiled kernel (``LINECHECK_KERNEL=numba``), fresh turbulence every run,
 best of ``--repeat``; the frequency-domain check is included where a run makes it.  The two
-agree within a tolerance (tests/test_kernel.py: RTOL_RUN, 1e-9 of the largest value); the last
+agree within a tolerance (tests/core/test_kernel.py: RTOL_RUN, 1e-9 of the largest value); the last
 column prints their largest relative difference here.
 """
 

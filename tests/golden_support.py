@@ -1,7 +1,7 @@
 """Golden results: the committed statistics of every shipped case and their comparison.
 
 Shared by ``tools/golden.py`` (write and check from the command line) and
-``tests/test_golden.py`` (the same check in the test suite); docs/testing.md, "Golden results".
+``tests/integration/test_golden.py`` (the same check in the test suite); docs/testing.md, "Golden results".
 
 A golden file ``tests/golden/<folder>-<name>.json`` holds what ``linecheck run CASE -n 2`` computes
 for one case (plus one ``--until`` run): the numbers of the run's result document

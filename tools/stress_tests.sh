@@ -6,7 +6,7 @@
 #   -n PASSES   consecutive passes of the suite (default 3); stops at the first failing pass
 #   -j HOGS     busy-loop processes started beside the tests (default 2: both cores of a
 #               2-core machine; use `nproc` to hog every core of a bigger one)
-#   PYTEST ARGS replace the default selection, e.g.  -- tests/test_tui.py
+#   PYTEST ARGS replace the default selection, e.g.  -- tests/frontends/test_tui.py
 #
 # The command is the README's: .venv/bin/python -m pytest (the fast suite; slow tests stay
 # deselected by pyproject.toml).  The hogs are stopped on exit, including Ctrl-C and errors.

@@ -20,7 +20,7 @@ unknowns N_0 are found by Newton's method with the exact flexibility
 
 integrated by 4-point Gauss-Legendre quadrature on every element (the integrand is smooth:
 the error is far below 1e-9 of the chord with 10 elements per span).  Under a uniform load this
-is Irvine's elastic catenary exactly (tests/test_sections.py checks the inclined span against
+is Irvine's elastic catenary exactly (tests/core/test_sections_core.py checks the inclined span against
 the closed form).
 
 The towers are solved as in the paper's Fig. 6 (strain clamps fixed, suspension clamps on

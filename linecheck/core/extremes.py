@@ -22,7 +22,7 @@ Choices (docs/method.md, "Statistics over realizations"):
   F(x) = exp(-exp(-(x - u)/beta)) inverted).
 - Confidence interval of a mean (GF_Dy, GF_QS, Cont_R): normal theory with Student's t,
   mean +- t_{0.975, n-1} se (the realizations are independent and identically distributed;
-  the coverage is checked on synthetic Gaussian records in tests/test_extremes.py).
+  the coverage is checked on synthetic Gaussian records in tests/core/test_extremes.py).
 """
 
 from __future__ import annotations

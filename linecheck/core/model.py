@@ -400,7 +400,7 @@ def build_models(system: LineSystem, states: Sequence[StaticState]) -> list[Line
     (n_k, n_el, 3, 3) and scattered into a stacked band (n_k, BANDWIDTH + 1, n_dof) with a
     leading state axis; the insulator blocks of all states and towers are batched the same
     way.  Every floating-point operation is the one :func:`build_model` does, in the same
-    order, so each model is bit-identical to building it alone (tests/test_build_models.py).
+    order, so each model is bit-identical to building it alone (tests/core/test_build_models.py).
     What does not depend on the state (DOF map, lumped mass, tributary lengths, axial DOFs)
     is computed once and shared, read-only, by all models.  Each model keeps its own dense
     reaction map G, as :func:`build_model` does (allocated state by state; 3 n_towers x n_dof
@@ -506,7 +506,7 @@ class Condensed:
 
 
 #: above this many DOFs :func:`condensed` works with sparse matrices (O(n) instead of the dense
-#: O(n^3) products; equal to the dense path to rounding, tests/test_sections_core.py); below it
+#: O(n^3) products; equal to the dense path to rounding, tests/core/test_sections_core.py); below it
 #: the dense path keeps every existing result bit for bit
 SPARSE_CONDENSATION_DOF = 600
 
@@ -654,7 +654,7 @@ def rotate_band(ab: np.ndarray, T: np.ndarray) -> np.ndarray:
             shape (..., n_nodes, 3, 3).
 
     Every 3x3 product is element-wise (:func:`mul3`), so a stack gives bit for bit the
-    matrices rotated one at a time on any CPU (tests/test_build_models.py).
+    matrices rotated one at a time on any CPU (tests/core/test_build_models.py).
     """
     D, E = band_blocks(ab)
     Tt = np.swapaxes(T, -1, -2)

@@ -27,7 +27,7 @@ def wood(eta: np.ndarray | float) -> np.ndarray:
 
 
 def wood_peak() -> float:
-    """The maximum of f_z, found numerically (tests/test_ring.py checks :data:`ETA_PEAK` against it)."""
+    """The maximum of f_z, found numerically (tests/core/test_ring.py checks :data:`ETA_PEAK` against it)."""
     from scipy.optimize import minimize_scalar
 
     res = minimize_scalar(lambda e: -float(wood(e)), bounds=(1e-6, 2.0), method="bounded",

@@ -61,7 +61,7 @@ def main() -> None:
             text += LINE.format(spans=spans, L=L, sag=L / 30, supports=supports, toi=toi) + "\n"
             text += WIND.format(wtype="synoptic" if kind == "Sy" else "downburst", V=V)
             if kind != "Sy":
-                text += f'\n[wind.downburst]\nmodel = "holmes-oliver"   # pinned: the results of issues 3-14 (docs/wind.md)\npreset = "{kind}"   # D_j = 2 L_x (Table 2)\n'
+                text += f'\n[wind.downburst]\nmodel = "holmes-oliver"   # pinned: the documented results (docs/wind.md, "Downburst models")\npreset = "{kind}"   # D_j = 2 L_x (Table 2)\n'
                 text += "\n" + ANALYSIS.replace("duration = 600.0\n", "").format(seed=2015 + n)
             else:
                 text += "\n" + ANALYSIS.format(seed=2015 + n)

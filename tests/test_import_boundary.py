@@ -60,7 +60,7 @@ CORE_MODULES = [
     "linecheck.io.provenance",
 ]
 #: core modules that import Numba themselves: loaded only by linecheck.core.kernel when the
-#: optional compiled kernel is asked for (issue 20)
+#: optional compiled kernel is asked for
 KERNEL_MODULES = ["linecheck.core._loops", "linecheck.core._loops_wind", "linecheck.core._loops_second_order"]
 
 
@@ -77,7 +77,7 @@ def test_core_imports_no_ui_libraries():
 
 
 def test_core_imports_numba_only_when_the_kernel_is_asked_for():
-    """Numba (the optional compiled step loop, issue 20) is never imported by importing the core;
+    """Numba (the optional compiled step loop) is never imported by importing the core;
     only :func:`linecheck.core.kernel.available` loads it."""
     code = (
         "import importlib, sys\n"

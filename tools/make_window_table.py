@@ -1,4 +1,4 @@
-"""Regenerate the peak-window table of docs/validation.md (issue 18).
+"""Regenerate the peak-window table of docs/validation.md ("Peak window").
 
 GF_QS and Cont_R of the synoptic paper cases (9-12, single and six spans, reactions R_y and
 R_x at the tower of interest) for peak windows of 30, 60, 120, 300 and 600 s of the 600 s
@@ -84,7 +84,7 @@ def main() -> None:
         a, b = text.index(START), text.index(END) + len(END)
         text = text[:a] + block + text[b:]
     else:
-        text = text.rstrip("\n") + "\n\n## Peak window (issue 18)\n\n" + block + "\n"
+        text = text.rstrip("\n") + "\n\n## Peak window\n\n" + block + "\n"
     DOC.write_text(text, encoding="utf-8")
     print(f"wrote {DOC.relative_to(ROOT)}")
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Run the test suite N times in a row while busy loops hog the CPU cores (issue 14).
+# Run the test suite N times in a row while busy loops hog the CPU cores (docs/testing.md, "The stress run").
 #
 #   tools/stress_tests.sh [-n PASSES] [-j HOGS] [-- PYTEST ARGS...]
 #

@@ -97,7 +97,7 @@ def run_chunk(
 ) -> Any:
     """Steps 1-3 of one case for a subset of its realizations.
 
-    ``until=(target, max_realizations)`` (``batch --until``, issue 18): the whole case with an
+    ``until=(target, max_realizations)`` (``batch --until``): the whole case with an
     adaptive count instead (:func:`linecheck.service.run_until`; ``realizations`` is then the
     initial count's range, used for progress only).
 
@@ -179,7 +179,7 @@ def scan_point(case: Case, distance: float, angle: float, jet_diameter: float,
     Returns (signed peak wind-induced mean reaction at the tower of interest [N] (3,),
     its instant [s] (3,), the V_ref at point p used [m/s]) and, with ``dynamic_realizations``
     = k > 0, a fourth item: the expected dynamic peak |M + B + R| of each reaction [N] (3,), the
-    mean over realizations 0..k-1 (issue 20: the scan ranks by the peak the design carries).
+    mean over realizations 0..k-1 (the scan ranks by the peak the design carries).
 
     ``v_max``: hold the storm's V_max [m/s] fixed (:func:`fixed_jet_case`); ``None``
     keeps the case's V_ref at point p of every configuration.
@@ -219,9 +219,9 @@ def scan_chunk(
 
     ``progress(points_done)``: called after each point (only when run in the coordinating process).
 
-    ``model``: the downburst running-mean model to scan under (issue 15; ``None``: the case's own).
+    ``model``: the downburst running-mean model to scan under (``None``: the case's own).
     ``dynamic_realizations``: k > 0 also runs steps 1-3 with realizations 0..k-1 at every point
-    and returns the expected dynamic peaks (issue 20).
+    and returns the expected dynamic peaks.
 
     ``v_max`` [m/s]: the storm's fixed V_max (see :func:`scan_point`), or ``None``.
 

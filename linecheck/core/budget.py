@@ -4,7 +4,7 @@ Nothing here allocates the arrays it sizes: every count is arithmetic on the cas
 absurd case (``time_step = 1e-9``, ``realizations = 1e9``, 200 spans x 200 elements) is
 refused in microseconds with a :class:`CaseError` (exit 2) that quotes the estimate.
 
-Limits (issue 14): memory above ``max_memory`` is refused; above half of it, or a run
+Limits: memory above ``max_memory`` is refused; above half of it, or a run
 time above :data:`WARN_SECONDS`, a warning is returned to the caller (the core never
 prints).  ``max_memory`` comes from the environment variable ``LINECHECK_MAX_MEMORY``
 (e.g. ``8GB``, ``512MB``, ``0.5TB`` or a number of bytes; the CLI option
@@ -167,7 +167,7 @@ def realization_chunk(case: Case, n_steps: int, threads: int = 1) -> int:
     """Realizations integrated together [-] (``service.run_case``): all of them unless their
     whole-record arrays (turbulence, loads and work arrays per node, reaction histories per
     tower: about 3 n_nodes + 24 n_towers doubles per step and realization) exceed
-    :data:`RUN_CHUNK_BYTES` (issue 20) shared by the ``threads`` chunks in flight at once."""
+    :data:`RUN_CHUNK_BYTES` shared by the ``threads`` chunks in flight at once."""
     n_nodes, _, n_towers = _sizes(case)
     per = float(n_steps) * F8 * (3 * n_nodes + 24 * n_towers)
     return max(1, int(RUN_CHUNK_BYTES / max(1, int(threads)) // per))
@@ -202,7 +202,7 @@ def estimate(case: Case, job: str = "run", *, realizations: int | None = None, b
         secs += n_k * (T_STATE0 + T_STATE * n_dof)
     # dense condensation: synoptic runs (burn-in, spectral), modes, structural-damping calibration
     # (above 600 DOFs the calibration is sparse); a long synoptic line's burn-in and check run on
-    # windows of at most about WINDOW_SPANS spans (issue 20, service.CHECK_WINDOW_*)
+    # windows of at most about WINDOW_SPANS spans (long lines, service.CHECK_WINDOW_*)
     windowed = synoptic and case.line.spans > WINDOW_SPANS and job != "modes"
     n_dense = min(n_dof, 3 * (WINDOW_SPANS * case.line.elements_per_span - 1)) if windowed else n_dof
     dense_needed = (job == "spectral" or (job == "modes" and n_dof <= 600)  # above: sparse Lanczos
@@ -252,7 +252,7 @@ def estimate_scan(case: Case, points: int, *, dynamic_realizations: int = 0, wor
 
 def memo_bytes(n_real: int, n_steps: int, n_nodes: int) -> float:
     """[bytes] What the process keeps of ``n_real`` realizations' turbulence for reuse
-    (:mod:`linecheck.core.wind.turbulence`'s per-process memos, issue 20): unit fields
+    (:mod:`linecheck.core.wind.turbulence`'s per-process memos): unit fields
     (n_steps x n_nodes) of at most a quarter of ``UNIT_FIELD_MEMO_BYTES`` each, up to it in all,
     and the random phases with their phasors (3 x n_nodes x n_freq, n_freq ≈ n_steps / 2) of at
     most an eighth each, up to half of it.  An upper bound: the phasors are kept only when the

@@ -1,4 +1,4 @@
-"""Design-code conductor wind loads (issue 19): ASCE Manual 74, IEC 60826, EN 50341-1, AS/NZS 7000.
+"""Design-code conductor wind loads (docs/codes.md): ASCE Manual 74, IEC 60826, EN 50341-1, AS/NZS 7000.
 
 One function per code returns the code's transverse wind load per unit length of conductor
 [N/m] for a wind normal to the line (Omega = 90 deg, Phi = 0), to be multiplied by the wind

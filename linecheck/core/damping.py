@@ -1,4 +1,4 @@
-"""Damping of the linearised conductor (paper Eqs 9-13; issue 10).
+"""Damping of the linearised conductor (paper Eqs 9-13; docs/method.md, "Damping").
 
 Two aerodynamic models, selected by ``[analysis] damping``:
 
@@ -77,7 +77,7 @@ def aerodynamic_damping(case: Case, model: LinearModel, vn_nodes: np.ndarray, no
     if case.analysis.damping == "paper":
         if system.straight_in_plan:
             ab[BANDWIDTH, first + 1] = c  # Eq. 9: transverse DOF only
-        else:  # along each node's transverse direction b (issue 17): c b b^T
+        else:  # along each node's transverse direction b (line sections): c b b^T
             b = system.node_normals[free]
             _add_node_blocks(ab, first, c[:, None, None] * b[:, :, None] * b[:, None, :])
         return project_axial(model, ab)  # a rigid insulator carries the axial part
@@ -87,7 +87,7 @@ def aerodynamic_damping(case: Case, model: LinearModel, vn_nodes: np.ndarray, no
     P = np.eye(3)[None] - e[:, :, None] * e[:, None, :]
     if system.straight_in_plan:
         w = P[:, :, 1]  # the wind (+y) projected normal to the axis
-    else:  # the node's transverse load direction b projected normal to the axis (issue 17)
+    else:  # the node's transverse load direction b projected normal to the axis (line sections)
         w = np.einsum("nab,nb->na", P, system.node_normals[free])
     w = w / np.linalg.norm(w, axis=1)[:, None]
     ww = w[:, :, None] * w[:, None, :]
@@ -110,7 +110,7 @@ def stiffness_proportional(model: LinearModel, ratio: float, omega1: float) -> n
 def aerodynamic_damping_stack(case: Case, models: list[LinearModel], vn_nodes: np.ndarray,
                               nodes: np.ndarray | None = None) -> np.ndarray:
     """:func:`aerodynamic_damping` of many mean states of one system in one vectorised pass
-    (issue 20), bit-identical to calling it state by state.
+    (long lines), bit-identical to calling it state by state.
 
     Args:
         models: the linear models of the states (one system, e.g. from
@@ -133,7 +133,7 @@ def aerodynamic_damping_stack(case: Case, models: list[LinearModel], vn_nodes: n
     if case.analysis.damping == "paper":
         if system.straight_in_plan:
             ab[:, BANDWIDTH, first + 1] = c  # Eq. 9: transverse DOF only
-        else:  # along each node's transverse direction b (issue 17): c b b^T
+        else:  # along each node's transverse direction b (line sections): c b b^T
             b = system.node_normals[free]
             _add_node_blocks(ab, first, c[..., None, None] * b[:, :, None] * b[:, None, :])
         return project_axial_stack(model.axial_dof, axes, ab)  # a rigid insulator carries the axial part
@@ -143,7 +143,7 @@ def aerodynamic_damping_stack(case: Case, models: list[LinearModel], vn_nodes: n
     P = np.eye(3) - e[..., :, None] * e[..., None, :]
     if system.straight_in_plan:
         w = P[..., :, 1]  # the wind (+y) projected normal to the axis
-    else:  # the node's transverse load direction b projected normal to the axis (issue 17)
+    else:  # the node's transverse load direction b projected normal to the axis (line sections)
         w = np.einsum("nab,nb->na", P.reshape(-1, 3, 3),
                       np.tile(system.node_normals[free], (n_k, 1))).reshape(P.shape[:-1])
     w = w / np.linalg.norm(w, axis=-1)[..., None]

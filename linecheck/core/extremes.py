@@ -1,5 +1,5 @@
 """Summaries of per-realization statistics: moments, fractiles, Gumbel fits, confidence
-intervals and the three-state "dynamic analysis" flag (issue 18).
+intervals and the three-state "dynamic analysis" flag (docs/method.md, "Statistics over realizations").
 
 Input everywhere is an array of per-realization (or per window x realization) values
 ``values`` of shape (n, ...) -- axis 0 the sample; outputs have shape ``values.shape[1:]``.

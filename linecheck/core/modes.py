@@ -1,4 +1,4 @@
-"""Natural frequencies and mode shapes of a linearised state (issue 4, `linecheck modes`).
+"""Natural frequencies and mode shapes of a linearised state (`linecheck modes`).
 
 Generalised eigenproblem K phi = omega^2 M phi with the lumped (diagonal) mass, on the
 model with the insulator-axial directions condensed out (:func:`~linecheck.core.model.condensed`),
@@ -33,7 +33,7 @@ class Modes:
         """Index (0 x, 1 y, 2 z) of the direction holding most of each mode's kinetic energy, (n_modes,).
 
         On a section with angle towers x, y, z are every node's own along-line, transverse
-        (horizontal normal) and vertical directions (issue 17)."""
+        (horizontal normal) and vertical directions."""
         sh = self.shapes if self.frames is None else np.einsum("mna,nab->mnb", self.shapes, self.frames)
         return np.argmax((sh**2).sum(axis=1), axis=1)
 
@@ -42,7 +42,7 @@ def natural_modes(model: LinearModel, n_modes: int = 20) -> Modes:
     """The ``n_modes`` lowest undamped modes of ``model``.
 
     Up to :data:`~linecheck.core.model.SPARSE_CONDENSATION_DOF` DOFs the dense symmetric
-    eigensolver of the condensed problem (module docstring).  Larger systems (issue 20: long
+    eigensolver of the condensed problem (module docstring).  Larger systems (long
     lines; the dense solver is O(n^3)): shift-invert Lanczos (ARPACK via
     ``scipy.sparse.linalg.eigsh``; Ericsson & Ruhe 1980) on the sparse banded K and lumped M
     about sigma = 0, O(n) per mode.  The insulator-axial DOFs carry no mass, so M is only

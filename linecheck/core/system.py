@@ -4,7 +4,7 @@
 points, per-span horizontal and unstretched lengths, element lengths and the
 still-air node coordinates.  The numerical path reads these arrays, never the
 case's ``span_length`` key (tests/test_import_boundary.py checks this), so that
-unequal spans (issue 17) only change how the arrays are built here.
+unequal spans (line sections) only change how the arrays are built here.
 
 Axes: x along the line (towers at x_j = (j-1) L_x), y transverse (the wind blows
 toward +y), z up.  Conductor attachment points are level (z = 0) in still air;
@@ -145,7 +145,7 @@ class LineSystem:
         p[:, 0] = self.tower_x
         return p
 
-    # ------------------------------------------------------------------ section form (issue 17)
+    # ------------------------------------------------------------------ section form (line sections)
     @property
     def is_section(self) -> bool:
         """True when the case describes its towers ([[line.towers]] / towers_file)."""
@@ -291,8 +291,8 @@ class LineSystem:
         """[m] still-air position of every global FE node (x, y, z), (n_nodes, 3).
 
         Equal-span form: (node_x0, 0, 0) (the paper's wind sees a straight, level line).
-        Section form: the still-air equilibrium under weight (issue 17: "height above ground of a
-        conductor point: from the still-air shape"; at angle towers the insulators have swung;
+        Section form: the still-air equilibrium under weight (the height above ground of a
+        conductor point is taken from the still-air shape, docs/wind.md, "Sections"; at angle towers the insulators have swung;
         on a straight section it is the clipped-in shape, :attr:`clip_in_nodes`)."""
         if self.is_section:
             return self.still_air.nodes
@@ -417,7 +417,7 @@ class LineSystem:
 
     @property
     def unstretched_length(self) -> float:
-        """Unstretched span length L_u = stretched / (1 + T0/EA) [m] (issue 2 definition)."""
+        """Unstretched span length L_u = stretched / (1 + T0/EA) [m] (linecheck's definition)."""
         return self.stretched_length / (1.0 + self.tension_nominal / self.line.ea)
 
     def span_of_node(self, node: np.ndarray | int) -> np.ndarray:

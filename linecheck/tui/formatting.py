@@ -38,7 +38,7 @@ def summary_rows(doc: RunDocument) -> list[tuple[str, str, str, str, str]]:
 
 
 def design_rows(doc: RunDocument) -> list[tuple[str, str, str, str, str]]:
-    """Issue 18 rows: Gumbel design peaks (wind-induced and total), 95 % intervals of GF_Dy, GF_QS
+    """Design-statistics rows: Gumbel design peaks (wind-induced and total), 95 % intervals of GF_Dy, GF_QS
     and Cont_R, and the Cont_R flag state, at the tower of interest."""
     reactions = doc.reactions
     p = doc.design_fractile

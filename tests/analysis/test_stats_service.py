@@ -1,4 +1,4 @@
-"""Issue 18 through the service: peak windows, --until, the typed result document."""
+"""Design statistics through the service: peak windows, --until, the typed result document."""
 
 from __future__ import annotations
 
@@ -202,7 +202,7 @@ def test_cli_run_until_and_export_of_old_results(tmp_path):
     assert json.loads(json.dumps(run_to_dict(fixed)["reactions"])) == doc["reactions"]  # bit for bit
     bad = runner.invoke(app, ["run", str(case), "--until", "abc"])
     assert bad.exit_code == 2 and "--until" in bad.output and "1%" in bad.output
-    # a result saved before issue 18 (no schema_version, statistics {"mean", "std"} only)
+    # a result saved before the typed document (no schema_version, statistics {"mean", "std"} only)
     old = {k: v for k, v in doc.items() if k not in ("schema_version", "until")}
     old["reactions"] = {r: {s: {"mean": e["mean"], "std": e["std"]} for s, e in blk.items() if isinstance(e, dict)}
                         for r, blk in doc["reactions"].items()}

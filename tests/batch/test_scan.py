@@ -189,7 +189,7 @@ def test_cli_scan_table_csv_and_dynamic(tmp_path):
 
 
 def test_scan_ranks_by_the_expected_dynamic_peak(tmp_path):
-    """Issue 20: with dynamic_realizations the scan runs steps 1-3 at every position; the value
+    """With dynamic_realizations the scan runs steps 1-3 at every position; the value
     ranked is the realization mean of the dynamic peak |M+B+R| at the tower of interest, equal
     to run_case's own statistics there (same seeds).  (It is not bounded below by the point's
     largest |mean|: a downburst's mean peak is brief, and a realization whose gust is negative
@@ -306,7 +306,7 @@ def test_one_storm_scan_positions_share_the_phases_bit_for_bit(monkeypatch):
     ("examples/section-12span", 5, 'drag = "quadratic"\ntension = "second-order"\n'),  # an 18 deg angle-strain tower
 ])
 def test_run_tower_equals_run_case_at_the_tower_of_interest(tmp_path, name, toi, options):
-    """Issue 20: a scan's steps 1-3 compute the tower of interest's reactions alone (service.run_tower:
+    """A scan's steps 1-3 compute the tower of interest's reactions alone (service.run_tower:
     its rows of G, of the direct loads and of the second-order forms; its own frame); every
     statistic there is the same bits as run_case's, the gust factors' definedness included (it is
     decided against the whole section's largest mean)."""

@@ -1,4 +1,4 @@
-"""Issue 10: damping models, burn-in, and the paper-damping regression."""
+"""Damping models, burn-in, and the paper-damping regression."""
 
 from __future__ import annotations
 

@@ -180,7 +180,7 @@ def test_statistics_definitions():
 
 
 def test_time_step_halving_changes_rms_by_less_than_one_percent():
-    """Issue 4: the same wind record (synthesised at 0.025 s; every second sample for 0.05 s)
+    """The same wind record (synthesised at 0.025 s; every second sample for 0.05 s)
     integrated at the default 0.05 s and at 0.025 s: r.m.s. of the fluctuating and resonant
     reactions differ by < 1 % (same realization, so no sampling error enters)."""
     import dataclasses
@@ -213,7 +213,7 @@ def test_time_step_halving_changes_rms_by_less_than_one_percent():
 
 
 def test_non_positive_definite_state_and_nan_loads_are_reported():
-    """Issue 4: a non-positive-definite stiffness or non-finite loads raise NumericalError
+    """A non-positive-definite stiffness or non-finite loads raise NumericalError
     (one line naming the state), never a result."""
     from linecheck.core.errors import NumericalError
 

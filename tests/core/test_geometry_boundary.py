@@ -1,4 +1,4 @@
-"""LineSystem owns the geometry (issue 17, "Structure first").
+"""LineSystem owns the geometry (structure first).
 
 No module under linecheck/ reads the case's ``span_length`` key except the geometry code
 (linecheck/core/case_model.py defines it, case_load.py reads it for a downburst preset,

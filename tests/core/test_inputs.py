@@ -1,4 +1,4 @@
-"""Hostile input and resource guards (issue 14, items 5, 6, 8, 9)."""
+"""Hostile input and resource guards."""
 
 from __future__ import annotations
 
@@ -183,7 +183,7 @@ def test_huge_realization_override_exits_2_with_the_estimate_before_computing(mo
     r = cli("run", str(PAPER / "case01-single.toml"), "-n", "1000000000")
     out = " ".join(r.output.split())
     assert r.exit_code == 2, out
-    # realizations run in memory-sized chunks (issue 20), but the result keeps B and R at the
+    # realizations run in memory-sized chunks, but the result keeps B and R at the
     # tower of interest of every one: 1e9 x 12001 steps x 6 doubles x 8 bytes = 5.76e14 bytes
     assert "run needs about 577 TB of memory" in out and "--max-memory" in out
 
@@ -263,7 +263,7 @@ def test_with_values_keeps_large_legal_case_refused_by_the_guard_not_the_schema(
     case = with_values(load_case(PAPER / "case09-single.toml"), {"analysis.realizations": 10000})
     est = budget.estimate(case)
     # realizations in chunks of 1 GB / (12001 steps x 8 bytes x (3 x 11 nodes + 24 x 2 towers)) = 128
-    # (issue 20): 4 arrays x 8 bytes x 128 x 12001 x 11 nodes + 8 x 8 x 12001 x 11, what the result
+    # at once: 4 arrays x 8 bytes x 128 x 12001 x 11 nodes + 8 x 8 x 12001 x 11, what the result
     # keeps of all 1e4 (6 doubles per step, 45 statistics per tower), + 100 MB + one state of
     # 27 DOF (33 less the 6 of the two pinned strain towers) + 7 dense 27 x 27 matrices + the
     # turbulence memos at their caps (1e4 unit fields of 1.06 MB: 256 MB; phases and phasors of
@@ -275,7 +275,7 @@ def test_with_values_keeps_large_legal_case_refused_by_the_guard_not_the_schema(
 
 
 def test_the_estimate_counts_the_turbulence_memos():
-    """The per-process memos of unit fields and phases (issue 20) are in the estimate: n_real
+    """The per-process memos of unit fields and phases are in the estimate: n_real
     fields of n_steps x n_nodes doubles and 3 n_nodes n_freq doubles of phases each, up to their
     caps; a field above a quarter of the cap (a long line) is not kept, so not counted."""
     six = load_case(PAPER / "case09-six.toml")

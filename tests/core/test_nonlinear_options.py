@@ -1,4 +1,4 @@
-"""Issue 16: the drag's v^2 term, the second-order tension and the exported wind field."""
+"""Nonlinear options: the drag's v^2 term, the second-order tension and the exported wind field."""
 
 from __future__ import annotations
 
@@ -155,7 +155,7 @@ def test_second_order_bit_identical_whatever_else_runs():
 
 
 def _reference_second_order(op, U, T=None, dtype=np.float64):
-    """R_2 = f2 A as first built (issue 16): the member forces f2 (module docstring of
+    """R_2 = f2 A as first built: the member forces f2 (module docstring of
     linecheck.core.second_order) assembled component by component, then the product with A.
     Kept here as the reference of the faster P W form (same operator, other arithmetic);
     ``dtype`` np.longdouble evaluates it in extended precision (x86: 64-bit mantissa)."""

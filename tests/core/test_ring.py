@@ -1,4 +1,4 @@
-"""Models "ring-jet" and "ring-jet-inviscid" (issues 15, 36): each published part against its
+"""Models "ring-jet" and "ring-jet-inviscid": each published part against its
 source, the travelling front, the exact D_j/V_j time scaling, the near-ground maximum and the
 published ranges of the field, step 1 under the field, and the model selection errors."""
 
@@ -296,7 +296,7 @@ def test_run_models_cli_json_block(tmp_path):
     doc = json.loads(out.read_text())
     assert list(doc["models"]) == ["holmes-oliver", "ring-jet"] and doc["model"] == "holmes-oliver"
     assert doc["models"]["holmes-oliver"] == doc["reactions"]
-    assert set(doc["models"]["ring-jet"]["Ry"]) == set(STATISTICS) | {"dynamic_analysis"}  # typed block (issue 18)
+    assert set(doc["models"]["ring-jet"]["Ry"]) == set(STATISTICS) | {"dynamic_analysis"}  # typed block
     for rn in ("Rx", "Ry"):
         vals = {m: doc["models"][m][rn]["peak_dynamic"]["mean"] for m in doc["models"]}
         e = doc["models_envelope"][rn]["peak_dynamic"]

@@ -1,4 +1,4 @@
-"""Line sections (issue 17): geometry, clipping-in, the exact-span step 1 and tower frames.
+"""Line sections: geometry, clipping-in, the exact-span step 1 and tower frames.
 
 References: Irvine (1981) elastic catenary in closed form (linecheck.reference for the level
 span; the inclined form re-derived here from the parametric solution x(s), z(s)), statics
@@ -97,7 +97,7 @@ def test_inclined_single_span_still_air_reactions_are_irvines():
 
 def test_straight_section_does_not_move_in_still_air():
     """Unequal, inclined but straight: clipping-in balances H0 at every suspension clamp, so the
-    still-air equilibrium is the clipping-in state (issue 17 definition)."""
+    still-air equilibrium is the clipping-in state (linecheck's definition)."""
     towers = [_tower(0.0, support="strain"), _tower(260.0, ground=12.0), _tower(700.0, ground=-20.0, height=50.0),
               _tower(990.0, ground=5.0, height=35.0), _tower(1300.0, ground=40.0, support="strain")]
     system = LineSystem(_case(towers).line)
@@ -146,8 +146,8 @@ def test_angle_tower_swings_inside_and_carries_the_tension_resultant():
 def test_section_form_agrees_with_the_paper_form_on_the_paper_geometry():
     """The paper's six 300 m level spans written as towers, with H0 = the equal-span form's
     still-air tension: still-air and 40 m/s reactions agree with the Appendix-A solver within
-    0.5 % of the largest component at every tower (parabolic vs exact span; issue 17 requires
-    the paper's geometry to be a special case)."""
+    0.5 % of the largest component at every tower (parabolic vs exact span; the paper's
+    geometry must be a special case of a section)."""
     from linecheck.validation import paper_line
 
     paper = LineSystem(paper_line(300.0, 6))
@@ -192,7 +192,7 @@ def test_section_dynamics_run_on_the_example(cases_dir):
 
 
 def test_frequency_domain_load_is_the_time_domain_load_on_an_oblique_section():
-    """Issue 17: with an oblique wind both domains load node i with rho C_d D L_i V_n v cos(phi)
+    """With an oblique wind both domains load node i with rho C_d D L_i V_n v cos(phi)
     (the normal part of the along-wind fluctuation), cos(phi) = |V_n|/|V| = |cos(d + h_i)| on a
     span of heading h_i; the spectral check's load per unit v equals the time domain's."""
     from linecheck import service
@@ -238,7 +238,7 @@ def test_downburst_on_the_example_section_runs_in_tower_frames(cases_dir):
 
 
 def test_sparse_condensation_equals_the_dense_one(cases_dir, monkeypatch):
-    """Issue 20: above SPARSE_CONDENSATION_DOF the condensation of the insulator-axial DOFs is
+    """Above SPARSE_CONDENSATION_DOF the condensation of the insulator-axial DOFs is
     sparse; on the 12-span section (both paths forced) S, K*, M*, C* agree with the dense
     algebra to 1e-12 of their largest entry (the axial penalty, 1e3 EA/L_e, makes K* lose
     about 1e-14 to rounding in either path; measured 3e-14)."""

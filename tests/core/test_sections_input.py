@@ -1,4 +1,4 @@
-"""Malformed sections through the CLI (issue 17 acceptance): ``linecheck check`` exits 2 with ONE
+"""Malformed sections through the CLI (section acceptance): ``linecheck check`` exits 2 with ONE
 line naming the file, the row (CSV) or key (TOML), the value and what is allowed.
 
 Each case is the shipped 12-span example with one defect: its CSV edited (one row or column) or

@@ -1,4 +1,5 @@
-"""Issue 5 / 10: frequency-domain estimates against the time domain and closed forms."""
+"""Frequency-domain estimates against the time domain and closed forms (docs/method.md,
+"Frequency-domain check")."""
 
 from __future__ import annotations
 

@@ -21,7 +21,7 @@ def test_single_span_matches_elastic_catenary(L, V):
     st = solve_static(system, span_loads_uniform(system, g))
     Lu, EA = system.unstretched_length, system.line.ea
     Rx, Ry, Rz = irvine.reactions(L, Lu, 17.92, g, EA)
-    # issue 2 acceptance: within 0.5 % of the exact elastic catenary
+    # acceptance: within 0.5 % of the exact elastic catenary
     assert st.tension[0] == pytest.approx(Rx, rel=5e-3)
     assert st.reactions[0, 0] == pytest.approx(Rx, rel=5e-3)
     assert st.reactions[0, 1] == pytest.approx(Ry, rel=5e-3, abs=1e-6)
@@ -119,7 +119,7 @@ def test_vectorised_tridiagonal_solve_matches_dense():
 
 
 def test_final_states_are_batch_invariant_and_hang_from_the_attachments():
-    """Issue 20: the deformed shapes and element tensions of many converged states in one
+    """The deformed shapes and element tensions of many converged states in one
     vectorised pass (static._final_states): a state's arrays are the same bits alone as in the
     batch; the shape starts and ends at the attachment points, and every element's tension is at
     least the span's horizontal tension (T = H ds/dx)."""

@@ -1,4 +1,4 @@
-"""Step 1 against an independent non-linear FE reference (issue 2, step 1 acceptance).
+"""Step 1 against an independent non-linear FE reference (step 1 acceptance).
 
 The reference (``tests/reference/fe_static.py``) models every span with 80 exact
 (large-displacement) cable elements and every suspension insulator with a stiff truss,
@@ -23,7 +23,7 @@ from ..reference import irvine
 from ..reference.fe_static import solve_fe
 
 RHO, CD, D, W = 1.25, 1.0, 0.022, 17.92  # paper Table 1 (kg/m3, -, m, N/m)
-TOL = 0.01  # issue 2: within 1 % of the FE solution
+TOL = 0.01  # acceptance: within 1 % of the FE solution
 LEFT_LOADED = (1.0, 1.0, 1.0, 0.0, 0.0, 0.0)  # wind on spans 1-3 only
 
 

@@ -1,4 +1,4 @@
-"""Wind fields (issue 3): downburst running mean, user field tables, turbulence synthesis.
+"""Wind fields: downburst running mean, user field tables, turbulence synthesis.
 
 Statistical checks use fixed seeds; each tolerance is justified next to it from the
 sampling error of the estimator for the number of records, bins and nodes used.
@@ -379,7 +379,7 @@ def test_ensemble_psd_within_15_percent_in_every_octave_band(ensemble):
         m = (f >= lo) & (f < hi)
         est = psd[:, m, :].mean()
         target = tb.von_karman_psd(f[m], L, V).mean()
-        # Tolerance 15 % (issue 3).  Expected error: a deterministic +3.6 % (bins rescaled for the
+        # Tolerance 15 %.  Expected error: a deterministic +3.6 % (bins rescaled for the
         # 3.5 % of variance above 2.5 Hz) plus sampling error 1/sqrt(n_bins n_real n_indep); the
         # lowest band has 12 bins x 30 records and ~3.4 independent node groups (line 1800 m over
         # coherence length V/(C f) = 530 m), so 1/sqrt(1224) = 2.9 %: 15 % is > 3.9 sigma from the
@@ -398,7 +398,7 @@ def test_co_coherence_within_0_05_at_three_separations(ensemble, sep):
     co = np.real(a * np.conj(b)).sum() / math.sqrt((np.abs(a) ** 2).sum() * (np.abs(b) ** 2).sum())
     w = tb.von_karman_psd(f[m], L, V)
     target = (w * tb.davenport_coherence(f[m], dx, C, V)).sum() / w.sum()
-    # Tolerance 0.05 (issue 3).  Co-coherence estimator std ~ (1 - gamma^2)/sqrt(2 n_d) with
+    # Tolerance 0.05.  Co-coherence estimator std ~ (1 - gamma^2)/sqrt(2 n_d) with
     # n_d = n_real x n_bins x independent pairs >= 30 x 25 x 10 = 7500 (sep 120 m, the smallest
     # band): 0.75/122 = 0.006, so 0.05 is ~8 sigma.
     assert co == pytest.approx(target, abs=0.05)
@@ -411,7 +411,7 @@ def test_fluctuation_std_within_3_percent_of_i_v(fft_length):
     system = LineSystem(case.line)
     t = np.arange(12001) * 0.05  # the paper's 600 s record at 0.05 s (fast: a 12,150-point transform)
     u = tb.fluctuating_velocity(case, system, t, range(10))
-    # Tolerance 3 % (issue 3).  The per-record std scatters by 2.0 % (60-record study; the energy
+    # Tolerance 3 %.  The per-record std scatters by 2.0 % (60-record study; the energy
     # sits in ~20 bins near the von Karman peak, 0.03 Hz); pooled over the paper's 10 records that
     # is 0.6 %, so 3 % is 5 sigma.  The process variance is exactly 1 by construction.
     assert u.std() == pytest.approx(0.12 * 40.0, rel=0.03)
@@ -445,7 +445,7 @@ def test_downburst_scale_spectrum_and_coherence_long_ensemble():
 
 
 def test_fast_fft_length_is_a_different_reproducible_draw_of_the_same_process():
-    """``fft_length = "fast"`` (issue 20): the transform is the next 5-smooth length (12,001 ->
+    """``fft_length = "fast"``: the transform is the next 5-smooth length (12,001 ->
     12,150 points), the record keeps its 12,001 samples, the field is reproducible bit for bit
     and is not the record-length field (other frequencies, other phases; the per-process memo
     keeps the two apart)."""

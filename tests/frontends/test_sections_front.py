@@ -1,4 +1,4 @@
-"""Front ends on a line section (issue 17, "Everything works on a section"): the shared display
+"""Front ends on a line section (everything works on a section): the shared display
 helpers (linecheck/io/section.py), the CLI tables and the Excel "Section" block.
 
 Reference values are read from the example's CSV with the csv module and the plan positions
@@ -105,7 +105,7 @@ def test_geometry_of_the_example_against_the_definition():
     np.testing.assert_allclose(np.c_[geo.x, geo.y], expected_plan(ref), rtol=0, atol=1e-9)
     np.testing.assert_allclose(geo.z, [float(t["ground"]) + float(t["height"]) for t in ref], atol=1e-12)
     # the still-air conductor passes through every clamp (lifted where an angle tower's insulator
-    # swung: the still-air equilibrium, issue 17) and hangs below the chords between them
+    # swung: the still-air equilibrium) and hangs below the chords between them
     from linecheck.core.static import still_air_state
     from linecheck.core.system import LineSystem
 
@@ -125,7 +125,7 @@ def test_line_from_parameters_inline_file_and_paper():
     assert line_from_parameters(params).towers == case.line.towers
     file_params = json.loads(json.dumps(case_to_dict(load_case(EXAMPLE))))
     assert line_from_parameters(file_params) is None  # only the file name: no table
-    # a result whose towers[] carry the geometry (issue 17 JSON): rebuilt from them
+    # a result whose towers[] carry the geometry (the section JSON): rebuilt from them
     towers = [{"index": k + 1, "name": t.name, "station": t.station, "ground": t.ground, "height": t.height,
                "support": t.support, "angle": t.angle} for k, t in enumerate(case.line.towers)]
     line = line_from_parameters(file_params, towers)
@@ -137,7 +137,7 @@ def test_line_from_parameters_inline_file_and_paper():
     typed = [SimpleNamespace(**t, insulator_length=c.insulator_length) for t, c in zip(towers, case.line.towers)]
     assert line_from_parameters(file_params, typed).towers == case.line.towers
     assert insulators_known(file_params, typed)
-    # a typed document tower keeps the section keys in its `section` dict (issue 17 JSON)
+    # a typed document tower keeps the section keys in its `section` dict (the section JSON)
     nested = [SimpleNamespace(index=t["index"], support=t["support"], reactions={},
                               section={k: v for k, v in t.items() if k not in ("index", "support")}) for t in towers]
     assert [(t.name, t.station, t.height) for t in line_from_parameters(file_params, nested).towers] == \
@@ -319,7 +319,7 @@ def test_spectral_line_without_a_closed_form():
 
 
 def test_tui_codes_rows_name_the_section_towers():
-    """The TUI's Codes table labels a section's towers "index name" (issue 17)."""
+    """The TUI's Codes table labels a section's towers "index name"."""
     from linecheck.io.document import CodeCheckRecord, CodeTower, CodeVerdict
     from linecheck.tui.widgets.codes import codes_rows
 

@@ -428,7 +428,7 @@ async def test_run_errors_open_a_dialog_not_a_crash(short_case: Path, monkeypatc
         assert "non-finite" in of_type(messages, msg.RunFailed)[0].message
 
 
-# --------------------------------------------------------------------------- issue 14
+# --------------------------------------------------------------------------- unsaved edits
 async def test_switching_case_with_unsaved_edits_asks(short_case: Path) -> None:
     other = write_case(short_case.parent, "case09-single.toml", "other", **{"analysis.duration": 20.0})
     messages = Recorder()
@@ -621,7 +621,7 @@ async def test_model_spread_action(tmp_path: Path) -> None:
         assert "ring-jet" in notes and "envelope" in notes
 
 
-# --------------------------------------------------------------------------- sections (issue 17)
+# --------------------------------------------------------------------------- sections
 SECTION = ROOT / "cases" / "examples" / "section-12span.toml"
 
 

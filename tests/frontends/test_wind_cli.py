@@ -1,4 +1,4 @@
-"""`linecheck wind CASE --csv --json --realization` (issue 3, paper Fig. 3)."""
+"""`linecheck wind CASE --csv --json --realization` (paper Fig. 3)."""
 
 from __future__ import annotations
 

@@ -5,7 +5,7 @@ interest).  The turbulence at p is the unit field of the FE node nearest p (the
 unit field is homogeneous along the line, so its statistics there are those at p),
 modulated by a(p, t) = I |V_m(p, t)| (downburst) or I V_ref (synoptic) (Chay et al. 2006).
 
-Section form (issue 17): p may lie off the line (the foot of the perpendicular from the
+Section form: p may lie off the line (the foot of the perpendicular from the
 downburst centre on the tower of interest's frame x axis), so everything is taken at the FE
 node nearest p in plan: its running mean (at its still-air plan position and height above
 ground; normal/longitudinal along its node normal and along-line direction) and its unit field.
@@ -86,7 +86,7 @@ def point_series(case: Case, realization: int = 0) -> PointSeries:
     xp = point_p(case)
     node = nearest_node_to_p(case, system)
     if system.is_section:
-        # issue 17: the running mean at the node nearest p (its plan position and height)
+        # section: the running mean at the node nearest p (its plan position and height)
         vy, vx = (c[:, node] for c in mean_components_at_nodes(case, system, time))
         node_x = float(system.node_station[node])
     else:

@@ -64,9 +64,6 @@ from .core.loads import fluctuating_loads, mean_loads, to_global_nodes, turbulen
 from .core.model import build_model, build_models
 from .core.system import LineSystem
 
-#: the unguarded step 1 under its former name (tests/core/test_kernel.py)
-_static_analysis = static_result
-
 __all__ = [  # the names front ends, tests and benchmarks use
     "BUILTIN_DOWNBURST_MODELS", "CHECK_WINDOW_HALVES", "CHECK_WINDOW_MIN_SPANS", "CHECK_WINDOW_RTOL",
     "CODES_PEAK", "BurnIn", "CheckWindow", "CodeCheck", "CodesResult", "LineSystem", "ModesResult", "Progress",

@@ -234,7 +234,7 @@ def _background_solves(run: _Run, R_B: np.ndarray) -> None:
     per = max(1, max(1, 2_000_000 // n_dof) // max(n_real, 1))  # right-hand sides per solve: ~16 MB
     for k in np.unique(run.state_of_step):
         c = _factor(run.models[k].K_band, np.zeros(n_dof), f"stiffness of mean state {k + 1}")
-        sparse_g = _sparse_rows(run.models[k].G)
+        sparse_g, solver = _sparse_rows(run.models[k].G), ColumnSolver(c)  # padded once per state
         all_steps = np.flatnonzero(run.state_of_step == k)
         for i0 in range(0, all_steps.size, per):
             steps = all_steps[i0:i0 + per]
@@ -243,7 +243,7 @@ def _background_solves(run: _Run, R_B: np.ndarray) -> None:
                                                sparse_g).reshape(steps.size, n_real, n_r)
                 continue
             rhs = run.loads_full(run.loads[steps].reshape(-1, n_free)).T  # (n_dof, m)
-            UB = (kernel.solve_columns(c, rhs) if run.compiled else _solve(c, rhs)).T  # (m, n_dof), global
+            UB = (kernel.solve_columns(c, rhs) if run.compiled else solver.columns(rhs)).T  # (m, n_dof), global
             R_B[steps] = _sparse_reactions(UB, *sparse_g).reshape(steps.size, n_real, n_r)
             sk = steps >= run.second_order_start
             if run.second_order is not None and sk.any():  # the quasi-static displacements themselves

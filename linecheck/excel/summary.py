@@ -107,15 +107,15 @@ def _put_id(cur: Cursor, row: int, at: int, col: Column, value: Any, link_to: st
         link(cell, link_to)
 
 
-def _put_stat(cur: Cursor, row: int, at: int, col: Column, doc: RunDocument | FailedRun, reaction: str) -> None:
-    """A statistic's cell [kN, -, or fraction shown in %]; empty for a failed case."""
-    stat = col.stat
-    assert stat is not None
+def _put_stat(cur: Cursor, row: int, at: int, stat: StatDef, which: str, doc: RunDocument | FailedRun,
+              reaction: str) -> None:
+    """A statistic's cell (``which``: "mean" or "std" over realizations) [kN, -, or fraction shown
+    in %]; empty for a failed case."""
     if isinstance(doc, FailedRun):
         cur.put(row, at, None)
         return
     entry = doc.reactions[reaction][stat.name]
-    if col.which == "std":
+    if which == "std":
         value = stat_cell(stat, entry.std) if doc.realizations > 1 and entry.std is not None else None
     else:
         value = stat_cell(stat, entry.mean)
@@ -158,8 +158,8 @@ def _write_row(cur: Cursor, row: int, left: int, cols: list[Column], doc: RunDoc
     ids = id_values(doc, reaction)
     flagged = None
     for k, col in enumerate(cols):
-        if col.name == "stat":
-            _put_stat(cur, row, left + k, col, doc, reaction)
+        if col.stat is not None:
+            _put_stat(cur, row, left + k, col.stat, col.which, doc, reaction)
         elif col.name == "sanity":
             flagged = k if _put_sanity(cur, row, left + k, doc) else None
         elif col.name == "note":

@@ -117,7 +117,7 @@ def test_structural_damping_remainder_by_diagonals_is_the_csr_product():
     from linecheck.core.dynamics import Newmark, _Stepper
 
     case = _short(CASES / "paper" / "case09-six.toml", damping="quasi-steady")
-    st = service._static_analysis(case)
+    st = service.static_result(case)
     model = service.build_model(st.system, st.mean.state(0))
     damping = service.damping_matrices(case, st, [model])[0]
     stepper = _Stepper.build(model, damping, Newmark(case.analysis.time_step))
@@ -151,7 +151,7 @@ def test_downburst_field_agrees(monkeypatch, name):
     monkeypatch.setenv("LINECHECK_KERNEL", "numba")
     case = load_case(CASES / "paper" / f"{name}.toml")
     field = wm.downburst_field(case)
-    st = service._static_analysis(case)
+    st = service.static_result(case)
     x = np.unique(np.concatenate([wm.span_node_x(st.system).ravel(), st.system.node_x0]))
     t = service.record_time(case)
     got = kernel.field_velocity(field, x, t, float(wm.vertical_profile(field.height, field.delta)),

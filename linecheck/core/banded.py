@@ -94,12 +94,9 @@ class ColumnSolver:
 
 
 def solve(c: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """K^-1 B by the band factor c (shape (kd + 1, n)) for B of shape (n, m) or (n,), each
-    column solved as if alone (see the module docstring)."""
-    solver = ColumnSolver(c)
-    if B.ndim == 1:
-        return solver.columns(B[:, None])[:, 0]
-    return solver.columns(B)
+    """K^-1 B by the band factor c (shape (kd + 1, n)) for B of shape (n, m), each column solved
+    as if alone (see the module docstring)."""
+    return ColumnSolver(c).columns(B)
 
 
 # ---- the banded solves of the compiled kernel's piece ``newmark`` (linecheck.core.kernel):

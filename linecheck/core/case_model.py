@@ -139,6 +139,7 @@ class Analysis:
     burn_in: float | None = None  # [s]; None = derived (synoptic)
     drag: str = schema_default("analysis.drag")  # DRAG_MODELS (docs/method.md "Quadratic drag")
     tension: str = schema_default("analysis.tension")  # TENSION_MODELS (docs/method.md "Second-order tension")
+    drag_direction: str = schema_default("analysis.drag_direction")  # DRAG_DIRECTIONS (docs/method.md "Loads")
     peak_window: float | None = None  # [s]; None = the whole analysed record
     design_fractile: float = schema_default("analysis.design_fractile")  # [-] non-exceedance probability of the design peak
 

@@ -32,7 +32,15 @@ tangential force components are the residual, and the tangent is
 
 the span stiffness projected on the sphere's tangent plane plus the pendulum stiffness of the
 insulator (f the conductor force on the clamp, u the insulator's unit axis), block-tridiagonal
-along the line.  Derivation: docs/method.md, "Line sections".  Nothing here prints.
+along the line.  Derivation: docs/method.md, "Line sections".
+
+Uplift: a rigid insulator hangs in equilibrium only while the conductor pulls its clamp away
+from the fixed top (f . u > 0; hanging, f points downward).  A clamp whose insulator would be in
+compression (f . u <= 0: the adjacent spans pull it up, e.g. a valley tower) has no stable
+pendulum equilibrium; it is then held at its still-air point (as a strain clamp, i.e. as if held
+down) for that load case and reported (:attr:`SectionEquilibrium.held`).  A held clamp whose
+conductor force turns downward at convergence is released and the iteration resumes (at most
+:data:`MAX_RELEASES` times per load case).  docs/method.md, "Line sections".  Nothing here prints.
 """
 
 from __future__ import annotations
@@ -47,6 +55,10 @@ from .errors import Cancelled, ConvergenceError
 _GT, _GW = np.polynomial.legendre.leggauss(4)
 _GT = 0.5 * (_GT + 1.0)  # Gauss points on [0, 1]
 _GW = 0.5 * _GW
+
+#: Times a load case may release its held clamps (uplift) and iterate again before its uplift is
+#: called undecided (an insulator whose vertical force is about zero, alternating in sign).
+MAX_RELEASES = 3
 
 
 # --------------------------------------------------------------------------- clipping-in
@@ -223,11 +235,14 @@ class SectionEquilibrium:
 
     Attributes: p [m] clamp positions (n_s, n_towers, 3); spans: :class:`SpanSolution`
     (leading axes (n_s, n_spans)); force [N] conductor force on every clamp f_j (z up),
-    (n_s, n_towers, 3); iterations (n_s,); residual [N] (n_s,).
+    (n_s, n_towers, 3); iterations (n_s,); residual [N] (n_s,); held: bool (n_s, n_towers),
+    the suspension clamps held at their still-air point because their insulator would be in
+    compression (uplift; module docstring).
     """
 
-    def __init__(self, p, spans, force, iterations, residual) -> None:
+    def __init__(self, p, spans, force, iterations, residual, held) -> None:
         self.p, self.spans, self.force, self.iterations, self.residual = p, spans, force, iterations, residual
+        self.held = held
 
 
 def conductor_forces(sol: SpanSolution, n_towers: int) -> np.ndarray:
@@ -248,12 +263,14 @@ def _check_finite(f: np.ndarray, labels: list[str], it: int) -> None:
 
 
 def _tangent_system(sol: SpanSolution, f: np.ndarray, pos: np.ndarray, tops: np.ndarray, along: np.ndarray,
-                    idx: np.ndarray, vs: np.ndarray, adjacent: np.ndarray, labels: list[str]):
+                    idx: np.ndarray, vs: np.ndarray, adjacent: np.ndarray, held: np.ndarray):
     """Newton system of the suspension clamps on their insulator spheres (module docstring).
 
     Args: sol: spans at the current clamps; f [N] conductor forces (n_s, n_towers, 3); pos [m]
         clamps (n_s, n_towers, 3); tops [m] (n_towers, 3); along (n_towers, 3); idx: suspension
-        towers (k,); vs [m] their insulator lengths (k,); adjacent: bool (k-1,) consecutive towers.
+        towers (k,); vs [m] their insulator lengths (k,); adjacent: bool (k-1,) consecutive towers;
+        held: bool (n_s, k), clamps held at their still-air point (uplift): their rows are the
+        identity with a zero residual, decoupled from their neighbours (a fixed clamp).
     Returns: B tangent bases (n_s, k, 3, 2); r [N] tangential forces (n_s, k, 2); D [N/m]
         diagonal blocks (n_s, k, 2, 2) and E [N/m] off-diagonal blocks (n_s, k-1, 2, 2) of
         A = B^T (K_left + K_right) B + (f . u / v) I.
@@ -262,12 +279,9 @@ def _tangent_system(sol: SpanSolution, f: np.ndarray, pos: np.ndarray, tops: np.
     u = (pos[:, idx] - tops[idx]) / vs[:, None]
     B = _tangent_bases(u, along[idx])  # (n_s, k, 3, 2)
     fk = f[:, idx]
-    fu = (fk * u).sum(axis=-1)  # insulator tension
-    if np.any(fu <= 0.0):
-        j = int(np.flatnonzero(np.any(fu <= 0.0, axis=1))[0])
-        raise ConvergenceError(f"{labels[j]}: a suspension insulator is in compression (uplift at tower "
-                               f"{int(idx[np.argmin(fu[j])]) + 1}); no admissible equilibrium with rigid insulators")
+    fu = (fk * u).sum(axis=-1)  # insulator tension (positive at every clamp not held)
     r = np.einsum("skab,ska->skb", B, fk)  # tangential force components [N]
+    r[held] = 0.0
     Bt = np.swapaxes(B, -1, -2)
     Kl = np.zeros((n_s, k, 3, 3))
     has_left = idx > 0
@@ -276,10 +290,46 @@ def _tangent_system(sol: SpanSolution, f: np.ndarray, pos: np.ndarray, tops: np.
     has_right = idx < nt - 1
     Kr[:, has_right] = sol.K[:, idx[has_right]]
     D = Bt @ (Kl + Kr) @ B + (fu / vs)[..., None, None] * np.eye(2)
+    D[held] = np.eye(2)
     E = np.zeros((n_s, max(k - 1, 0), 2, 2))
     if k > 1:
         E[:, adjacent] = -(Bt[:, :-1] @ sol.K[:, idx[:-1]] @ B[:, 1:])[:, adjacent]
+        E[held[:, :-1] | held[:, 1:]] = 0.0
     return B, r, D, E
+
+
+def _hold_compressed(pos: np.ndarray, f: np.ndarray, clamps: np.ndarray, tops: np.ndarray, idx: np.ndarray,
+                     vs: np.ndarray, held: np.ndarray, active: np.ndarray) -> bool:
+    """Hold the active states' suspension clamps whose insulator is in compression (f . u <= 0,
+    uplift) at their still-air points (``pos`` and ``held`` updated in place); True if any."""
+    u = (pos[:, idx] - tops[idx]) / vs[:, None]
+    new = ((f[:, idx] * u).sum(axis=-1) <= 0.0) & ~held & active[:, None]
+    if not new.any():
+        return False
+    held |= new
+    s, i = np.nonzero(new)
+    pos[s, idx[i]] = clamps[idx[i]]
+    return True
+
+
+def _release_pulled_down(f: np.ndarray, idx: np.ndarray, held: np.ndarray, done: np.ndarray, releases: np.ndarray,
+                         labels: list[str]) -> None:
+    """Release the held clamps of converged states whose conductor force points downward
+    (f_z < 0: a hanging insulator would be in tension there) and reopen those states (``held``,
+    ``done`` and ``releases`` updated in place).  Raises :class:`ConvergenceError` when a state
+    needs more than :data:`MAX_RELEASES` releases (its uplift is undecided)."""
+    pulled = held & (f[:, idx, 2] < 0.0) & (done > 0)[:, None]
+    if not pulled.any():
+        return
+    states = np.flatnonzero(pulled.any(axis=1))
+    releases[states] += 1
+    if np.any(releases[states] > MAX_RELEASES):
+        j = int(states[np.argmax(releases[states])])
+        t = int(idx[np.flatnonzero(held[j])[0]]) + 1
+        raise ConvergenceError(f"{labels[j]}: the suspension insulator at tower {t} alternates between tension "
+                               "and compression (its vertical force is about zero): uplift undecided")
+    held &= ~pulled
+    done[states] = 0
 
 
 def _move_clamps(pos: np.ndarray, tops: np.ndarray, idx: np.ndarray, vs: np.ndarray, B: np.ndarray,
@@ -300,23 +350,26 @@ def _move_clamps(pos: np.ndarray, tops: np.ndarray, idx: np.ndarray, vs: np.ndar
 
 
 def _tangential_residual(f: np.ndarray, pos: np.ndarray, tops: np.ndarray, idx: np.ndarray,
-                         vs: np.ndarray) -> np.ndarray:
-    """Largest force [N] on a suspension clamp normal to its insulator, per state (n_s,)."""
+                         vs: np.ndarray, held: np.ndarray) -> np.ndarray:
+    """Largest force [N] on a suspension clamp normal to its insulator, per state (n_s,); a held
+    clamp (uplift) is fixed and carries any force."""
     if not idx.size:
         return np.zeros(pos.shape[0])
     u = (pos[:, idx] - tops[idx]) / vs[:, None]
     fk = f[:, idx]
-    return np.max(np.linalg.norm(fk - (fk * u).sum(axis=-1, keepdims=True) * u, axis=-1), axis=1)
+    normal = np.linalg.norm(fk - (fk * u).sum(axis=-1, keepdims=True) * u, axis=-1)
+    return np.max(np.where(held, 0.0, normal), axis=1)
 
 
 def equilibrium(clamps: np.ndarray, tops: np.ndarray, v: np.ndarray, suspension: np.ndarray, along: np.ndarray,
                 p: np.ndarray, Lu: np.ndarray, EA: float, p_start: np.ndarray, N0_start: np.ndarray, *,
                 labels: list[str], tol: float, max_iter: int, progress: Callable[[int, int], None] | None = None,
                 cancel: threading.Event | None = None) -> SectionEquilibrium:
-    """Step-1 equilibrium of a section under ``n_s`` load cases (Newton over the suspension clamps).
+    """Step-1 equilibrium of a section under ``n_s`` load cases (Newton over the suspension clamps;
+    a clamp whose insulator would be in compression is held at its still-air point, module docstring).
 
     Args:
-        clamps: [m] still-air clamp points (n_towers, 3) (strain clamps stay there).
+        clamps: [m] still-air clamp points (n_towers, 3) (strain clamps and held clamps stay there).
         tops: [m] insulator fixed tops (n_towers, 3) (used at suspension towers).
         v: [m] insulator lengths (n_towers,); suspension: bool (n_towers,).
         along: [-] horizontal along-line unit vector at every tower (n_towers, 3) (basis reference).
@@ -337,6 +390,8 @@ def equilibrium(clamps: np.ndarray, tops: np.ndarray, v: np.ndarray, suspension:
     what = labels[0] if n_s == 1 else "mean states"
     done_at = np.zeros(n_s, dtype=int)
     last = np.full(n_s, np.inf)
+    held = np.zeros((n_s, k), dtype=bool)
+    releases = np.zeros(n_s, dtype=int)
     for it in range(1, max_iter + 1):
         if cancel is not None and cancel.is_set():
             raise Cancelled("step 1 cancelled")
@@ -348,11 +403,14 @@ def equilibrium(clamps: np.ndarray, tops: np.ndarray, v: np.ndarray, suspension:
             done_at[:] = it
             last[:] = 0.0
             break
-        B, r, D, E = _tangent_system(sol, f, pos, tops, along, idx, vs, adjacent, labels)
         active = done_at == 0
+        if _hold_compressed(pos, f, clamps, tops, idx, vs, held, active):
+            continue  # held clamps moved back to their still-air points: solve the spans there first
+        B, r, D, E = _tangent_system(sol, f, pos, tops, along, idx, vs, adjacent, held)
         change = _move_clamps(pos, tops, idx, vs, B, _block_tridiag_solve(D, E, r), active)
         last = np.where(active, change, last)
         done_at[active & (change <= tol_d)] = it
+        _release_pulled_down(f, idx, held, done_at, releases, labels)
         if progress is not None:
             progress(int((done_at > 0).sum()), n_s)
         if np.all(done_at > 0):
@@ -363,4 +421,6 @@ def equilibrium(clamps: np.ndarray, tops: np.ndarray, v: np.ndarray, suspension:
                                f"(last clamp motion {last[j]:.3g} m)")
     sol = solve_spans(np.diff(pos, axis=1), p, Lu, EA, N0, what=what)
     f = conductor_forces(sol, nt)
-    return SectionEquilibrium(pos, sol, f, done_at, _tangential_residual(f, pos, tops, idx, vs))
+    held_towers = np.zeros((n_s, nt), dtype=bool)
+    held_towers[:, idx] = held
+    return SectionEquilibrium(pos, sol, f, done_at, _tangential_residual(f, pos, tops, idx, vs, held), held_towers)

@@ -58,6 +58,9 @@ class StaticState:
         element_tension: [N] axial tension of every cable element, shape (n_spans * ne,).
         iterations: outer (Fig. 6) iterations used.
         residual: [N] largest out-of-balance force at an attachment point.
+        held: bool per tower, shape (n_towers,): the suspension clamps held at their still-air
+            point because their insulator would be in compression (uplift; section form,
+            :func:`linecheck.core.catenary.equilibrium`); None when no clamp is held.
     """
 
     displacement: np.ndarray
@@ -68,6 +71,7 @@ class StaticState:
     element_tension: np.ndarray
     iterations: int
     residual: float
+    held: np.ndarray | None = None
 
 
 def span_loads_uniform(system: LineSystem, intensity: np.ndarray | float) -> np.ndarray:
@@ -470,6 +474,7 @@ def _section_states(system: LineSystem, gy: np.ndarray, labels: list[str], *, to
             element_tension=T_el,
             iterations=int(eq.iterations[j]),
             residual=float(eq.residual[j]),
+            held=eq.held[j] if eq.held[j].any() else None,
         ))
     return out
 
@@ -550,6 +555,8 @@ class MeanStates:
         nodes: [m] (n_t, n_nodes, 3); element_tension: [N] (n_t, n_elements);
         gy: [N/m] the mean transverse loads used, (n_t, n_spans, ne+1).
         still_air: the zero-wind reference state.
+        held: bool (n_t, n_towers): the suspension clamps held at their still-air point in each
+            state because their insulator would be in compression (uplift, :class:`StaticState`).
     """
 
     time: np.ndarray
@@ -561,12 +568,13 @@ class MeanStates:
     element_tension: np.ndarray
     gy: np.ndarray
     still_air: StaticState
+    held: np.ndarray
 
     def state(self, k: int) -> StaticState:
         """The k-th instant as a :class:`StaticState`."""
         return StaticState(
             self.displacement[k], self.reactions[k], self.tension[k], self.insulator_force[k],
-            self.nodes[k], self.element_tension[k], 0, 0.0,
+            self.nodes[k], self.element_tension[k], 0, 0.0, self.held[k] if self.held[k].any() else None,
         )
 
     @property
@@ -620,6 +628,7 @@ def solve_mean_states(
         element_tension=np.stack([s.element_tension for s in states]),
         gy=np.asarray(gy, dtype=float),
         still_air=still,
+        held=np.stack([np.zeros(system.n_towers, dtype=bool) if s.held is None else s.held for s in states]),
     )
 
 

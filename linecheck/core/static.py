@@ -189,6 +189,7 @@ def solve_static(
     tol: float = 1e-8,
     max_iter: int = 500,
     label: str = "mean state",
+    drag: np.ndarray | None = None,
 ) -> StaticState:
     """Non-linear static equilibrium under weight and the transverse mean-wind load.
 
@@ -202,6 +203,9 @@ def solve_static(
         tol: [m] convergence tolerance on the attachment displacements, relative to v.
         max_iter: limit on outer (Fig. 6) iterations.
         label: names the state in error messages (e.g. "mean state 37 (t = 120.0 s)").
+        drag: [N/m] the cross-flow form's drag vectors on a section with inclined spans
+            (:func:`~linecheck.core.loads.mean_drag_vectors`), (n_spans, ne+1, 3), in place of
+            gy along the span normals (gy still sets the solver's start).
 
     Raises:
         ConvergenceError: no convergence, non-finite values or an inadmissible strain.
@@ -214,7 +218,8 @@ def solve_static(
     if not np.all(np.isfinite(gy)):
         raise ConvergenceError(f"{label}: non-finite mean-wind load")
     if system.is_section:
-        return _section_states(system, gy[None], [label], tol=tol, max_iter=max_iter, initial=initial)[0]
+        return _section_states(system, gy[None], [label], tol=tol, max_iter=max_iter, initial=initial,
+                               drag=None if drag is None else drag[None])[0]
     if initial is not None:
         d = initial.displacement.copy()
         H = initial.tension.copy()
@@ -419,16 +424,18 @@ def _final_states(system: LineSystem, Lu: np.ndarray, my_hat: np.ndarray, mz_hat
             for j in range(n_s)]
 
 
-def section_loads(system: LineSystem, gy: np.ndarray) -> np.ndarray:
+def section_loads(system: LineSystem, gy: np.ndarray, drag: np.ndarray | None = None) -> np.ndarray:
     """Load vectors per unit unstretched length [N/m] of a section: weight W downward plus the
-    transverse intensity gy along each span's horizontal normal, shape gy.shape + (3,)."""
-    p = gy[..., None] * system.span_normals[:, None, :]
+    transverse intensity gy along each span's horizontal normal, shape gy.shape + (3,), or plus
+    the drag vectors ``drag`` (same shape; the cross-flow form)."""
+    p = gy[..., None] * system.span_normals[:, None, :] if drag is None else np.array(drag, dtype=float)
     p[..., 2] -= system.line.weight
     return p
 
 
 def _section_states(system: LineSystem, gy: np.ndarray, labels: list[str], *, tol: float, max_iter: int,
-                    initial: StaticState | None = None, progress=None, cancel=None) -> list[StaticState]:
+                    initial: StaticState | None = None, progress=None, cancel=None,
+                    drag: np.ndarray | None = None) -> list[StaticState]:
     """Step 1 of the section form: exact elastic spans, Newton over the suspension
     clamps (:mod:`linecheck.core.catenary`); the same StaticState as the paper's solver."""
     from .catenary import equilibrium, start_tension
@@ -437,7 +444,7 @@ def _section_states(system: LineSystem, gy: np.ndarray, labels: list[str], *, to
     line = system.line
     Lu = system.unstretched_lengths
     clamps = system.clamp_points
-    p = section_loads(system, gy)
+    p = section_loads(system, gy, drag)
     if initial is not None:
         pos = np.broadcast_to(clamps + initial.displacement, (n_s,) + clamps.shape).copy()
         H = np.broadcast_to(initial.tension, (n_s, system.n_spans))
@@ -513,6 +520,7 @@ def solve_static_batch(
     max_iter: int = 500,
     progress: Callable[[int, int], None] | None = None,
     cancel: threading.Event | None = None,
+    drag: np.ndarray | None = None,
 ) -> list[StaticState]:
     """:func:`solve_static` for many load cases at once (the downburst's mean states).
 
@@ -525,6 +533,7 @@ def solve_static_batch(
         gy: [N/m] transverse loads, shape (n_states, n_spans, ne+1).
         labels: names of the states for error messages, length n_states.
         progress: ``progress(converged, n_states)`` once per outer iteration.
+        drag: [N/m] the cross-flow form's drag vectors, (n_states, n_spans, ne+1, 3) (:func:`solve_static`).
     """
     nt = system.n_towers
     gy = np.asarray(gy, dtype=float)
@@ -535,7 +544,8 @@ def solve_static_batch(
     if bad.size:
         raise ConvergenceError(f"{labels[bad[0]]}: non-finite mean-wind load")
     if system.is_section:
-        return _section_states(system, gy, labels, tol=tol, max_iter=max_iter, progress=progress, cancel=cancel)
+        return _section_states(system, gy, labels, tol=tol, max_iter=max_iter, progress=progress, cancel=cancel,
+                               drag=drag)
     still = still_air_state(system)
     d = np.broadcast_to(still.displacement, (n_s, nt, 3))
     H = np.broadcast_to(still.tension, (n_s, system.n_spans))
@@ -598,6 +608,7 @@ def solve_mean_states(
     *,
     progress: Callable[[int, int], None] | None = None,
     cancel: threading.Event | None = None,
+    drag: np.ndarray | None = None,
 ) -> MeanStates:
     """Step 1 at every instant of ``time`` (several instants: :func:`solve_static_batch`).
 
@@ -606,16 +617,17 @@ def solve_mean_states(
         gy: [N/m] mean transverse loads, shape (n_t, n_spans, ne+1).
         progress: called as ``progress(done, total)``.
         cancel: set it to stop; raises :class:`Cancelled`.
+        drag: [N/m] the cross-flow form's drag vectors, (n_t, n_spans, ne+1, 3) (:func:`solve_static`).
     """
     still = still_air_state(system)
     n_t = len(time)
     labels = [f"mean state {k + 1} of {n_t} (t = {time[k]:.1f} s)" for k in range(n_t)]
     if n_t > 1:  # all states at once (same iteration, vectorised over the states)
-        states = solve_static_batch(system, gy, labels=labels, progress=progress, cancel=cancel)
+        states = solve_static_batch(system, gy, labels=labels, progress=progress, cancel=cancel, drag=drag)
     else:
         if cancel is not None and cancel.is_set():
             raise Cancelled("step 1 cancelled")
-        states = [solve_static(system, gy[0], initial=still, label=labels[0])]
+        states = [solve_static(system, gy[0], initial=still, label=labels[0], drag=None if drag is None else drag[0])]
         if progress is not None:
             progress(1, 1)
     return MeanStates(

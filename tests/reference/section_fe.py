@@ -23,11 +23,23 @@ Model (global frame: x along the first span, y to its left, z up; SI units)
   EA_ins = ``insulator_stiffness`` * EA, unstretched length v_j) from the fixed T_j to the
   conductor node; it carries no moment, so it swings freely (a rigid pendulum up to a stretch of
   ~1e-5 m, reported as ``insulator_length_error``).
-* Loads per unit UNSTRETCHED length: weight W (-z); drag 1/2 rho C_d D |V_n| V_n n_i with
-  n_i = (-sin h_i, cos h_i, 0), V_n = V(z) (sin d, cos d, 0) . n_i, V(z) = v_ref (z_agl/z_ref)^alpha,
-  z_agl = the node's still-air height above the ground interpolated linearly in station.  Nodal
-  loads: consistent lumping of the linearly interpolated nodal intensities (l0 (2q_a + q_b)/6,
-  l0 (q_a + 2 q_b)/6), exact for weight.
+* Loads per unit UNSTRETCHED length: weight W (-z); the mean wind at a node is the horizontal
+  vector V = V(z) (sin d, cos d, 0), V(z) = v_ref (z_agl/z_ref)^alpha, z_agl = the node's
+  still-air height above the ground interpolated linearly in station.  Drag (``drag_direction``):
+
+  - ``"horizontal-normal"`` (default): 1/2 rho C_d D |V_n| V_n n_i with n_i = (-sin h_i, cos h_i, 0)
+    the span's horizontal normal and V_n = V . n_i; a fixed (dead) load.
+  - ``"cross-flow"``: the cross-flow (independence) principle, Hoerner 1965, "Fluid-Dynamic Drag",
+    ch. 3: the drag on a yawed cylinder is that of the velocity component normal to its axis.
+    On every element with CURRENT (deformed) unit axis e: V_perp = V - (V . e) e and the drag is
+    1/2 rho C_d D |V_perp| V_perp, a follower load.  Its load stiffness -df/dx (derived in
+    :meth:`_Model.crossflow`) is part of the (then non-symmetric) Newton tangent.
+
+  On a level span in wind normal to the line the two coincide on the still-air geometry
+  (V . e = 0); after the blow-out the elements near the clamps have e_y != 0 and the cross-flow
+  drag is slightly smaller and gets a small upward part (second order in the sag slope).
+  Nodal loads: consistent lumping of the linearly interpolated nodal intensities
+  (l0 (2q_a + q_b)/6, l0 (q_a + 2 q_b)/6), exact for weight.
 * Solution: full Newton-Raphson with step limiting (largest nodal move <= ``dmax``) on the weight
   from the clipped-in catenary (the still-air state), then the wind in adaptive load increments.
   Sparse direct solves.
@@ -273,6 +285,9 @@ class _Model:
         self._keep = (gmap[rows] >= 0) & (gmap[cols] >= 0)
         self._r = gmap[rows][self._keep]
         self._c = gmap[cols][self._keep]
+        kc = self._keep[: ns * n]  # the conductor elements' entries (cross-flow load stiffness)
+        self._rows_cond = gmap[rows[: ns * n]][kc]
+        self._cols_cond = gmap[cols[: ns * n]][kc]
         self.nf = self.free_idx.size
 
         # weight: W l0 / 2 to each end of every conductor element (exact for a uniform load)
@@ -308,8 +323,15 @@ class _Model:
 
     # ---------------------------------------------------------------- wind
     def set_wind(self, X_still: np.ndarray) -> None:
-        """Drag per unit unstretched length from the still-air positions (section model)."""
+        """Wind vectors at the element ends and the horizontal-normal drag (section model).
+
+        Sets ``Va``, ``Vb`` [m/s] (n_cond, 3): the horizontal mean wind V(z) (sin d, cos d, 0) at
+        each conductor element's ends from their still-air heights, and ``fq`` [N] (3 nn,): the
+        nodal horizontal-normal drag 1/2 rho C_d D |V_n| V_n n_i (consistent lumping)."""
         sec, geo = self.sec, self.geo
+        ne = self.n_cond
+        self.Va = np.zeros((ne, 3))
+        self.Vb = np.zeros((ne, 3))
         if sec.v_ref == 0.0:
             self.fq = np.zeros(3 * self.nn)
             return
@@ -319,12 +341,11 @@ class _Model:
         station = np.array([t.station for t in sec.towers])
         ground = np.array([t.ground for t in sec.towers])
         fq = np.zeros((self.nn, 3))
-        ne = self.n_cond
+        i = self.span_of_el
+        h = geo.heading[i]
+        t = np.column_stack([np.cos(h), np.sin(h)])
+        nrm = np.column_stack([-np.sin(h), np.cos(h), np.zeros_like(h)])
         for end, nodes in (("a", self.a[:ne]), ("b", self.b[:ne])):
-            i = self.span_of_el
-            h = geo.heading[i]
-            t = np.column_stack([np.cos(h), np.sin(h)])
-            nrm = np.column_stack([-np.sin(h), np.cos(h), np.zeros_like(h)])
             P = X_still[nodes]
             st = station[i] + np.clip(np.einsum("ij,ij->i", P[:, :2] - geo.plan[i], t), 0.0, geo.length[i])
             zg = np.interp(st, station, ground)
@@ -335,20 +356,65 @@ class _Model:
             Vn = V * (nrm @ vdir)
             q = (0.5 * sec.rho * sec.Cd * sec.D * np.abs(Vn) * Vn)[:, None] * nrm  # [N/m] along n_i
             if end == "a":
-                qa = q
+                qa, self.Va = q, V[:, None] * vdir
             else:
-                qb = q
+                qb, self.Vb = q, V[:, None] * vdir
         l0 = self.l0[:ne, None]
         np.add.at(fq, self.a[:ne], l0 * (2.0 * qa + qb) / 6.0)
         np.add.at(fq, self.b[:ne], l0 * (qa + 2.0 * qb) / 6.0)
         self.fq = fq.reshape(-1)
 
+    def crossflow(self, U: np.ndarray, stiffness: bool = True):
+        """Cross-flow drag at displacements U: nodal loads [N] (3 nn,) and, if ``stiffness``, the
+        load stiffness K_L = -df/dx [N/m] on the free dofs (sparse, non-symmetric), else None.
 
-def _newton(m: _Model, U: np.ndarray, fext: np.ndarray, tol: float, max_iter: int, dmax: float):
-    """Full Newton-Raphson with step limiting; returns (U, iterations, residual [N])."""
+        Per element (ends a, b; current length l, unit axis e; c = 1/2 rho C_d D [kg/m2]):
+        u_k = V_k - (V_k . e) e, q_k = c |u_k| u_k [N/m] (Hoerner 1965 ch. 3), nodal loads
+        f_a = l0 (2 q_a + q_b)/6, f_b = l0 (q_a + 2 q_b)/6.  Derivatives: d(|u|u)/du = |u| I +
+        u u^T/|u| (0 at u = 0); du_k/de = -(e V_k^T + (V_k . e) I); de/dx_b = -de/dx_a = (I - e e^T)/l
+        (Crisfield 1991 Vol. 1 ch. 3).  With G_k = dq_k/dx_b, A = l0 (2 G_a + G_b)/6,
+        B = l0 (G_a + 2 G_b)/6: df/dx = [[-A, A], [-B, B]] on (a, b), so K_L = [[A, -A], [B, -B]]."""
+        sec, ne = self.sec, self.n_cond
+        c = 0.5 * sec.rho * sec.Cd * sec.D
+        _, e, ell = self.state(U)
+        e, ell = e[:ne], ell[:ne]
+        l0 = self.l0[:ne, None]
+        q, G = [], []
+        P = np.eye(3) - e[:, :, None] * e[:, None, :]
+        for V in (self.Va, self.Vb):
+            Ve = np.einsum("ij,ij->i", V, e)
+            u = V - Ve[:, None] * e
+            un = np.sqrt(np.einsum("ij,ij->i", u, u))
+            q.append(c * un[:, None] * u)
+            if stiffness:
+                inv = np.divide(1.0, un, out=np.zeros_like(un), where=un > 0.0)
+                dq_du = c * (un[:, None, None] * np.eye(3) + (u * inv[:, None])[:, :, None] * u[:, None, :])
+                du_de = -(e[:, :, None] * V[:, None, :] + Ve[:, None, None] * np.eye(3))
+                G.append(np.einsum("nij,njk,nkl->nil", dq_du, du_de, P) / ell[:, None, None])
+        qa, qb = q
+        f = np.zeros((self.nn, 3))
+        np.add.at(f, self.a[:ne], l0 * (2.0 * qa + qb) / 6.0)
+        np.add.at(f, self.b[:ne], l0 * (qa + 2.0 * qb) / 6.0)
+        if not stiffness:
+            return f.reshape(-1), None
+        A = l0[:, :, None] * (2.0 * G[0] + G[1]) / 6.0
+        B = l0[:, :, None] * (G[0] + 2.0 * G[1]) / 6.0
+        Ke = np.block([[A, -A], [B, -B]])
+        K = sp.coo_matrix((Ke[self._keep[:ne]], (self._rows_cond, self._cols_cond)), shape=(self.nf, self.nf))
+        return f.reshape(-1), K.tocsc()
+
+
+def _newton(m: _Model, U: np.ndarray, fext, tol: float, max_iter: int, dmax: float):
+    """Full Newton-Raphson with step limiting; returns (U, iterations, residual [N]).
+
+    ``fext``: the external nodal loads [N] (3 nn,), or for a follower load a callable
+    ``fext(U) -> (loads, K_L)`` with K_L = -d loads/dU on the free dofs (sparse) added to the
+    tangent, or None (then the iteration uses the structural tangent alone and converges
+    linearly to the same residual tolerance)."""
     res = np.inf
     for it in range(max_iter + 1):
-        r = (fext - m.internal(U))[m.free_idx]
+        f, KL = fext(U) if callable(fext) else (fext, None)
+        r = (f - m.internal(U))[m.free_idx]
         res = float(np.max(np.abs(r)))
         if not np.isfinite(res):
             raise FEConvergenceError("non-finite residual")
@@ -356,7 +422,8 @@ def _newton(m: _Model, U: np.ndarray, fext: np.ndarray, tol: float, max_iter: in
             return U, it, res
         if it == max_iter:
             break
-        du = spsolve(m.tangent(U), r)
+        K = m.tangent(U) if KL is None else m.tangent(U) + KL
+        du = spsolve(K, r)
         big = float(np.max(np.abs(du)))
         if not np.isfinite(big):
             raise FEConvergenceError("singular tangent")
@@ -397,7 +464,8 @@ class State:
 
 @dataclass(frozen=True)
 class Solution:
-    """Still-air and wind states of a section (``wind`` is None when v_ref = 0)."""
+    """Still-air and wind states of a section (``wind`` is None when v_ref = 0); unstretched_length
+    [m] per span; drag_direction: the drag model of the wind state (see :func:`solve`)."""
 
     section: Section
     geometry: Geometry
@@ -405,6 +473,7 @@ class Solution:
     still: State
     wind: State | None
     unstretched_length: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    drag_direction: str = "horizontal-normal"
 
 
 def _state(m: _Model, U: np.ndarray, fext: np.ndarray, res: float, its: int, steps: int) -> State:
@@ -436,8 +505,12 @@ def _still(m: _Model, tol: float, max_iter: int, dmax: float):
     return _newton(m, np.zeros_like(m.X0), m.fw, tol, max_iter, dmax)
 
 
+DRAG_DIRECTIONS = ("horizontal-normal", "cross-flow")
+
+
 def solve(source: Section | str | Path, *, n_el: int = 100, insulator_stiffness: float = 1e3,
-          tol: float = 1e-5, max_iter: int = 50, wind: bool = True, wind_steps: int = 4) -> Solution:
+          tol: float = 1e-5, max_iter: int = 50, wind: bool = True, wind_steps: int = 4,
+          drag_direction: str = "horizontal-normal", load_stiffness: bool = True) -> Solution:
     """Still-air equilibrium and (if v_ref > 0 and ``wind``) the mean-wind equilibrium.
 
     Args:
@@ -447,7 +520,15 @@ def solve(source: Section | str | Path, *, n_el: int = 100, insulator_stiffness:
         tol: [N] force residual at every free dof (the insulator penalty's round-off floor,
             EA_ins/v times the spacing of doubles near |dX| ~ 4 m, is ~1e-6 N).
         wind_steps: initial number of wind increments (halved on failure, doubled after easy steps).
+        drag_direction: ``"horizontal-normal"`` (the drag along each span's horizontal normal, a
+            dead load) or ``"cross-flow"`` (the wind component normal to each element's current
+            axis, a follower load); see the module docstring.  Any value is accepted in still air.
+        load_stiffness: cross-flow only: include the load stiffness -df/dx in the Newton tangent
+            (quadratic convergence; default) or iterate with the structural tangent alone (the
+            same equilibrium to ``tol``, more iterations).
     """
+    if drag_direction not in DRAG_DIRECTIONS:
+        raise ValueError(f"drag_direction {drag_direction!r}: expected one of {DRAG_DIRECTIONS}")
     sec, geo, m = _build(source, n_el, insulator_stiffness)
     dmax = 0.1 * float(np.min(geo.length))
     U, its, res = _still(m, tol, max_iter, dmax)
@@ -455,10 +536,23 @@ def solve(source: Section | str | Path, *, n_el: int = 100, insulator_stiffness:
     wstate = None
     if wind and sec.v_ref > 0.0:
         m.set_wind(m.X0 + U)
-        U, res, total, steps = load_stepping(lambda U0, f: _newton(m, U0, f, tol, max_iter, dmax), U, m.fw, m.fq,
-                                             wind_steps, 6, FEConvergenceError)
-        wstate = _state(m, U, m.fw + m.fq, res, total, steps)
-    return Solution(sec, geo, n_el, still, wstate, np.array([c.Lu for c in geo.catenary]))
+        if drag_direction == "horizontal-normal":
+            U, res, total, steps = load_stepping(lambda U0, f: _newton(m, U0, f, tol, max_iter, dmax), U, m.fw,
+                                                 m.fq, wind_steps, 6, FEConvergenceError)
+            fext = m.fw + m.fq
+        else:
+            def load(lam: float):  # the load at wind factor lam (0..1): weight + lam * cross-flow drag
+                def f(U1: np.ndarray):
+                    fq, KL = m.crossflow(U1, load_stiffness)
+                    return m.fw + lam * fq, (None if KL is None else lam * KL)
+                return f
+
+            # load_stepping hands the increment f0 + lam df to its solver: with f0 = 0, df = 1 that is lam
+            U, res, total, steps = load_stepping(lambda U0, lam: _newton(m, U0, load(lam), tol, max_iter, dmax), U,
+                                                 0.0, 1.0, wind_steps, 6, FEConvergenceError)
+            fext = m.fw + m.crossflow(U, False)[0]
+        wstate = _state(m, U, fext, res, total, steps)
+    return Solution(sec, geo, n_el, still, wstate, np.array([c.Lu for c in geo.catenary]), drag_direction)
 
 
 # ============================================================================ vibrations

@@ -43,6 +43,7 @@ CORE_MODULES = [
     "linecheck.core.wind.downburst_case",
     "linecheck.core.wind.field_table",
     "linecheck.core.wind.turbulence",
+    "linecheck.core.wind.wires",
     "linecheck.core.wind.point",
     "linecheck.core.wind.ring",
     "linecheck.core.wind.profiles",

@@ -1,0 +1,388 @@
+"""One turbulence field for every wire of a line (phases, bundles, ground wires).
+
+The single-wire synthesis (:mod:`.turbulence`) gives the unit field u(x, t) of one wire's nodes
+with the Davenport coherence along the line.  Here n_w wires share one field: their nodes sit at
+the same stations x (the same towers, the same mesh) and each wire w is offset across the line by
+(y_w, z_w) [m] (y horizontal, square to the line; z up; e.g. its attachment point in the tower
+frame -- only differences matter).  The coherence of node j of wire a and node m of wire b is
+
+    gamma(f) = exp(-f (C_x |x_j - x_m| + C_y |y_a - y_b| + C_z |z_a - z_b|) / V)
+
+the product of the along-line Davenport coherence (Davenport 1961; C_x = ``coherence_decay``) and
+exponential coherences across the line and in height with their own decay constants (Davenport
+1961; Simiu & Scanlan 1996, sec. 2.3: C_y = 16, C_z = 10 as defaults, docs/wind.md "Many wires").
+V = V_ref, one speed for the whole field as in the single-wire synthesis.  With ``combine="root"``
+the wires' term is Simiu & Scanlan's sqrt(C_y^2 dy^2 + C_z^2 dz^2) instead of C_y |dy| + C_z |dz|
+(equal for a separation along one axis; higher coherence for a diagonal one).  The across-line
+separation y is along the mean wind when the wind blows square to the line; the model applies
+the same real (zero-phase) exponential coherence to it (docs/wind.md "Many wires").
+
+Factorisation.  Ordered wire-major, the coherence matrix of all n_w N points at frequency f is the
+Kronecker product Gamma_w(f) (x) Gamma_x(f) of the wires' n_w x n_w matrix and the nodes' N x N
+matrix, so L = L_w (x) L_x is a factor (L L^T = Gamma) and L xi = (L_w (x) I)(I (x) L_x) xi: each
+wire's phasors go through the O(N) Markov recursion along x (the single-wire spectrum, unchanged),
+then every node's n_w values are mixed by the small lower factor L_w(f).  Cost per frequency
+O(n_w N) for the recursions and O(n_w^2 N) for the mixing; the n_w N x n_w N matrix is never formed.
+
+Wire 0 is the single-wire field bit for bit: L_w is lower triangular with L_w[0] = (1, 0, ..., 0),
+so wire 0's spectrum is not touched, and its phases are those of ``turbulence.unit_phases``.  Wire
+w >= 1 draws its phases from child w of the realization's seed sequence
+(``SeedSequence(seed, spawn_key=(r, w))``), independent of wire 0's stream.  Wire a's field depends
+only on wires 0 .. a (their offsets and phases): appending a wire changes none of the others.
+Wires at the same point (equal offsets) get the same field exactly (the first one's); nearly or
+fully coherent wires (Gamma_w semidefinite) are factored by a Cholesky that gives zero columns
+for zero pivots (:func:`semidefinite_cholesky`).
+
+Layout: wire-major, a unit field of shape (n_w, n_steps, n_nodes) (``field[w]`` is the array the
+single-wire code gives for that wire); velocities (n_w, n_real, n_steps, n_nodes).
+Nothing here prints.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import fft as sfft
+
+from .. import kernel
+from ..case import Case
+from ..errors import Cancelled, CaseError
+from ..system import LineSystem
+from . import turbulence as tb
+
+__all__ = [
+    "COMBINATIONS",
+    "DECAY_Y",
+    "DECAY_Z",
+    "PIVOT_TOL",
+    "CrossCoherence",
+    "fluctuating_velocity_wires",
+    "semidefinite_cholesky",
+    "synthesize_wires",
+    "unit_field_wires",
+    "wire_coherence",
+    "wire_factor",
+    "wire_phases",
+    "wire_rng",
+]
+
+#: [-] decay constant of the coherence for horizontal separation across the line, C_y
+#: (Simiu & Scanlan 1996, sec. 2.3, after Vellozzi & Cohen 1968; docs/wind.md "Many wires")
+DECAY_Y = 16.0
+#: [-] decay constant of the coherence for vertical separation, C_z (same source)
+DECAY_Z = 10.0
+#: how the across and vertical separations combine: "sum" exp(-f (C_y |dy| + C_z |dz|) / V) (a
+#: product of one exponential per direction) or "root" exp(-f sqrt(C_y^2 dy^2 + C_z^2 dz^2) / V)
+#: (Simiu & Scanlan 1996, sec. 2.3, their form); equal for a separation along one axis only
+COMBINATIONS = ("sum", "root")
+#: [-] a Cholesky pivot (a conditional variance, the diagonal being 1) at or below this is zero:
+#: the wire is then fully explained by the wires before it at that frequency
+PIVOT_TOL = 1e-12
+
+
+# ------------------------------------------------------------------------- the wires' factor
+def _offsets(offsets: np.ndarray) -> np.ndarray:
+    off = np.asarray(offsets, dtype=float)
+    if off.ndim != 2 or off.shape[1] != 2 or off.shape[0] < 1:
+        raise ValueError(f"wire offsets of shape {off.shape}: expected (n_wires, 2) = (y, z) [m]")
+    if not np.all(np.isfinite(off)):
+        raise ValueError("wire offsets must be finite")
+    return off
+
+
+@dataclass(frozen=True)
+class CrossCoherence:
+    """The coherence of the wires across the line and in height (docs/wind.md "Many wires").
+
+    decay_y, decay_z: [-] C_y, C_z >= 0 (0: fully coherent in that direction); combine: one of
+    :data:`COMBINATIONS`."""
+
+    decay_y: float = DECAY_Y
+    decay_z: float = DECAY_Z
+    combine: str = "sum"
+
+    def __post_init__(self):
+        if not (self.decay_y >= 0 and self.decay_z >= 0 and math.isfinite(self.decay_y + self.decay_z)):
+            raise ValueError(f"coherence decay constants must be finite and >= 0: got C_y={self.decay_y}, "
+                             f"C_z={self.decay_z}")
+        if self.combine not in COMBINATIONS:
+            raise ValueError(f"combine {self.combine!r}: expected one of {COMBINATIONS}")
+
+
+def wire_coherence(freq: np.ndarray, offsets: np.ndarray, v_mean: float,
+                   cross: CrossCoherence | None = None) -> np.ndarray:
+    """Coherence of the wires' points [-] at f [Hz] (n_freq,): shape (n_w, n_w, n_freq).
+
+    offsets [m] (n_w, 2) = (y, z); V [m/s]; ``cross`` the constants (default :class:`CrossCoherence`).
+    "sum": Gamma_ab = exp(-f (C_y |y_a - y_b| + C_z |z_a - z_b|) / V), the product of two exponential
+    coherences with one constant per direction (Davenport 1961); "root": exp(-f sqrt(C_y^2 dy^2 +
+    C_z^2 dz^2) / V) (Simiu & Scanlan 1996, sec. 2.3).  Both are positive semidefinite (a product of
+    two exponential kernels, Schur product theorem; an exponential kernel of a scaled distance).
+    """
+    cross = CrossCoherence() if cross is None else cross
+    off = _offsets(offsets)
+    dy = np.abs(off[:, None, 0] - off[None, :, 0])
+    dz = np.abs(off[:, None, 1] - off[None, :, 1])
+    if cross.combine == "sum":
+        reach = cross.decay_y * dy + cross.decay_z * dz  # [m] C_y |dy| + C_z |dz| (Davenport 1961)
+    else:
+        reach = np.hypot(cross.decay_y * dy, cross.decay_z * dz)  # [m] Simiu & Scanlan (1996), sec. 2.3
+    # exponential coherence exp(-f reach / V) (Davenport 1961)
+    return np.exp(-reach[:, :, None] * np.asarray(freq, dtype=float)[None, None, :] / v_mean)
+
+
+def semidefinite_cholesky(c: np.ndarray, tol: float = PIVOT_TOL) -> np.ndarray:
+    """Lower factor L with L L^T = c of symmetric positive semidefinite matrices, one per frequency.
+
+    c shape (n, n, n_freq) (matrix first, frequency last) -> L same shape, lower triangular in the
+    first two axes.  Column-by-column Cholesky (Golub & Van Loan 2013, Alg. 4.2.1) in which a pivot
+    d_j = c_jj - sum_(k<j) L_jk^2 <= ``tol`` gives a zero column (L_jj = 0 and L_ij = 0 below): for a
+    semidefinite matrix the Schur complement's column is then zero too, so nothing is lost.  Fully
+    coherent points (c all ones) give L[:, 0] = 1 and zero columns elsewhere, i.e. identical fields.
+    """
+    c = np.asarray(c, dtype=float)
+    n = c.shape[0]
+    low = np.zeros_like(c)
+    for j in range(n):
+        d = c[j, j] - np.sum(low[j, :j] ** 2, axis=0)
+        keep = d > tol
+        low[j, j] = np.sqrt(np.where(keep, d, 0.0))
+        for i in range(j + 1, n):
+            num = c[i, j] - np.sum(low[i, :j] * low[j, :j], axis=0)
+            np.divide(num, low[j, j], out=low[i, j], where=keep)  # zero where the pivot is zero
+    return low
+
+
+def wire_factor(freq: np.ndarray, offsets: np.ndarray, v_mean: float,
+                cross: CrossCoherence | None = None) -> np.ndarray:
+    """The lower factor L_w(f) of :func:`wire_coherence` [-], shape (n_w, n_w, n_freq).
+
+    Row 0 is (1, 0, ..., 0) at every frequency (wire 0 is the single-wire field)."""
+    return semidefinite_cholesky(wire_coherence(freq, offsets, v_mean, cross))
+
+
+def _distinct_points(off: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The first wire at each distinct offset, in order of appearance (n_p,), and each wire's point
+    index (n_w,): wires at equal offsets share one point, hence one field, exactly."""
+    first: list[int] = []
+    point = np.empty(off.shape[0], dtype=np.int64)
+    for w in range(off.shape[0]):
+        same = [p for p, f in enumerate(first) if np.array_equal(off[f], off[w])]
+        if same:
+            point[w] = same[0]
+        else:
+            point[w] = len(first)
+            first.append(w)
+    return np.asarray(first, dtype=np.int64), point
+
+
+# ------------------------------------------------------------------------- randomness
+def wire_rng(seed: int, realization: int, wire: int) -> np.random.Generator:
+    """The generator of wire w >= 1 in realization r: child w of the realization's seed sequence,
+    ``SeedSequence(seed, spawn_key=(r, w))`` (= ``SeedSequence(seed, spawn_key=(r,)).spawn(w + 1)[w]``).
+    Wire 0 uses the realization's own stream (``turbulence.realization_rng``); child 0 is unused."""
+    if realization < 0:
+        raise CaseError(f"realization {realization} is not allowed: expected an index >= 0")
+    if wire < 1:
+        raise ValueError(f"wire {wire}: wire 0 draws from turbulence.realization_rng")
+    ss = np.random.SeedSequence(int(seed), spawn_key=(int(realization), int(wire)))
+    return np.random.Generator(np.random.PCG64(ss))
+
+
+def wire_phases(seed: int, realization: int, wires: Sequence[int], n_nodes: int, n_freq: int) -> list[tb.UnitPhases]:
+    """The random phases [rad] (n_nodes, n_freq) of the given wires, as :class:`turbulence.UnitPhases`
+    (with the compiled kernel's phasors when it is on).  Wire 0: ``turbulence.unit_phases`` (the
+    single-wire phases, memo included); wire w >= 1: uniform on [0, 2 pi) from :func:`wire_rng`."""
+    out = []
+    for w in wires:
+        if w == 0:
+            out.append(tb.unit_phases(seed, realization, n_nodes, n_freq))
+            continue
+        phases = wire_rng(seed, realization, int(w)).random((n_nodes, n_freq)) * (2.0 * math.pi)
+        out.append(tb.UnitPhases(phases, kernel.phasors(phases)))
+    return out
+
+
+# ------------------------------------------------------------------------- synthesis
+def _equal_spacing(x: np.ndarray) -> float | None:
+    """The spacing of equally spaced increasing x, else None: the rule by which
+    ``turbulence.synthesize`` picks its KMS path (the same rule, so wire 0 takes the same path)."""
+    d = np.diff(x)
+    if d.size == 0:
+        return 0.0
+    if d[0] > 0 and np.allclose(d, d[0], rtol=1e-9, atol=0.0):
+        return float(d[0])
+    return None
+
+
+def _resolve(x: np.ndarray, method: str) -> tuple[str, float | None]:
+    spacing = _equal_spacing(x)
+    if method == "auto":
+        method = "kms" if spacing is not None else ("markov" if np.all(np.diff(x) >= 0) else "general")
+    if method not in ("kms", "markov", "general"):
+        raise ValueError(f"unknown method {method!r}")
+    if method == "kms" and spacing is None:
+        raise ValueError("the KMS path needs equally spaced, increasing x")
+    return method, spacing
+
+
+def _wire_spectrum(x: np.ndarray, grid: tb.SpectralGrid, phases: tb.UnitPhases | np.ndarray, decay: float,
+                   v_mean: float, method: str, spacing: float | None) -> np.ndarray:
+    """One wire's inverse-FFT input (n_nodes, n_fft // 2 + 1) complex, exactly as
+    ``turbulence.synthesize`` builds it (the same calls in the same order): the along-line factor
+    L_x applied to the unit phasors, scaled by (m/2) A_k (Deodatis 1996)."""
+    given = phases
+    if isinstance(phases, tb.UnitPhases):
+        phases, given = phases.phases, (phases.phasors if phases.phasors is not None else phases.phases)
+    m = grid.n_fft
+    if method == "kms":
+        rho = tb.davenport_coherence(grid.freq, spacing, decay, v_mean)  # Davenport (1961), neighbours
+        spec = kernel.coherent_spectrum(given, rho[None, :], np.zeros(max(x.size - 1, 0), dtype=np.int64),
+                                        grid.amplitude, m)
+        if spec is None:
+            spec = tb.fft_input(tb.kms_apply(rho, np.exp(1j * phases)), grid.amplitude, m)
+    elif method == "markov":
+        spec = kernel.coherent_spectrum(given, *tb.gap_rows(x, grid.freq, decay, v_mean), grid.amplitude, m)
+        if spec is None:
+            spec = tb.fft_input(tb.markov_apply(x, grid.freq, np.exp(1j * phases), decay, v_mean), grid.amplitude, m)
+    else:
+        spec = tb.fft_input(tb.general_apply(x, grid.freq, np.exp(1j * phases), decay, v_mean), grid.amplitude, m)
+    return spec
+
+
+def _to_time(spec: np.ndarray, grid: tb.SpectralGrid, lead: int, out: np.ndarray) -> None:
+    """out (lead + n_steps, n_nodes) = the inverse FFT of one wire's spectrum, its first n_steps
+    samples after ``lead`` samples of periodic continuation (as ``turbulence.synthesize``)."""
+    full = sfft.irfft(spec, n=grid.n_fft, axis=1)
+    if lead == 0:
+        out[...] = full[:, : grid.n_steps].T
+    else:
+        out[...] = np.take(full, np.arange(-lead, grid.n_steps), axis=1, mode="wrap").T
+
+
+def synthesize_wires(x: np.ndarray, offsets: np.ndarray, grid: tb.SpectralGrid,
+                     phases: Sequence[tb.UnitPhases | np.ndarray], decay: float, v_mean: float,
+                     cross: CrossCoherence | None = None, method: str = "auto", lead: int = 0) -> np.ndarray:
+    """Unit-variance field of n_w wires at stations x [m]: shape (n_w, lead + n_steps, n_nodes).
+
+    x [m] (n_nodes,), the stations every wire's nodes share; offsets [m] (n_w, 2) = (y, z) across
+    the line and up; phases: one per wire, each (n_nodes, n_freq) [rad] or ``UnitPhases`` (the
+    entries of wires that share a point with an earlier wire are not used); C_x = ``decay`` [-];
+    V [m/s]; ``cross``: C_y, C_z and their combination (default :class:`CrossCoherence`); ``method`` and ``lead`` as ``turbulence.synthesize`` (wire 0 is its
+    result bit for bit).  Per frequency f_k: y = (L_w(f_k) (x) L_x(f_k)) xi_k, the single-wire
+    spectrum of each distinct point mixed across wires by the lower factor L_w (Deodatis 1996;
+    docs/wind.md "Many wires").
+    """
+    x = np.asarray(x, dtype=float)
+    off = _offsets(offsets)
+    if len(phases) != off.shape[0]:
+        raise ValueError(f"{len(phases)} phase arrays for {off.shape[0]} wires")
+    method, spacing = _resolve(x, method)
+    first, point = _distinct_points(off)
+    low = wire_factor(grid.freq, off[first], v_mean, cross)  # (n_p, n_p, n_freq)
+    specs = []
+    for w in first:
+        ph = phases[w]
+        shape = (ph.phases if isinstance(ph, tb.UnitPhases) else np.asarray(ph)).shape
+        if shape != (x.size, grid.n_freq):
+            raise ValueError(f"wire {w}: phases shape {shape} != {(x.size, grid.n_freq)}")
+        specs.append(_wire_spectrum(x, grid, ph, decay, v_mean, method, spacing))
+    out = np.empty((off.shape[0], lead + grid.n_steps, x.size))
+    k = slice(1, grid.n_freq + 1)  # the simulated bins; the others are zero in every spectrum
+    # descending, so that the raw spectra of the points before p are still there when p is mixed
+    for p in range(len(first) - 1, -1, -1):
+        spec = specs[p]
+        if p > 0:
+            mixed = np.zeros_like(spec)
+            acc = mixed.view(float).reshape(x.size, -1, 2)[:, k]
+            for q in range(p + 1):
+                # (L_w (x) I) y: point p's value = sum_(q<=p) L_w[p, q](f) times point q's (real factor)
+                acc += low[p, q][None, :, None] * specs[q].view(float).reshape(x.size, -1, 2)[:, k]
+            spec = mixed
+        _to_time(spec, grid, lead, out[first[p]])
+        specs[p] = None if p > 0 else specs[p]
+    for w in range(off.shape[0]):
+        if first[point[w]] != w:
+            out[w] = out[first[point[w]]]  # the same point: the same field
+    return out
+
+
+# ------------------------------------------------------------------------- case-level API
+def _stations(system: LineSystem) -> np.ndarray:
+    return system.node_station if system.is_section else system.node_x0
+
+
+def unit_field_wires(case: Case, system: LineSystem, offsets: np.ndarray, n_steps: int, dt: float,
+                     realization: int, lead: int = 0, cross: CrossCoherence | None = None) -> np.ndarray:
+    """Zero-mean, unit-variance turbulence of n_w wires [-]: shape (n_w, lead + n_steps, n_nodes).
+
+    ``system``: the mesh every wire shares (its stations, as ``turbulence.unit_field``); offsets
+    [m] (n_w, 2) = (y, z); n_steps samples at dt [s] after ``lead`` samples of periodic lead-in;
+    realization 0-based; ``cross`` as :func:`synthesize_wires`.  Wire 0 equals ``turbulence.unit_field`` bit for bit; the
+    spectrum, L_u, C_x = ``wind.coherence_decay`` and V = V_ref are the case's.
+    """
+    x = _stations(system)
+    v = float(case.wind.v_ref)
+    if not v > 0:
+        raise CaseError("value 0.0 is not allowed for turbulence synthesis: expected v_ref > 0",
+                        file=str(case.source) if case.source else None, key="wind.v_ref")
+    off = _offsets(offsets)
+    grid = tb.spectral_grid(int(n_steps), float(dt), tb.length_scale(case), v, case.wind.fft_length == "fast")
+    first, _ = _distinct_points(off)
+    phases: list = [None] * off.shape[0]
+    for w, ph in zip(first, wire_phases(case.analysis.seed, realization, [int(f) for f in first], x.size,
+                                        grid.n_freq)):
+        phases[w] = ph
+    return synthesize_wires(x, off, grid, phases, case.wind.coherence_decay, v, cross, lead=lead)
+
+
+def _record(time: np.ndarray) -> tuple[int, float]:
+    """(n_steps, dt [s]) of an equally spaced time axis, dt to 12 significant digits: the rule of
+    ``turbulence.fluctuating_velocity`` (the same spectral grid, so wire 0 is its field bit for bit)."""
+    t = np.asarray(time, dtype=float)
+    if t.ndim != 1 or t.size < 4:
+        raise CaseError(f"time axis of {t.size} instants is not allowed: expected at least 4 equally spaced instants")
+    d = np.diff(t)
+    dt = float((t[-1] - t[0]) / (t.size - 1))
+    if not dt > 0 or not np.allclose(d, dt, rtol=1e-6, atol=1e-9 * max(1.0, abs(t[-1]))):
+        raise CaseError("time axis is not allowed: expected equally spaced, increasing instants")
+    return t.size, float(f"{dt:.12g}")
+
+
+def fluctuating_velocity_wires(case: Case, system: LineSystem, offsets: np.ndarray, time: np.ndarray,
+                               realizations: Sequence[int], a: np.ndarray | None = None, lead: int = 0,
+                               cancel=None, cross: CrossCoherence | None = None) -> np.ndarray:
+    """Fluctuating along-wind velocity a u [m/s] of n_w wires: shape (n_w, n_real, n_steps, n_nodes).
+
+    As ``turbulence.fluctuating_velocity`` (time [s] (n_steps,) with its first ``lead`` samples a
+    burn-in continued periodically; ``cancel`` checked before each realization) for the wires at
+    ``offsets`` [m] (n_w, 2).  ``a`` [m/s]: the modulation, (n_w, n_steps, n_nodes) for each wire's
+    own running mean (downbursts: I V_m at that wire's nodes) or anything that broadcasts to it;
+    default ``turbulence.modulation(case, system, time)`` for every wire.  Wire 0 with that
+    modulation equals ``turbulence.fluctuating_velocity`` bit for bit.
+    """
+    n_steps, dt = _record(time)
+    if not 0 <= lead < n_steps - 3:
+        raise ValueError(f"lead of {lead} samples does not fit a record of {n_steps}")
+    off = _offsets(offsets)
+    if a is None:
+        a = tb.modulation(case, system, np.asarray(time, dtype=float))
+    a = np.asarray(a, dtype=float)
+    if a.ndim == 3 and a.shape[0] not in (1, off.shape[0]):
+        raise ValueError(f"modulation of shape {a.shape} for {off.shape[0]} wires")
+    per_wire = a.ndim == 3 and a.shape[0] > 1  # else one modulation broadcast to every wire
+    if a.ndim == 3 and not per_wire:
+        a = a[0]
+    reals = list(realizations)
+    out = np.empty((off.shape[0], len(reals), n_steps, system.n_nodes))
+    for i, r in enumerate(reals):
+        if cancel is not None and cancel.is_set():
+            raise Cancelled("run cancelled")
+        u = unit_field_wires(case, system, off, n_steps - lead, dt, int(r), int(lead), cross)
+        for w in range(off.shape[0]):
+            out[w, i] = u[w]
+            out[w, i] *= a[w] if per_wire else a
+    return out

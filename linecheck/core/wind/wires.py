@@ -138,7 +138,7 @@ def semidefinite_cholesky(c: np.ndarray, tol: float = PIVOT_TOL) -> np.ndarray:
     """Lower factor L with L L^T = c of symmetric positive semidefinite matrices, one per frequency.
 
     c shape (n, n, n_freq) (matrix first, frequency last) -> L same shape, lower triangular in the
-    first two axes.  Column-by-column Cholesky (Golub & Van Loan 2013, Alg. 4.2.1) in which a pivot
+    first two axes.  Column-by-column Cholesky (Golub & Van Loan 2013, sec. 4.2) in which a pivot
     d_j = c_jj - sum_(k<j) L_jk^2 <= ``tol`` gives a zero column (L_jj = 0 and L_ij = 0 below): for a
     semidefinite matrix the Schur complement's column is then zero too, so nothing is lost.  Fully
     coherent points (c all ones) give L[:, 0] = 1 and zero columns elsewhere, i.e. identical fields.

@@ -270,8 +270,9 @@ def synthesize_wires(x: np.ndarray, offsets: np.ndarray, grid: tb.SpectralGrid,
 
     x [m] (n_nodes,), the stations every wire's nodes share; offsets [m] (n_w, 2) = (y, z) across
     the line and up; phases: one per wire, each (n_nodes, n_freq) [rad] or ``UnitPhases`` (the
-    entries of wires that share a point with an earlier wire are not used); C_x = ``decay`` [-];
-    V [m/s]; ``cross``: C_y, C_z and their combination (default :class:`CrossCoherence`); ``method`` and ``lead`` as ``turbulence.synthesize`` (wire 0 is its
+    entry of a wire at the same point as an earlier wire is not used and may be None);
+    C_x = ``decay`` [-]; V [m/s]; ``cross``: C_y, C_z and their combination (default
+    :class:`CrossCoherence`); ``method`` and ``lead`` as ``turbulence.synthesize`` (wire 0 is its
     result bit for bit).  Per frequency f_k: y = (L_w(f_k) (x) L_x(f_k)) xi_k, the single-wire
     spectrum of each distinct point mixed across wires by the lower factor L_w (Deodatis 1996;
     docs/wind.md "Many wires").
@@ -303,7 +304,8 @@ def synthesize_wires(x: np.ndarray, offsets: np.ndarray, grid: tb.SpectralGrid,
                 acc += low[p, q][None, :, None] * specs[q].view(float).reshape(x.size, -1, 2)[:, k]
             spec = mixed
         _to_time(spec, grid, lead, out[first[p]])
-        specs[p] = None if p > 0 else specs[p]
+        if p > 0:
+            specs[p] = None  # no point before p needs it: free it
     for w in range(off.shape[0]):
         if first[point[w]] != w:
             out[w] = out[first[point[w]]]  # the same point: the same field
@@ -321,8 +323,9 @@ def unit_field_wires(case: Case, system: LineSystem, offsets: np.ndarray, n_step
 
     ``system``: the mesh every wire shares (its stations, as ``turbulence.unit_field``); offsets
     [m] (n_w, 2) = (y, z); n_steps samples at dt [s] after ``lead`` samples of periodic lead-in;
-    realization 0-based; ``cross`` as :func:`synthesize_wires`.  Wire 0 equals ``turbulence.unit_field`` bit for bit; the
-    spectrum, L_u, C_x = ``wind.coherence_decay`` and V = V_ref are the case's.
+    realization 0-based; ``cross`` as :func:`synthesize_wires`.  Wire 0 equals
+    ``turbulence.unit_field`` bit for bit; the spectrum, L_u, C_x = ``wind.coherence_decay`` and
+    V = V_ref are the case's.
     """
     x = _stations(system)
     v = float(case.wind.v_ref)

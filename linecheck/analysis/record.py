@@ -12,13 +12,14 @@ from collections.abc import Callable
 import numpy as np
 
 from ..core.case import Case
+from ..core.crossflow import NodeWind, applies, node_wind
 from ..core.damping import aerodynamic_damping, stiffness_proportional
 from ..core.line_damping import reference_state_index, structural_omega1
 from ..core.loads import to_global_nodes
 from ..core.model import LinearModel, build_model
 from ..core.static import MeanStates
 from ..core.system import LineSystem
-from ..core.wind.mean import mean_wind
+from ..core.wind.mean import mean_vector_at_nodes, mean_wind
 from .step1 import StaticResult
 
 
@@ -65,6 +66,34 @@ def record_mean_wind(case: Case, st: StaticResult, t: np.ndarray) -> tuple[np.nd
         return vn, vl
     mw = mean_wind(case, system, t)
     return to_global_nodes(system, mw.normal), to_global_nodes(system, mw.longitudinal)
+
+
+def states_cross_wind(case: Case, st: StaticResult) -> NodeWind | None:
+    """The cross-flow form's wind at the global nodes at the step-1 mean states
+    (:class:`~linecheck.core.crossflow.NodeWind`, (n_k, n_nodes) each), its load directions d_j
+    at each node's largest |V_perp| among the states; None where the horizontal-normal form
+    applies (:func:`~linecheck.core.crossflow.applies`)."""
+    if not applies(case, st.system):
+        return None
+    return node_wind(st.system, mean_vector_at_nodes(case, st.system, st.mean.time))
+
+
+def record_cross_wind(case: Case, st: StaticResult, t: np.ndarray) -> NodeWind | None:
+    """:func:`states_cross_wind` over the record ``t`` [s], (n_steps, n_nodes) each, with the mean
+    states' load directions (one direction per node for the whole record; synoptic: the held mean,
+    rows of stride 0)."""
+    states = states_cross_wind(case, st)
+    if states is None:
+        return None
+    system, d = st.system, states.directions
+    if case.wind.type == "synoptic":
+        one = node_wind(system, mean_vector_at_nodes(case, system, t[:1]), d)
+
+        def held(a: np.ndarray) -> np.ndarray:
+            return np.broadcast_to(a, (t.size,) + a.shape[1:])
+
+        return NodeWind(held(one.along), held(one.rest), held(one.perp), held(one.perp_vectors), d)
+    return node_wind(system, mean_vector_at_nodes(case, system, t), d)
 
 
 def record_wind(case: Case, st: StaticResult, t: np.ndarray) -> tuple[np.ndarray, np.ndarray | None, np.ndarray]:
@@ -119,6 +148,7 @@ def interpolated_models(case: Case, st: StaticResult, bracket: np.ndarray,
 
     mean, system = st.mean, st.system
     vn_all = to_global_nodes(system, st.wind.normal)
+    cross = states_cross_wind(case, st)
     n_k = mean.time.size
     zs = case.analysis.structural_ratio
     w1 = 1.0
@@ -137,7 +167,8 @@ def interpolated_models(case: Case, st: StaticResult, bracket: np.ndarray,
                             lerp(mean.insulator_force), lerp(mean.nodes), lerp(mean.element_tension), 0, 0.0)
         model = build_model(system, state)
         vn = (1 - w) * vn_all[k0] + w * vn_all[k1]
-        c = aerodynamic_damping(case, model, vn, state.nodes)
+        u = None if cross is None else (lerp(cross.perp_vectors), cross.directions)
+        c = aerodynamic_damping(case, model, vn, state.nodes, u)
         if zs > 0:
             c = c + stiffness_proportional(model, zs, w1)
         return model, c

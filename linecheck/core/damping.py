@@ -56,7 +56,24 @@ def node_tangents(model: LinearModel, nodes: np.ndarray) -> np.ndarray:
     return t / np.linalg.norm(t, axis=-1)[..., None]
 
 
-def aerodynamic_damping(case: Case, model: LinearModel, vn_nodes: np.ndarray, nodes: np.ndarray | None = None) -> np.ndarray:
+def _cross_blocks(c: np.ndarray, u: np.ndarray, dirs: np.ndarray, P: np.ndarray | None) -> np.ndarray:
+    """[N s/m] the aerodynamic damping blocks (..., n_free, 3, 3) of the cross-flow form: c the
+    coefficients rho C_d D L |V_perp| (..., n_free), u [m/s] V_perp (..., n_free, 3), dirs the
+    load directions d (n_free, 3); "paper" (P None): c d d^T (Eq. 13 along the load); quasi-steady:
+    the relative wind w = P V_perp / |P V_perp| (P the projector normal to the deformed axis)."""
+    if P is None:
+        return c[..., None, None] * dirs[:, :, None] * dirs[:, None, :]
+    w = np.einsum("...ab,...b->...a", P, u)
+    size = np.linalg.norm(w, axis=-1)
+    fall = np.einsum("...ab,...b->...a", P, np.broadcast_to(dirs, w.shape))  # no wind: the load direction
+    w = np.where((size > 0)[..., None], w, fall)
+    w = w / np.linalg.norm(w, axis=-1)[..., None]
+    ww = w[..., :, None] * w[..., None, :]
+    return c[..., None, None] * (ww + 0.5 * (P - ww))
+
+
+def aerodynamic_damping(case: Case, model: LinearModel, vn_nodes: np.ndarray, nodes: np.ndarray | None = None,
+                        cross: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """Aerodynamic damping matrix [N s/m] in upper band storage, shape (BANDWIDTH + 1, n_dof).
 
     Args:
@@ -65,15 +82,28 @@ def aerodynamic_damping(case: Case, model: LinearModel, vn_nodes: np.ndarray, no
         vn_nodes: [m/s] running-mean normal speed at every global node, shape (n_nodes,).
         nodes: [m] deformed node coordinates of the mean state, (n_nodes, 3); needed for
             ``"quasi-steady"``.
+        cross: the cross-flow form on inclined spans (:mod:`linecheck.core.crossflow`): V_perp
+            [m/s] (n_nodes, 3) and the load directions d (n_nodes, 3); ``vn_nodes`` is then unused.
     """
     line = case.line
     coef = case.wind.air_density * line.drag_coefficient * line.diameter  # rho C_d D (Eq. 13)
     free = model.dofs.free_nodes
     n_dof = model.dofs.n_dof
     ab = np.zeros((BANDWIDTH + 1, n_dof))
-    c = coef * model.tributary[free] * np.abs(vn_nodes[free])  # (n_free,)
     first = model.dofs.node_dof[free]
     system = model.system
+    if cross is not None:  # |V_perp| (cross-flow principle, Hoerner 1965) in place of |V_n|
+        u, dirs = cross[0][free], cross[1][free]
+        c = coef * model.tributary[free] * np.linalg.norm(u, axis=-1)
+        P = None
+        if case.analysis.damping != "paper":
+            if nodes is None:
+                raise ValueError("quasi-steady damping needs the mean-state node coordinates")
+            e = node_tangents(model, nodes)[free]
+            P = np.eye(3)[None] - e[:, :, None] * e[:, None, :]
+        _add_node_blocks(ab, first, _cross_blocks(c, u, dirs, P))
+        return project_axial(model, ab)  # a rigid insulator carries the axial part
+    c = coef * model.tributary[free] * np.abs(vn_nodes[free])  # (n_free,)
     if case.analysis.damping == "paper":
         if system.straight_in_plan:
             ab[BANDWIDTH, first + 1] = c  # Eq. 9: transverse DOF only
@@ -108,7 +138,8 @@ def stiffness_proportional(model: LinearModel, ratio: float, omega1: float) -> n
 
 
 def aerodynamic_damping_stack(case: Case, models: list[LinearModel], vn_nodes: np.ndarray,
-                              nodes: np.ndarray | None = None) -> np.ndarray:
+                              nodes: np.ndarray | None = None,
+                              cross: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """:func:`aerodynamic_damping` of many mean states of one system in one vectorised pass
     (long lines), bit-identical to calling it state by state.
 
@@ -117,6 +148,8 @@ def aerodynamic_damping_stack(case: Case, models: list[LinearModel], vn_nodes: n
             :func:`~linecheck.core.model.build_models`), length n_k.
         vn_nodes: [m/s] running-mean normal speed at every global node, shape (n_k, n_nodes).
         nodes: [m] deformed node coordinates, shape (n_k, n_nodes, 3) (``"quasi-steady"``).
+        cross: the cross-flow form (as :func:`aerodynamic_damping`): V_perp [m/s] of every state
+            (n_k, n_nodes, 3) and the load directions d (n_nodes, 3).
 
     Returns: [N s/m] upper band storage, shape (n_k, BANDWIDTH + 1, n_dof).
     """
@@ -126,10 +159,21 @@ def aerodynamic_damping_stack(case: Case, models: list[LinearModel], vn_nodes: n
     free = model.dofs.free_nodes
     n_k = len(models)
     ab = np.zeros((n_k, BANDWIDTH + 1, model.dofs.n_dof))
-    c = coef * model.tributary[free] * np.abs(np.asarray(vn_nodes)[:, free])  # (n_k, n_free)
     first = model.dofs.node_dof[free]
     system = model.system
     axes = np.stack([m.axes for m in models])  # (n_k, n_s, 3)
+    if cross is not None:  # |V_perp| (cross-flow principle, Hoerner 1965) in place of |V_n|
+        u, dirs = np.asarray(cross[0])[:, free], cross[1][free]
+        c = coef * model.tributary[free] * np.linalg.norm(u, axis=-1)  # (n_k, n_free)
+        P = None
+        if case.analysis.damping != "paper":
+            if nodes is None:
+                raise ValueError("quasi-steady damping needs the mean-state node coordinates")
+            e = node_tangents(model, np.asarray(nodes))[:, free]
+            P = np.eye(3) - e[..., :, None] * e[..., None, :]
+        _add_node_blocks(ab, first, _cross_blocks(c, u, dirs, P))
+        return project_axial_stack(model.axial_dof, axes, ab)  # a rigid insulator carries the axial part
+    c = coef * model.tributary[free] * np.abs(np.asarray(vn_nodes)[:, free])  # (n_k, n_free)
     if case.analysis.damping == "paper":
         if system.straight_in_plan:
             ab[:, BANDWIDTH, first + 1] = c  # Eq. 9: transverse DOF only

@@ -32,16 +32,20 @@ def structural_omega1(ref: LinearModel) -> float:
 
 
 def damping_stack(case: Case, system: LineSystem, mean: MeanStates, vn: np.ndarray, models: list[LinearModel],
-                  states: list[int], omega1: float | None = None) -> np.ndarray:
+                  states: list[int], omega1: float | None = None,
+                  cross: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """Damping of mean states [N s/m], upper band storage, shape (len(models), 6, n_dof).
 
     ``models[i]`` is the model of mean state ``states[i]``; ``vn`` [m/s] the running-mean normal
     speed at the global nodes of every mean state, (n_k, n_nodes).  Aerodynamic (``analysis.damping``)
     plus stiffness-proportional structural damping, C_s = 2 zeta_s / omega_1 K (Chopra 2012,
     section 11.4), calibrated at the lowest mode of the reference mean state
-    (:func:`reference_state_index`), or at ``omega1`` [rad/s] when given.
+    (:func:`reference_state_index`), or at ``omega1`` [rad/s] when given.  ``cross``: the
+    cross-flow form's V_perp [m/s] of every mean state (n_k, n_nodes, 3) and load directions
+    (n_nodes, 3) (:func:`~linecheck.core.damping.aerodynamic_damping_stack`).
     """
-    C = aerodynamic_damping_stack(case, models, vn[states], mean.nodes[states])  # all states in one pass
+    u = None if cross is None else (cross[0][states], cross[1])
+    C = aerodynamic_damping_stack(case, models, vn[states], mean.nodes[states], u)  # all states in one pass
     zs = case.analysis.structural_ratio
     if zs > 0:
         if omega1 is None:

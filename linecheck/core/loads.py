@@ -14,10 +14,12 @@ import numpy as np
 
 from . import kernel
 from .case import Case
+from .crossflow import applies, span_drag_vectors
 from .static import drag_intensity
 from .system import LineSystem
 
 if TYPE_CHECKING:  # names of annotations only
+    from .crossflow import NodeWind
     from .model import LinearModel
     from .wind.mean import MeanWind
 
@@ -63,31 +65,55 @@ def mean_loads(case: Case, wind: MeanWind) -> np.ndarray:
     return g
 
 
-def synoptic_load_per_v(case: Case, model: LinearModel, vn: np.ndarray, vl: np.ndarray | None) -> np.ndarray:
+def mean_drag_vectors(case: Case, system: LineSystem, wind: MeanWind) -> np.ndarray | None:
+    """Cross-flow form of :func:`mean_loads` on a section with inclined spans: the mean drag per
+    unit length [N/m] as vectors, 1/2 rho C_d D |V_perp| V_perp (times 1 + sigma^2/|V|^2 with the
+    quadratic drag), V_perp the wind's part normal to the span's chord (cross-flow principle,
+    Hoerner 1965; :mod:`linecheck.core.crossflow`), shape (n_t, n_spans, ne+1, 3).  None where
+    it equals the horizontal-normal form (:func:`~linecheck.core.crossflow.applies`)."""
+    if not applies(case, system):
+        return None
+    line = case.line
+    u = span_drag_vectors(case, system, wind.normal, wind.longitudinal)
+    size = np.linalg.norm(u, axis=-1)
+    g = 0.5 * case.wind.air_density * line.drag_coefficient * line.diameter * size  # 1/2 rho C_d D |V_perp|
+    if case.analysis.drag == "quadratic":
+        g = g * (1.0 + turbulence_variance_ratio(case, wind.normal, wind.longitudinal))
+    return g[..., None] * u
+
+
+def synoptic_load_per_v(case: Case, model: LinearModel, vn: np.ndarray, vl: np.ndarray | None,
+                        perp: np.ndarray | None = None) -> np.ndarray:
     """[N s/m] the synoptic load per unit along-wind turbulence at the global nodes, shape
     (n_nodes,): rho C_d D L_i V_n (paper Eq. 5 per unit v), times cos(phi) = |V_n|/|V| for the
     normal component of the fluctuation when ``vl`` [m/s] (the longitudinal mean speed, oblique
-    wind or section) is given; ``vn`` [m/s] the normal mean speed, (n_nodes,)."""
+    wind or section) is given; ``vn`` [m/s] the normal mean speed, (n_nodes,).  ``perp``: the
+    cross-flow form, as :func:`fluctuating_loads` (|V_perp| / |V| in place of |V_n| / |V|)."""
     line, wind = case.line, case.wind
     a = wind.air_density * line.drag_coefficient * line.diameter * model.tributary * vn  # Eq. 5 per unit v
     if vl is not None:
         speed = np.hypot(vn, vl)  # cos(phi) = |V_n| / |V|, as the time domain (fluctuating_loads)
-        a = a * np.where(speed > 0, np.abs(vn) / np.where(speed > 0, speed, 1.0), 1.0)
+        size = np.abs(vn) if perp is None else perp
+        a = a * np.where(speed > 0, size / np.where(speed > 0, speed, 1.0), 1.0)
     return a
 
 
-def _load_factors(case: Case, model: LinearModel, vn: np.ndarray, vl: np.ndarray | None):
+def _load_factors(case: Case, model: LinearModel, vn: np.ndarray, vl: np.ndarray | None,
+                  perp: np.ndarray | None = None):
     """Per-node factors of the fluctuating drag over the rows of ``vn`` [m/s] (n_rows, n_nodes):
     per_v [N s/m] (paper Eq. 5 per unit v, normal component v cos(phi)) and, with the quadratic
     drag, per_q [N s^2/m^2] (1/2 rho C_d D L V_n|V_n|/|V|^2) and sig2 [m^2/s^2] (sigma^2), else
-    None twice."""
+    None twice.  ``perp`` [m/s] (cross-flow form, :class:`~linecheck.core.crossflow.NodeWind`):
+    |V_perp| in place of |V_n|, ``vn`` then the component of V_perp along the load direction and
+    hypot(vn, vl) = |V|."""
     line, wind = case.line, case.wind
+    size = np.abs(vn) if perp is None else perp  # |V_n|, or |V_perp| (cross-flow principle, Hoerner 1965)
     if vl is None:
         cos_n = np.ones_like(vn)
     else:
         speed = np.hypot(vn, vl)
         with np.errstate(invalid="ignore", divide="ignore"):
-            cos_n = np.where(speed > 0, np.abs(vn) / np.where(speed > 0, speed, 1.0), 1.0)
+            cos_n = np.where(speed > 0, size / np.where(speed > 0, speed, 1.0), 1.0)
     coef = wind.air_density * line.drag_coefficient * line.diameter
     # Eq. 5 per unit v, normal component of the fluctuation: v cos(phi), phi the angle of
     # the mean wind to the normal of the line
@@ -100,21 +126,27 @@ def _load_factors(case: Case, model: LinearModel, vn: np.ndarray, vl: np.ndarray
     with np.errstate(divide="ignore", invalid="ignore"):
         inv = np.where(speed2 > 0, 1.0 / np.where(speed2 > 0, speed2, 1.0), 0.0)
     # 1/2 rho C_d D L V_n|V_n| / |V|^2 per unit (v^2 - sigma^2); sigma^2 = ratio |V|^2
-    per_q = 0.5 * coef * model.tributary[None, :] * vn * np.abs(vn) * inv
+    per_q = 0.5 * coef * model.tributary[None, :] * vn * size * inv
     return per_v, per_q, ratio * speed2
 
 
 def _pinned_reactions(system: LineSystem, pinned: np.ndarray, pv_p, pq_p, s2_p, v: np.ndarray,
-                      direct: np.ndarray) -> None:
+                      direct: np.ndarray, dirs: np.ndarray | None = None) -> None:
     """Write the loads [N] at the pinned nodes ``pinned`` straight into their supports' reactions
-    ``direct`` (n_steps, n_real, 3 n_towers): R_y, or along the node normal of a section."""
+    ``direct`` (n_steps, n_real, 3 n_towers): R_y, or along the node normal of a section, or
+    along the nodes' load directions ``dirs`` (n_nodes, 3) (cross-flow form; R_z downward)."""
     cols = 3 * np.flatnonzero(~system.suspension)
     for i in range(v.shape[0] if pinned.size else 0):
         vp = v[i][:, pinned]
         f_i = pv_p * vp  # (n_steps, n_pinned)
         if pq_p is not None:
             f_i += pq_p * (vp * vp - s2_p)
-        if system.straight_in_plan:
+        if dirs is not None:
+            b = dirs[pinned]
+            direct[:, i, cols] = f_i * b[:, 0]
+            direct[:, i, cols + 1] = f_i * b[:, 1]
+            direct[:, i, cols + 2] = -f_i * b[:, 2]  # the reaction's z is downward
+        elif system.straight_in_plan:
             direct[:, i, cols + 1] = f_i
         else:
             b = system.node_normals[pinned]
@@ -123,7 +155,8 @@ def _pinned_reactions(system: LineSystem, pinned: np.ndarray, pv_p, pq_p, s2_p, 
 
 
 def fluctuating_loads(case: Case, system: LineSystem, model: LinearModel, t: np.ndarray, v: np.ndarray,
-                      vn: np.ndarray, vl: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+                      vn: np.ndarray, vl: np.ndarray | None = None,
+                      cross: NodeWind | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Fluctuating transverse nodal loads of steps 2-3 from the along-wind turbulence.
 
     Args:
@@ -131,6 +164,9 @@ def fluctuating_loads(case: Case, system: LineSystem, model: LinearModel, t: np.
         v: [m/s] along-wind turbulence, shape (n_real, n_steps, n_nodes).
         vn: [m/s] running-mean normal speed at the nodes, (n_steps, n_nodes);
         vl: [m/s] running-mean longitudinal speed (downburst; None: zero, cos(phi) = 1).
+        cross: the cross-flow form on inclined spans (:class:`~linecheck.core.crossflow.NodeWind`
+            over the record; ``vn``, ``vl`` are then ignored): the load acts along each node's
+            direction d_j with |V_perp| in place of |V_n|.
     Returns:
         loads [N] on the free nodes, (n_steps, n_real, n_free); direct [N] reactions of the loads
         at pinned nodes, (n_steps, n_real, 3 n_towers).
@@ -140,15 +176,20 @@ def fluctuating_loads(case: Case, system: LineSystem, model: LinearModel, t: np.
     1/2 rho C_d D L_i V_n|V_n|/|V|^2 (v^2 - sigma^2) (docs/method.md "Quadratic drag"; its mean
     sigma^2 is in step 1, :func:`mean_loads`).
     """
+    perp = None
+    if cross is not None:  # cross-flow principle (Hoerner 1965): V_perp along d_j, |V_perp| for |V_n|
+        vn, vl, perp = cross.along, cross.rest, cross.perp
     shape = vn.shape  # (n_steps, n_nodes)
     # a synoptic record holds its mean (rows broadcast, stride 0): the per-node factors are
     # elementwise, so they are computed on one row and viewed over the record (the same values;
     # ≈ 20 ms less per chunk with the quadratic drag)
-    held = vn.ndim == 2 and vn.strides[0] == 0 and (vl is None or vl.strides[0] == 0)
+    held = (vn.ndim == 2 and vn.strides[0] == 0 and (vl is None or vl.strides[0] == 0)
+            and (perp is None or perp.strides[0] == 0))
     if held:
         vn = vn[:1]
         vl = None if vl is None else vl[:1]
-    per_v, per_q, sig2 = _load_factors(case, model, vn, vl)
+        perp = None if perp is None else perp[:1]
+    per_v, per_q, sig2 = _load_factors(case, model, vn, vl, perp)
     quad = per_q is not None
     if held:  # writeable views, as the materialised factors (np.broadcast_to's are read-only: another
         # array type, i.e. another specialisation of the compiled drag)
@@ -170,5 +211,5 @@ def fluctuating_loads(case: Case, system: LineSystem, model: LinearModel, t: np.
     # compiled pass with the kernel's piece ``loads``)
     kernel.drag_loads(per_v[:, sel], per_q[:, sel] if quad else None, sig2[:, sel] if quad else None, v, sel, loads)
     _pinned_reactions(system, pinned, per_v[:, pinned], per_q[:, pinned] if quad else None,
-                      sig2[:, pinned] if quad else None, v, direct)
+                      sig2[:, pinned] if quad else None, v, direct, None if cross is None else cross.directions)
     return loads, direct

@@ -82,6 +82,8 @@ class LinearModel:
         axes: unit insulator axes at the suspension attachment nodes, shape (n_susp, 3).
         axial_dof: first DOF of each suspension attachment node, shape (n_susp,).
         K_axial_band: [N/m] the insulator axial penalty part of ``K_band`` (same storage).
+        load_directions: [-] the transverse load's direction at every node, (n_nodes, 3), where
+            it is not ``system.node_normals`` (the cross-flow form, :mod:`linecheck.core.crossflow`).
     """
 
     system: LineSystem
@@ -93,6 +95,7 @@ class LinearModel:
     axes: np.ndarray
     axial_dof: np.ndarray
     K_axial_band: np.ndarray
+    load_directions: np.ndarray | None = None
 
     @cached_property
     def M_band(self) -> np.ndarray:
@@ -591,15 +594,19 @@ def _condensed_sparse(model: LinearModel, damping_band: np.ndarray | None) -> Co
     return Condensed(S.toarray(), out[0], out[1], C)
 
 
-def reaction_matrix_direct(system: LineSystem) -> np.ndarray:
+def reaction_matrix_direct(system: LineSystem, directions: np.ndarray | None = None) -> np.ndarray:
     """D: reactions from nodal transverse loads applied at pinned nodes, shape (n_towers*3, n_nodes).
 
     A load applied directly at a pinned node goes straight into its support (along the
-    node's load direction, :attr:`LineSystem.node_normals`; global y on a straight line).
+    node's load direction, :attr:`LineSystem.node_normals`; global y on a straight line; or
+    ``directions`` (n_nodes, 3), the cross-flow form's, z up, the reaction's z down).
     """
     D = np.zeros((3 * system.n_towers, system.n_nodes))
     for j in np.flatnonzero(~system.suspension):
-        if system.straight_in_plan:
+        if directions is not None:
+            b = directions[system.tower_nodes[j]]
+            D[3 * j:3 * j + 3, system.tower_nodes[j]] = (b[0], b[1], -b[2])
+        elif system.straight_in_plan:
             D[3 * j + 1, system.tower_nodes[j]] = 1.0
         else:
             b = system.node_normals[system.tower_nodes[j]]

@@ -153,9 +153,10 @@ def load_rows(model: LinearModel, A: np.ndarray) -> np.ndarray:
     free = model.dofs.free_nodes
     ydof = model.dofs.node_dof[free] + 1
     system = model.system
-    if system.straight_in_plan:
+    dirs = model.load_directions  # the cross-flow form's directions, else the node normals
+    if dirs is None and system.straight_in_plan:
         return A[ydof]
-    b = system.node_normals[free]
+    b = (system.node_normals if dirs is None else dirs)[free]
     first = model.dofs.node_dof[free]
     return sum(b[:, c].reshape((-1,) + (1,) * (A.ndim - 1)) * A[first + c] for c in range(3))
 
@@ -419,9 +420,10 @@ def _direct_transfer(model: LinearModel, damping: np.ndarray, Gt: np.ndarray):
 
     def direct(omega: np.ndarray) -> np.ndarray:  # (3, n_free, n_f)
         X = dynamic_solve(blocks, omega, rhs)  # (n_free, 3 dofs, 3 reactions, n_f)
-        if system.straight_in_plan:
+        dirs = model.load_directions  # the cross-flow form's directions, else the node normals
+        if dirs is None and system.straight_in_plan:
             return X[:, 1].transpose(1, 0, 2)  # y DOF of every free node
-        b = system.node_normals[free]  # along every node's load direction (section form)
+        b = (system.node_normals if dirs is None else dirs)[free]  # along every node's load direction
         return np.einsum("ncrf,nc->rnf", X, b)
 
     return direct
@@ -519,7 +521,7 @@ def random_vibration(
     """
     system = model.system
     Gt = tower_rows(model, model.G, tower)  # (3, n_dof), in the tower's frame
-    Dt = tower_rows(model, reaction_matrix_direct(system), tower)  # (3, n_nodes)
+    Dt = tower_rows(model, reaction_matrix_direct(system, model.load_directions), tower)  # (3, n_nodes)
     xB, tB = _background_transfer(model, Gt, Dt)
     if modes is None:
         modes = complex_modes(model, damping, max_hz=band[1] * 1.5)
@@ -623,7 +625,7 @@ def modal_contributions(
     # background r.m.s. by the quasi-static transfer, integrated over the spectrum
     K_gen = _general_band(model.K_band)
     xB = solve_banded((BANDWIDTH, BANDWIDTH), K_gen, Gt.T)
-    tB = tower_rows(model, reaction_matrix_direct(system), tower).astype(float).copy()
+    tB = tower_rows(model, reaction_matrix_direct(system, model.load_directions), tower).astype(float).copy()
     tB[:, free] += load_rows(model, xB).T
     fb = np.geomspace(1e-5, 10.0, 600)
     rhob = markov_rho(system, fb, coherence_decay, v_mean)

@@ -36,6 +36,7 @@ CORE_MODULES = [
     "linecheck.core.second_order",
     "linecheck.core.banded",
     "linecheck.core.catenary",
+    "linecheck.core.uplift",
     "linecheck.core.node_bases",
     "linecheck.core.pieces",
     "linecheck.core.wind.mean",

@@ -17,6 +17,7 @@ from ..core.model import build_model
 from .guard import Warn, check_budget, warn_case
 from .linear import damping_matrices
 from .step1 import static_result
+from .uplift import require_tension
 
 if TYPE_CHECKING:  # names of annotations only
     from ..core.modes import Modes
@@ -51,6 +52,7 @@ def modes_analysis(case: Case, *, n_modes: int = 20, warn: Warn | None = None) -
     warn_case(case, warn)
     check_budget(case, "modes", warn=warn)
     st = static_result(case)
+    require_tension(st)  # modes of the still-air and mean states: every insulator hanging
     system, mean = st.system, st.mean
     k = reference_state_index(case, mean)
     still = natural_modes(build_model(system, mean.still_air), n_modes)

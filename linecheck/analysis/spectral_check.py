@@ -18,6 +18,7 @@ from .guard import Warn, check_budget
 from .linear import SynopticModel, synoptic_model
 from .record import record_time
 from .step1 import StaticResult, static_result
+from .uplift import require_tension
 from .windows import window_models, windowed
 
 if TYPE_CHECKING:  # names of annotations only
@@ -90,6 +91,7 @@ def spectral_analysis(case: Case, *, static: StaticResult | None = None,
     if static is None:
         check_budget(case, "spectral", warn=warn)
     st = static if static is not None else static_result(case)
+    require_tension(st)  # the linear model of the mean state: every insulator hanging
     estimate = _estimator(case, st)
     j = case.line.tower_of_interest - 1
 

@@ -6,6 +6,8 @@ exit with ``err.exit_code``.  Nothing in the core prints.
 - :class:`CaseError` -- bad user input (case file, field file, CLI value): exit 2.
 - :class:`ConvergenceError` -- the static solver found no admissible equilibrium: exit 1.
 - :class:`NumericalError` -- NaN/inf or a non-positive-definite state: exit 1.
+- :class:`UpliftError` -- a job that linearises about the mean states met an uplifting
+  suspension insulator (step 1 itself reports the uplift): exit 1.
 - :class:`Cancelled` -- the user cancelled a long job: exit 130.
 
 Every message is shown through :func:`printable`: control characters (ESC, NUL, ...), bidi
@@ -91,6 +93,15 @@ class NumericalError(LinecheckError):
 
     exit_code = 1
     title = "Numerical failure"
+
+
+class UpliftError(LinecheckError):
+    """A suspension insulator would be in compression (uplift) in a state a job needs in tension:
+    the dynamic model linearises about the mean states with every suspension insulator hanging.
+    Names the case, the tower and its vertical margin [N]."""
+
+    exit_code = 1
+    title = "Uplift"
 
 
 class Cancelled(LinecheckError):

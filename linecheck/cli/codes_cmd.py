@@ -16,17 +16,19 @@ from .progress import progress_bar
 
 
 def codes_table(codes: dict[str, CodeCheckRecord], title: str) -> Table:
-    """Rich table of a typed ``codes`` block (kN at display)."""
+    """Rich table of a typed ``codes`` block (kN at display): the code load's two parts (wind, angle;
+    :data:`~linecheck.core.codes.CODES_COMPARED`), the code load, linecheck's peak, ratio, verdict."""
     t = Table(title=title, title_justify="left")
-    for col in ("code", "verified", "tower", "code load kN", "linecheck peak kN", "ratio", "verdict"):
+    for col in ("code", "verified", "tower", "wind kN", "angle kN", "code load kN", "linecheck peak kN", "ratio",
+                "verdict"):
         t.add_column(col, justify="left" if col in ("code", "verdict") else "right")
 
     for name, block in codes.items():
         for k, tower in enumerate(block.towers):
             ry = tower.reactions["Ry"]
             t.add_row(name if k == 0 else "", ("yes" if block.verified else "no") if k == 0 else "",
-                      str(tower.index), kn_text(ry.code_load), kn_text(ry.linecheck_peak),
-                      "-" if ry.ratio is None else f"{ry.ratio:.3f}", ry.verdict)
+                      str(tower.index), kn_text(ry.wind_load), kn_text(ry.angle_load), kn_text(ry.code_load),
+                      kn_text(ry.linecheck_peak), "-" if ry.ratio is None else f"{ry.ratio:.3f}", ry.verdict)
     return t
 
 
@@ -56,11 +58,12 @@ def codes(
         with progress_bar() as cb:
             run = service.run_case(case, spectral_check=False, progress=cb)
     res = service.codes_analysis(case, run)
-    doc = {"case": case.name, "units": "SI", "peak": res.peak, "codes": codes_to_dict(res)}
+    doc = {"case": case.name, "units": "SI", "peak": res.peak, "compared": res.compared, "codes": codes_to_dict(res)}
     typed = codes_document(res)
-    console.print(codes_table(typed, f"{case.name}: conductor wind load on Ry, design codes vs linecheck "
+    console.print(codes_table(typed, f"{case.name}: transverse load on Ry (wind + angle), design codes vs linecheck "
                                             f"(v_ref {case.wind.v_ref:g} m/s, terrain \"{case.codes.terrain}\")"))
     print_codes_notes(typed)
+    console.print("[dim]" + res.compared + ".[/]", highlight=False)
     console.print("[dim]linecheck peak: " + res.peak + ". Unverified codes are shown, not judged (docs/codes.md).[/]",
                   highlight=False)
     if json_out is not None:

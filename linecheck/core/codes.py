@@ -4,7 +4,9 @@ One function per code returns the code's transverse wind load per unit length of
 [N/m] for a wind normal to the line (Omega = 90 deg, Phi = 0), to be multiplied by the wind
 span (half the sum of the adjacent spans) to give the load on a tower's transverse reaction.
 No code defines a longitudinal conductor wind load for a straight line, so only ``Ry`` is
-compared.
+compared.  At an angle tower the compared code load adds the code's wind-induced angle load
+(:data:`CODES_COMPARED`; computed in :mod:`linecheck.analysis.code_check`, which needs the
+section's static model).
 
 Reference wind.  The callers pass ``v_ref`` as the case's 10-minute mean speed at conductor
 height h (the case's v_ref carried to h by its own profile; the paper's synoptic records are
@@ -56,7 +58,19 @@ EN50341_TERRAINS = ("0", "I", "II", "III", "IV")
 #: the one wording of the ``codes`` command, the TUI's Codes tab and the Excel Codes sheet.
 CODES_PEAK = ("design value of peak_dynamic (Gumbel fit at analysis.design_fractile; the mean over "
               "realizations when a single realization gives no fit) of the wind-induced peak |M + B + R| of the "
-              "reaction, still air excluded: the same wind-induced quantity as the code's conductor wind load")
+              "reaction, still air excluded: the same wind-induced quantity as the code load (at an angle tower "
+              "both include the resultant of the wind-induced rise in conductor tension)")
+
+#: What the code load beside linecheck's peak is (``code_load`` = |``wind_load`` + ``angle_load``|,
+#: :func:`linecheck.analysis.code_check.codes_analysis`; docs/codes.md, "What is compared"): the one
+#: wording of every front end.
+CODES_COMPARED = ("code load = |wind load + angle load|. Wind load: the code's conductor wind load on the "
+                  "tower's wind span, resolved on the tower's transverse axis (times cos(alpha/2), alpha the line "
+                  "deviation at the tower). Angle load: the code's wind-induced angle load "
+                  "(dT_left + dT_right) sin(alpha/2) = 2 dT sin(alpha/2), dT the rise of the horizontal conductor "
+                  "tension from still air under the code's wind load on every span (linecheck's static model of "
+                  "the section); negative where it opposes the wind load (wind toward the outside of the angle); "
+                  "zero on a straight tower")
 
 
 @dataclass(frozen=True)

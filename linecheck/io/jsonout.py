@@ -247,7 +247,9 @@ def run_document(res: Any, *, full_histories: bool = False, max_points: int = 20
 def codes_to_dict(cr: Any) -> dict[str, Any]:
     """JSON of a :class:`~linecheck.service.CodesResult` (contract):
     ``{"ASCE74": {"edition", "verified", "provision", "inputs", "note", "load_per_length",
-    "towers": [{"index", "Ry": {"code_load", "linecheck_peak", "ratio", "verdict"}}]}, ...}``, N."""
+    "towers": [{"index", "Ry": {"wind_load", "angle_load", "code_load", "linecheck_peak", "ratio",
+    "verdict"}}]}, ...}``, N; ``code_load`` = |``wind_load`` + ``angle_load``| (``CodesResult.compared``),
+    the two parts absent where the code has no load."""
     out: dict[str, Any] = {}
     for c in cr.checks:
         out[c.code] = {
@@ -257,11 +259,16 @@ def codes_to_dict(cr: Any) -> dict[str, Any]:
             "inputs": {k: _num(v) for k, v in c.inputs.items()},
             "note": c.note,
             "load_per_length": _num(c.load_per_length),
-            "towers": [{"index": t.index, **{r: {"code_load": _num(v.code_load), "linecheck_peak": _num(v.linecheck_peak),
-                                                 "ratio": _num(v.ratio), "verdict": v.verdict}
-                                             for r, v in t.reactions.items()}} for t in c.towers],
+            "towers": [{"index": t.index, **{r: _verdict_dict(v) for r, v in t.reactions.items()}} for t in c.towers],
         }
     return out
+
+
+def _verdict_dict(v: Any) -> dict[str, Any]:
+    """One reaction's check (:class:`~linecheck.analysis.code_check.ReactionCheck`) as JSON, N."""
+    parts = {k: _num(x) for k, x in (("wind_load", v.wind_load), ("angle_load", v.angle_load)) if x is not None}
+    return {**parts, "code_load": _num(v.code_load), "linecheck_peak": _num(v.linecheck_peak), "ratio": _num(v.ratio),
+            "verdict": v.verdict}
 
 
 def codes_block(res: Any) -> dict[str, Any]:

@@ -255,12 +255,30 @@ class Spectral(_Block):
 
 @dataclass(frozen=True)
 class CodeVerdict(_Block):
-    """A code's load beside linecheck's peak for one reaction [N], their ratio [-] and the verdict."""
+    """A code's load beside linecheck's peak for one reaction [N], their ratio [-] and the verdict.
+
+    ``code_load`` = |``wind_load`` + ``angle_load``| (:data:`~linecheck.core.codes.CODES_COMPARED`):
+    the code's conductor wind load on the tower's transverse axis [N] and its wind-induced angle
+    load [N] (+ where it adds to the wind load; 0 on a straight tower).  Both are absent from the
+    JSON where the code has no load, and in results saved before they were recorded.
+    """
 
     code_load: float | None
     linecheck_peak: float | None
     ratio: float | None
     verdict: str
+    wind_load: float | None = None
+    angle_load: float | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        parts = {k: v for k, v in (("wind_load", self.wind_load), ("angle_load", self.angle_load)) if v is not None}
+        return {**parts, "code_load": self.code_load, "linecheck_peak": self.linecheck_peak, "ratio": self.ratio,
+                "verdict": self.verdict}
+
+    @classmethod
+    def from_json(cls, d: dict[str, Any]) -> CodeVerdict:
+        return cls(d["code_load"], d["linecheck_peak"], d["ratio"], d["verdict"], d.get("wind_load"),
+                   d.get("angle_load"))
 
 
 @dataclass(frozen=True)

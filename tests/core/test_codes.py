@@ -243,7 +243,9 @@ def test_run_json_has_codes_block(short_run):
     for block in doc["codes"].values():
         assert {"edition", "verified", "inputs", "towers"} <= set(block)
         assert [t["index"] for t in block["towers"]] == [1, 2]
-        assert set(block["towers"][0]["Ry"]) == {"code_load", "linecheck_peak", "ratio", "verdict"}
+        assert list(block["towers"][0]["Ry"]) == ["wind_load", "angle_load", "code_load", "linecheck_peak", "ratio",
+                                                  "verdict"]
+        assert block["towers"][0]["Ry"]["angle_load"] == 0.0  # a straight line: the wind load alone
 
 
 def test_per_span_speeds_scale_the_wind_span():
@@ -311,10 +313,14 @@ def test_excel_codes_sheet(short_run):
     rows = list(ws.iter_rows(min_row=4, max_row=11, values_only=True))
     asce = doc["codes"]["ASCE74"]["towers"][0]["Ry"]
     assert rows[0][1] == "ASCE74" and rows[0][4] == 1 and rows[0][5] == "Ry"
-    assert rows[0][6] == pytest.approx(asce["code_load"] / 1e3) and rows[0][9] == asce["verdict"]
+    assert rows[0][6] == pytest.approx(asce["wind_load"] / 1e3) and rows[0][7] == 0.0
+    assert rows[0][8] == pytest.approx(asce["code_load"] / 1e3) and rows[0][11] == asce["verdict"]
     # the note says what the number is: the Gumbel design value, not the mean of the peak
     notes = [c for row in ws.iter_rows(values_only=True) for c in row if isinstance(c, str) and "linecheck peak:" in c]
     assert len(notes) == 1 and C.CODES_PEAK in notes[0] and "mean over realizations of the wind" not in notes[0]
+    # and what the code load is: wind load + angle load
+    assert any(isinstance(c, str) and c.startswith(C.CODES_COMPARED) for row in ws.iter_rows(values_only=True)
+               for c in row)
 
 
 async def test_tui_codes_tab_shows_the_run_document(short_run):
@@ -337,9 +343,11 @@ async def test_tui_codes_tab_shows_the_run_document(short_run):
         first = [str(c) for c in table.get_row_at(0)]
         ry = doc["codes"]["ASCE74"]["towers"][0]["Ry"]
         assert first[:4] == ["ASCE74", "yes", "1", "Ry"]
-        assert first[4] == f"{ry['code_load'] / 1e3:.3f}" and first[7] == ry["verdict"]
+        assert first[4] == f"{ry['wind_load'] / 1e3:.3f}" and first[5] == "0.000"
+        assert first[6] == f"{ry['code_load'] / 1e3:.3f}" and first[9] == ry["verdict"]
         note = str(app.query_one("#codes-notes").render())
         assert "design value of peak_dynamic (Gumbel fit" in note and "mean over realizations of the wind" not in note
+        assert "code load = |wind load + angle load|" in note
 
 
 def test_the_same_wind_written_two_ways_gives_the_same_code_loads():

@@ -1,4 +1,4 @@
-"""Codes: the design codes' conductor wind loads beside linecheck's peaks.
+"""Codes: the design codes' conductor wind and angle loads beside linecheck's peaks.
 
 Shows the ``"codes"`` block of the run document (computed by the service); no code value is
 computed here.
@@ -11,12 +11,12 @@ from textual.app import ComposeResult
 from textual.containers import Vertical
 from textual.widgets import DataTable, Static
 
-from ...core.codes import CODES_PEAK
+from ...core.codes import CODES_COMPARED, CODES_PEAK
 from ...io.display import kn_text
 from ...io.document import CodeCheckRecord, RunDocument
 
 HELP = "No result yet. Run a case (r): the four design codes' conductor wind loads appear here beside its peaks."
-PEAK_NOTE = (f"linecheck peak: {CODES_PEAK}; ratio = peak / code load. "
+PEAK_NOTE = (f"{CODES_COMPARED}.\nlinecheck peak: {CODES_PEAK}; ratio = peak / code load. "
              "Unverified codes are shown, not judged (docs/codes.md).")
 
 
@@ -29,13 +29,15 @@ def codes_rows(codes: dict[str, CodeCheckRecord], names: dict[int, str] | None =
         for t in block.towers:
             label = f"{t.index} {names[t.index]}" if t.index in names else str(t.index)
             for r, v in t.reactions.items():
-                rows.append((name, "yes" if block.verified else "no", label, r, kn_text(v.code_load),
-                             kn_text(v.linecheck_peak), "-" if v.ratio is None else f"{v.ratio:.3f}", v.verdict))
+                rows.append((name, "yes" if block.verified else "no", label, r, kn_text(v.wind_load),
+                             kn_text(v.angle_load), kn_text(v.code_load), kn_text(v.linecheck_peak),
+                             "-" if v.ratio is None else f"{v.ratio:.3f}", v.verdict))
     return rows
 
 
 class CodesView(Vertical):
-    """One row per code, tower and reaction; the codes' notes below."""
+    """One row per code, tower and reaction (the code load's wind and angle parts, the code load, the
+    peak, ratio, verdict); what is compared and the codes' notes below."""
 
     def compose(self) -> ComposeResult:
         yield Static(HELP, id="codes-title")
@@ -44,7 +46,8 @@ class CodesView(Vertical):
 
     def on_mount(self) -> None:
         t = self.query_one(DataTable)
-        t.add_columns("code", "verified", "tower", "reaction", "code load kN", "linecheck peak kN", "ratio", "verdict")
+        t.add_columns("code", "verified", "tower", "reaction", "wind kN", "angle kN", "code load kN", "linecheck peak kN",
+                      "ratio", "verdict")
 
     def show(self, doc: RunDocument | None) -> None:
         title = self.query_one("#codes-title", Static)
@@ -56,7 +59,7 @@ class CodesView(Vertical):
             title.update(HELP)
             notes.update("")
             return
-        title.update(Text(f"{doc.case}: conductor wind load on Ry, design codes vs linecheck", style="bold"))
+        title.update(Text(f"{doc.case}: transverse load on Ry (wind + angle), design codes vs linecheck", style="bold"))
         names = {t.index: t.section["name"] for t in doc.towers if t.section and "name" in t.section}
         for row in codes_rows(codes, names):
             table.add_row(*row)

@@ -35,9 +35,14 @@ Model (global frame: x along the first span, y to its left, z up; SI units)
     1/2 rho C_d D |V_perp| V_perp, a follower load.  Its load stiffness -df/dx (derived in
     :meth:`_Model.crossflow`) is part of the (then non-symmetric) Newton tangent.
 
+    ``crossflow_axes`` = ``"still-air"`` or ``"chord"`` freezes e at the still-air elements or
+    at each span's chord C_i C_i+1 (dead loads, for comparison with models that do so).
+
   On a level span in wind normal to the line the two coincide on the still-air geometry
-  (V . e = 0); after the blow-out the elements near the clamps have e_y != 0 and the cross-flow
-  drag is slightly smaller and gets a small upward part (second order in the sag slope).
+  (V . e = 0, :func:`still_air_drag`).  After the blow-out the elements away from mid-span
+  have e_y != 0: the follower drag is smaller (by ~1.5 <e_y^2>) and has an upward part, both
+  second order in the sag slope; with wind off the normal (V_x != 0) V . e changes to first
+  order, |V_perp| drops near one end of each span and rises near the other.
   Nodal loads: consistent lumping of the linearly interpolated nodal intensities
   (l0 (2q_a + q_b)/6, l0 (q_a + 2 q_b)/6), exact for weight.
 * Solution: full Newton-Raphson with step limiting (largest nodal move <= ``dmax``) on the weight
@@ -465,7 +470,7 @@ class State:
 @dataclass(frozen=True)
 class Solution:
     """Still-air and wind states of a section (``wind`` is None when v_ref = 0); unstretched_length
-    [m] per span; drag_direction: the drag model of the wind state (see :func:`solve`)."""
+    [m] per span; drag_direction, crossflow_axes: the drag model of the wind state (:func:`solve`)."""
 
     section: Section
     geometry: Geometry
@@ -474,6 +479,7 @@ class Solution:
     wind: State | None
     unstretched_length: np.ndarray = field(default_factory=lambda: np.zeros(0))
     drag_direction: str = "horizontal-normal"
+    crossflow_axes: str = "current"
 
 
 def _state(m: _Model, U: np.ndarray, fext: np.ndarray, res: float, its: int, steps: int) -> State:
@@ -505,12 +511,35 @@ def _still(m: _Model, tol: float, max_iter: int, dmax: float):
     return _newton(m, np.zeros_like(m.X0), m.fw, tol, max_iter, dmax)
 
 
+def still_air_drag(source: Section | str | Path, *, n_el: int = 100, drag_direction: str = "horizontal-normal",
+                   insulator_stiffness: float = 1e3, tol: float = 1e-5) -> np.ndarray:
+    """[N] nodal drag loads of ``drag_direction`` evaluated on the still-air equilibrium (the first
+    wind increment's load), conductor nodes only, shape (n_spans n_el + 1, 3), global frame."""
+    _sec, geo, m = _build(source, n_el, insulator_stiffness)
+    U, _, _ = _still(m, tol, 50, 0.1 * float(np.min(geo.length)))
+    m.set_wind(m.X0 + U)
+    f = m.fq if drag_direction == "horizontal-normal" else m.crossflow(U, False)[0]
+    return f.reshape(-1, 3)[: m.nc].copy()
+
+
 DRAG_DIRECTIONS = ("horizontal-normal", "cross-flow")
+CROSSFLOW_AXES = ("current", "still-air", "chord")
+
+
+def _chord_displacements(m: _Model) -> np.ndarray:
+    """[m] displacements (nn, 3) that put every span's conductor nodes on the straight line between
+    its still-air clamps C_i, C_i+1 (the span's chord), at equal spacing."""
+    X = m.X0.copy()
+    t = np.linspace(0.0, 1.0, m.n + 1)[:, None]
+    for i in range(m.ns):
+        X[i * m.n:(i + 1) * m.n + 1] = m.geo.clamp[i] + t * (m.geo.clamp[i + 1] - m.geo.clamp[i])
+    return X - m.X0
 
 
 def solve(source: Section | str | Path, *, n_el: int = 100, insulator_stiffness: float = 1e3,
           tol: float = 1e-5, max_iter: int = 50, wind: bool = True, wind_steps: int = 4,
-          drag_direction: str = "horizontal-normal", load_stiffness: bool = True) -> Solution:
+          drag_direction: str = "horizontal-normal", crossflow_axes: str = "current",
+          load_stiffness: bool = True) -> Solution:
     """Still-air equilibrium and (if v_ref > 0 and ``wind``) the mean-wind equilibrium.
 
     Args:
@@ -521,14 +550,22 @@ def solve(source: Section | str | Path, *, n_el: int = 100, insulator_stiffness:
             EA_ins/v times the spacing of doubles near |dX| ~ 4 m, is ~1e-6 N).
         wind_steps: initial number of wind increments (halved on failure, doubled after easy steps).
         drag_direction: ``"horizontal-normal"`` (the drag along each span's horizontal normal, a
-            dead load) or ``"cross-flow"`` (the wind component normal to each element's current
-            axis, a follower load); see the module docstring.  Any value is accepted in still air.
-        load_stiffness: cross-flow only: include the load stiffness -df/dx in the Newton tangent
-            (quadratic convergence; default) or iterate with the structural tangent alone (the
-            same equilibrium to ``tol``, more iterations).
+            dead load) or ``"cross-flow"`` (the wind component normal to each element's axis);
+            see the module docstring.  Any value is accepted in still air.
+        crossflow_axes: the axes e of the cross-flow drag: ``"current"`` (each element's deformed
+            axis, a follower load: the cross-flow principle on the conductor as it stands; default),
+            ``"still-air"`` (each element's axis in the still-air equilibrium, a dead load) or
+            ``"chord"`` (every element of span i on the straight line C_i C_i+1, a dead load).  The
+            two dead forms show how much of the difference to "horizontal-normal" is the follower
+            effect; "chord" is the form of a model that loads each span with one drag per unit length.
+        load_stiffness: cross-flow on current axes only: include the load stiffness -df/dx in the
+            Newton tangent (quadratic convergence; default) or iterate with the structural tangent
+            alone (the same equilibrium to ``tol``, more iterations).
     """
     if drag_direction not in DRAG_DIRECTIONS:
         raise ValueError(f"drag_direction {drag_direction!r}: expected one of {DRAG_DIRECTIONS}")
+    if crossflow_axes not in CROSSFLOW_AXES:
+        raise ValueError(f"crossflow_axes {crossflow_axes!r}: expected one of {CROSSFLOW_AXES}")
     sec, geo, m = _build(source, n_el, insulator_stiffness)
     dmax = 0.1 * float(np.min(geo.length))
     U, its, res = _still(m, tol, max_iter, dmax)
@@ -536,10 +573,15 @@ def solve(source: Section | str | Path, *, n_el: int = 100, insulator_stiffness:
     wstate = None
     if wind and sec.v_ref > 0.0:
         m.set_wind(m.X0 + U)
-        if drag_direction == "horizontal-normal":
+        follower = drag_direction == "cross-flow" and crossflow_axes == "current"
+        if not follower:
+            if drag_direction == "horizontal-normal":
+                fq = m.fq
+            else:  # cross-flow on fixed axes: one evaluation, a dead load
+                fq = m.crossflow(U if crossflow_axes == "still-air" else _chord_displacements(m), False)[0]
             U, res, total, steps = load_stepping(lambda U0, f: _newton(m, U0, f, tol, max_iter, dmax), U, m.fw,
-                                                 m.fq, wind_steps, 6, FEConvergenceError)
-            fext = m.fw + m.fq
+                                                 fq, wind_steps, 6, FEConvergenceError)
+            fext = m.fw + fq
         else:
             def load(lam: float):  # the load at wind factor lam (0..1): weight + lam * cross-flow drag
                 def f(U1: np.ndarray):
@@ -552,7 +594,8 @@ def solve(source: Section | str | Path, *, n_el: int = 100, insulator_stiffness:
                                                  0.0, 1.0, wind_steps, 6, FEConvergenceError)
             fext = m.fw + m.crossflow(U, False)[0]
         wstate = _state(m, U, fext, res, total, steps)
-    return Solution(sec, geo, n_el, still, wstate, np.array([c.Lu for c in geo.catenary]), drag_direction)
+    return Solution(sec, geo, n_el, still, wstate, np.array([c.Lu for c in geo.catenary]), drag_direction,
+                    crossflow_axes)
 
 
 # ============================================================================ vibrations

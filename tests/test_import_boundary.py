@@ -15,6 +15,7 @@ CORE_MODULES = [
     "linecheck.core.case_files",
     "linecheck.core.case_towers",
     "linecheck.core.case_geometry",
+    "linecheck.core.case_wires",
     "linecheck.core.case_load",
     "linecheck.core.errors",
     "linecheck.core.names",

@@ -12,7 +12,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from linecheck.core.case_schema import SCHEMA
+from linecheck.core.case_schema import SCHEMA, WIRE_SCHEMA
 
 HEADER = """# Case files
 
@@ -180,21 +180,154 @@ docs/performance.md). Derivations: docs/method.md, "Closing the linearisation ga
 
 """
 
+WIRES = """## Every wire on the tower: phases, bundles and ground wires
+
+A tower carries several wires. `[[wires]]` lists them (one table per wire: a phase conductor or
+bundle, a ground wire), `[[tower_types]]` says where each wire hangs on each type of tower, and
+every tower of the section (`[[line.towers]]` or a `towers_file` row) names its `type`. A case
+without `[[wires]]` is the single wire of `[line]`, unchanged.
+
+With `[[wires]]` the line is a section (towers, no equal-span keys). `[line]` keeps
+`insulator_length` (the default of suspension attachments), `tower_of_interest`,
+`elements_per_span` and `towers_file`; `weight`, `diameter`, `drag_coefficient`, `area`,
+`elastic_modulus` and `tension` are given per wire and refused in `[line]`. A tower gives
+`station`, `ground`, `angle`, `name` and `type` (required); `height`, `support` and
+`insulator_length` come from its type's attachments and are refused on the tower (a tower CSV
+needs the columns `station` and `type`).
+
+- **Wires.** The conductor keys describe one sub-conductor, with the units and ranges of
+  `[line]`. A bundle of n = `bundle` sub-conductors acts as one wire, the sum of n identical
+  sub-conductors: weight n W (mass n W/g), area n A (axial stiffness n E A), tension n H0 (the
+  still-air sag W L²/8H0 stays the sub-conductor's), and drag on the projected width n D s with
+  s = `shielding`. The default s = 1 takes no shielding of the leeward sub-conductors (each loaded
+  as if alone); no code's value is assumed, give s from a source you trust. `bundle_spacing` is
+  recorded only.
+- **Attachments.** An attachment is a point of the tower in the tower frame: `y` to the left of
+  the line's centre (looking along the line), `z` above the tower's ground, at the insulator's
+  top for a suspension attachment (its still-air clamp hangs `insulator_length` v below, at
+  z − v: the insulator's top is T = C + (0, 0, v), docs/method.md "Line sections") and at the
+  clamp for a strain attachment. Each wire's single-wire line (`linecheck.core.case.wire_case`)
+  has at tower k the clamp height, support and insulator of the wire's attachment on tower k's
+  type, on the towers' stations, ground and angles; it runs along the line's centre (the offset
+  `y` is kept for the tower's moments, not in the wire's plan geometry).
+- **Coherence.** `[wind] coherence_decay_y` and `coherence_decay_z` are the decay constants C_y,
+  C_z of the exponential coherence between wires separated across the line and in height (the
+  along-line constant stays `coherence_decay`; the model: docs/wind.md "Many wires"); defaults 16
+  and 10 as in Simiu & Scanlan, "Wind Effects on Structures" (3rd ed., 1996, Sect. 2.3, after
+  Vellozzi & Cohen 1968; quoted as the literature quotes them, not checked against the book's
+  page). Only a case with `[[wires]]` reads them.
+
+Cross-checks (one line naming the file, key and line or CSV row and column, the value and what
+is allowed; exit 2): `[[wires]]` and `[[tower_types]]` both given; wire and type names unique
+and not empty; every type attaches every wire exactly once, each attachment naming a known
+wire; every tower names a known type; at both end towers every attachment is `"strain"`;
+`insulator_length` only on suspension attachments; at a suspension attachment z > 2 v (the clamp
+z − v above v, as a single-wire tower's `height` > `insulator_length`); `bundle_spacing` and
+`shielding` only with `bundle` ≥ 2; every wire's still-air spans, with its own W and H0, as a
+section's `tension` (sag below a quarter of the span, clear of the ground line; the message
+names `wires[k].tension`). For example:
+
+```
+error: c.toml:16: line.towers[2].type: value "SS" is not allowed: expected one of "S", "DE"
+(the [[tower_types]] names) (did you mean "S"?)
+error: c.toml:63: tower_types[2].attachments: has no attachment of wire "G": expected one
+attachment per wire ("A", "B", "G")
+```
+
+Example (three wires, two tower types; a full case adds `[wind]` and `[analysis]`):
+
+```toml
+[line]
+insulator_length = 3.6     # m, default of the suspension attachments
+tower_of_interest = 2
+
+[[line.towers]]
+name = "T1"
+station = 0.0              # m
+type = "DE"                # a dead-end (strain) type at both ends
+[[line.towers]]
+name = "T2"
+station = 300.0
+ground = 2.0               # m
+type = "S"
+[[line.towers]]
+name = "T3"
+station = 600.0
+type = "DE"
+
+[[wires]]
+name = "A"
+kind = "phase"
+weight = 17.92             # N/m, one sub-conductor
+diameter = 0.022           # m
+area = 0.7e-4              # m2
+elastic_modulus = 5.2e10   # Pa
+tension = 20000.0          # N, H0 of one sub-conductor
+bundle = 2                 # twin bundle: 35.84 N/m, 40 kN, drag on 2 x 0.022 x 0.9 m
+bundle_spacing = 0.4       # m, recorded only
+shielding = 0.9
+[[wires]]
+name = "B"
+kind = "phase"
+weight = 17.92
+diameter = 0.022
+area = 0.7e-4
+elastic_modulus = 5.2e10
+tension = 20000.0
+[[wires]]
+name = "G"
+kind = "ground"
+weight = 6.0
+diameter = 0.012
+area = 0.5e-4
+elastic_modulus = 1.6e11
+tension = 8000.0
+
+[[tower_types]]
+name = "S"                 # suspension: z at the insulator's top
+attachments = [
+    { wire = "A", y = -5.5, z = 31.0, support = "suspension" },
+    { wire = "B", y = 5.5, z = 31.0, support = "suspension", insulator_length = 4.0 },
+    { wire = "G", y = 0.0, z = 40.0, support = "suspension", insulator_length = 0.3 },
+]
+[[tower_types]]
+name = "DE"                # strain: z at the clamp
+attachments = [
+    { wire = "A", y = -5.5, z = 28.0, support = "strain" },
+    { wire = "B", y = 5.5, z = 28.0, support = "strain" },
+    { wire = "G", y = 0.0, z = 37.0, support = "strain" },
+]
+```
+
+"""
+
+#: headings of the array-of-tables sections
+HEADINGS = {
+    "line.towers": "[[line.towers]] (one table per tower, in line order; or one row of `towers_file`)",
+    "wires": "[[wires]] (one table per wire)",
+    "tower_types": "[[tower_types]] (one table per tower type; its `attachments`: the next table)",
+    "tower_types.attachments": "attachments of a [[tower_types]] table (one inline table per wire)",
+}
+
+
+def _table(section: str, specs) -> list[str]:
+    heading = HEADINGS.get(section) or ("[" + section + "]" if section else "Top level")
+    out = [f"## {heading}\n", "| key | type | unit | default | allowed | meaning |", "| --- | --- | --- | --- | --- | --- |"]
+    for s in specs:
+        default = "required" if s.required else ("—" if s.default is None else f"`{s.default!r}`".replace("'", '"'))
+        unit = s.unit if s.unit and s.unit != "-" else ""
+        out.append(f"| `{s.name}` | {s.kind} | {unit} | {default} | {s.allowed()} | {s.help} |")
+    out.append("")
+    return out
+
 
 def render() -> str:
     out = [HEADER]
     for section, specs in SCHEMA.items():
-        if section == "line.towers":  # an array of tables: one per tower (or one CSV row, towers_file)
-            out.append("## [[line.towers]] (one table per tower, in line order; or one row of `towers_file`)\n")
-        else:
-            out.append(f"## {'[' + section + ']' if section else 'Top level'}\n")
-        out.append("| key | type | unit | default | allowed | meaning |")
-        out.append("| --- | --- | --- | --- | --- | --- |")
-        for s in specs:
-            default = "required" if s.required else ("—" if s.default is None else f"`{s.default!r}`".replace("'", '"'))
-            unit = s.unit if s.unit and s.unit != "-" else ""
-            out.append(f"| `{s.name}` | {s.kind} | {unit} | {default} | {s.allowed()} | {s.help} |")
-        out.append("")
+        out += _table(section, specs)
+    out.append(WIRES)
+    for section, specs in WIRE_SCHEMA.items():
+        out += _table(section, specs)
     return "\n".join(out)
 
 

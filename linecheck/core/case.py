@@ -3,12 +3,16 @@
 A case is split by job over these modules, re-exported here so that
 ``from linecheck.core.case import X`` serves every caller:
 
-* :mod:`.case_schema` -- :data:`SCHEMA`, every TOML key's type, range, default, unit and help;
+* :mod:`.case_schema` -- :data:`SCHEMA` and :data:`WIRE_SCHEMA`, every TOML key's type, range,
+  default, unit and help;
 * :mod:`.case_model` -- the frozen dataclasses (:class:`Case`, :class:`Line`, :class:`Tower`,
-  :class:`Wind`, :class:`Downburst`, :class:`Analysis`, :class:`Codes`), defaults from SCHEMA;
+  :class:`Wire`, :class:`TowerType`, :class:`Attachment`, :class:`Wind`, :class:`Downburst`,
+  :class:`Analysis`, :class:`Codes`), defaults from SCHEMA;
 * :mod:`.case_load` -- :func:`load_case`, :func:`case_from_dict`, :func:`case_hash`;
 * :mod:`.case_validate` -- key checks, one-line messages, :func:`case_warnings`;
 * :mod:`.case_geometry` -- the line's equal-span and section (towers) forms;
+* :mod:`.case_wires` -- every wire on the tower: ``[[wires]]``, ``[[tower_types]]``, and each
+  wire's single-wire case (:func:`wire_case`);
 * :mod:`.case_towers` -- the tower table CSV reader;
 * :mod:`.case_files` -- safe reading of user files (regular files only, size caps).
 
@@ -26,7 +30,7 @@ from typing import Any
 from .case_files import MAX_CASE_BYTES, MAX_RESULT_BYTES, read_regular_file, read_text_file
 from .case_geometry import EQUAL_SPAN_KEYS, MAX_TOWERS
 from .case_load import case_from_dict, case_hash, load_case
-from .case_model import GRAVITY, Analysis, Case, Codes, Downburst, Line, Tower, Wind
+from .case_model import GRAVITY, Analysis, Attachment, Case, Codes, Downburst, Line, Tower, TowerType, Wind, Wire
 from .case_schema import (
     CODE_TERRAINS,
     DAMPING_MODELS,
@@ -41,34 +45,40 @@ from .case_schema import (
     TENSION_MODELS,
     TOWER_COLUMNS,
     WIND_TYPES,
+    WIRE_KINDS,
+    WIRE_SCHEMA,
     FieldSpec,
     field_spec,
     schema_default,
+    schema_table,
 )
-from .case_towers import MAX_QUOTED_CELL, cell_text, reads_as_header
+from .case_towers import MAX_QUOTED_CELL, TYPED_TOWER_COLUMNS, cell_text, reads_as_header
 from .case_validate import DENSITY_RANGE, FMT_LIST_ITEMS, MAX_NESTING, ErrorContext, case_warnings, check_value
+from .case_wires import TYPE_TOWER_KEYS, WIRE_LINE_KEYS, clamp_height, wire_case
 from .errors import CaseError
 
 __all__ = [
     "CODE_TERRAINS", "DAMPING_MODELS", "DEFAULT_STRUCTURAL_DAMPING", "DENSITY_RANGE", "DOWNBURST_MODELS",
     "DOWNBURST_PRESETS", "DRAG_MODELS", "FFT_LENGTHS", "FMT_LIST_ITEMS", "GRAVITY", "MAX_CASE_BYTES",
     "MAX_NESTING", "MAX_QUOTED_CELL", "MAX_RESULT_BYTES", "MAX_TOWERS", "RING_MODELS", "SCHEMA",
-    "SUPPORT_TYPES", "TENSION_MODELS", "TOWER_COLUMNS", "WIND_TYPES",
-    "Analysis", "Case", "CaseError", "Codes", "Downburst", "FieldSpec", "Line", "Tower", "Wind",
-    "case_from_dict", "case_hash", "case_to_dict", "case_to_toml", "case_warnings", "cell_text",
+    "SUPPORT_TYPES", "TENSION_MODELS", "TOWER_COLUMNS", "TYPED_TOWER_COLUMNS", "TYPE_TOWER_KEYS", "WIND_TYPES",
+    "WIRE_KINDS", "WIRE_LINE_KEYS", "WIRE_SCHEMA",
+    "Analysis", "Attachment", "Case", "CaseError", "Codes", "Downburst", "FieldSpec", "Line", "Tower", "TowerType",
+    "Wind", "Wire",
+    "case_from_dict", "case_hash", "case_to_dict", "case_to_toml", "case_warnings", "cell_text", "clamp_height",
     "field_spec", "load_case", "read_regular_file", "read_text_file", "reads_as_header", "replace",
-    "schema_default", "with_options", "with_value", "with_values",
+    "schema_default", "schema_table", "wire_case", "with_options", "with_value", "with_values",
 ]
 
 #: [wind] keys written only when not at their default (documents from before them stay unchanged)
-_QUIET_DEFAULTS = ("direction", "profile_exponent")
+_QUIET_DEFAULTS = ("direction", "profile_exponent", "coherence_decay_y", "coherence_decay_z")
 
 
 def case_to_dict(case: Case) -> dict[str, Any]:
     """The TOML document of a case (only keys that are set), inverse of :func:`case_from_dict`."""
     def pick(obj: Any, section: str) -> dict[str, Any]:
         out = {}
-        for spec in SCHEMA[section]:
+        for spec in schema_table(section):
             v = getattr(obj, spec.name)
             if v is None:
                 continue
@@ -83,8 +93,18 @@ def case_to_dict(case: Case) -> dict[str, Any]:
         for key in EQUAL_SPAN_KEYS:
             doc["line"].pop(key, None)
         if case.line.towers_file is None:
-            doc["line"]["towers"] = [{k: v for k, v in dataclasses.asdict(t).items() if v is not None}
+            drop = TYPE_TOWER_KEYS if case.has_wires else ()  # with wires, the types place them
+            doc["line"]["towers"] = [{k: v for k, v in dataclasses.asdict(t).items() if v is not None and k not in drop}
                                      for t in case.line.towers]
+    if case.has_wires:
+        for key in WIRE_LINE_KEYS:  # the line is the first wire's: its conductor is written per wire
+            doc["line"].pop(key, None)
+        doc["wires"] = [pick(w, "wires") for w in case.wires]
+        for w, table in zip(case.wires, doc["wires"]):
+            if w.bundle == 1:  # shielding is a bundle's key (at its default on a single conductor)
+                table.pop("shielding")
+        doc["tower_types"] = [{"name": t.name, "attachments": [pick(a, "tower_types.attachments") for a in t.attachments]}
+                              for t in case.tower_types]
     doc["wind"] = pick(case.wind, "wind")
     for key in _QUIET_DEFAULTS:  # keys added with the section form: not written at their defaults (older documents unchanged)
         if doc["wind"].get(key) == field_spec("wind", key).default:
@@ -119,7 +139,7 @@ def case_to_toml(case: Case) -> str:
     lines: list[str] = []
 
     def emit(section: str, table: dict[str, Any]) -> None:
-        for spec in SCHEMA[section]:
+        for spec in schema_table(section):
             if spec.name in table:
                 unit = f"  # {spec.unit}" if spec.unit and spec.unit != "-" else ""
                 lines.append(f"{spec.name} = {_toml_value(table[spec.name])}{unit}")
@@ -137,7 +157,22 @@ def case_to_toml(case: Case) -> str:
                 lines.append("")
                 lines.append("[[line.towers]]")
                 emit("line.towers", tower)
+    for wire in doc.get("wires", ()):
+        lines += ["", "[[wires]]"]
+        emit("wires", wire)
+    for tower_type in doc.get("tower_types", ()):
+        lines += ["", "[[tower_types]]"]
+        emit("tower_types", tower_type)
+        lines.append("attachments = [")
+        lines += [f"    {_inline_table(a, 'tower_types.attachments')}," for a in tower_type["attachments"]]
+        lines.append("]")
     return "\n".join(lines) + "\n"
+
+
+def _inline_table(table: dict[str, Any], section: str) -> str:
+    """A TOML inline table of ``table``'s keys in schema order: ``{ wire = "A", y = -5.5 }``."""
+    items = [f"{spec.name} = {_toml_value(table[spec.name])}" for spec in schema_table(section) if spec.name in table]
+    return "{ " + ", ".join(items) + " }"
 
 
 def with_value(case: Case, dotted_key: str, value: Any) -> Case:

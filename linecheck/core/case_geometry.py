@@ -10,7 +10,6 @@ and column.
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 from typing import Any
 
@@ -19,7 +18,7 @@ import numpy as np
 from .case_model import Line, Tower
 from .case_schema import field_spec
 from .case_towers import read_towers_csv
-from .case_validate import ErrorContext, fmt_value, read_section
+from .case_validate import ErrorContext, array_table_line, fmt_value, read_section
 from .errors import CaseError
 
 MAX_TOWERS = 201  # 200 spans (the equal-span form's limit)
@@ -60,26 +59,6 @@ def equal_span_line(line_d: dict[str, Any], ctx: ErrorContext) -> Line:
     return Line(**line_d)
 
 
-def _tower_line(text: str | None, k: int, key: str | None) -> int | None:
-    """1-based file line of ``key`` in the k-th (0-based) ``[[line.towers]]`` table."""
-    if text is None:
-        return None
-    count = -1
-    inside = False
-    for n, raw in enumerate(text.splitlines(), start=1):
-        stripped = raw.strip()
-        if stripped.startswith("["):
-            inside = re.match(r"^\[\[\s*line\s*\.\s*towers\s*\]\]", stripped) is not None
-            if inside:
-                count += 1
-                if count == k and key is None:
-                    return n
-            continue
-        if inside and count == k and key is not None and re.match(rf"^\s*\"?{re.escape(key)}\"?\s*=", raw):
-            return n
-    return None
-
-
 class _TowerCtx(ErrorContext):
     """Error context of one tower: an inline [[line.towers]] table or a CSV row."""
 
@@ -92,29 +71,27 @@ class _TowerCtx(ErrorContext):
             where = f"row {self.row}" + (f", column {key}" if key else "")
             return CaseError(message, file=self.csv_file, key=where)
         dotted = f"line.towers[{self.k + 1}]" + (f".{key}" if key else "")
-        return CaseError(message, file=self.file, key=dotted, line=_tower_line(self.text, self.k, key))
+        return CaseError(message, file=self.file, key=dotted, line=array_table_line(self.text, "line.towers", self.k, key))
 
 
 def section_line(line_d: dict[str, Any], towers_data: Any, ctx: ErrorContext, base_dir: Path | None) -> Line:
     """The section form: [[line.towers]] (``towers_data``, as parsed) or towers_file (relative to
     ``base_dir``), and tension H0.  The towers are checked one by one in line order, then every
     span's still-air sag and ground clearance; ``spans``, ``span_length``, ``sag``, ``height`` and
-    ``supports`` are derived for display (:func:`_derived_line`)."""
-    _check_section_keys(line_d, towers_data, ctx)
-    raw = _raw_towers(line_d, towers_data, ctx, base_dir)
+    ``supports`` are derived for display (:func:`derived_line`)."""
+    check_section_keys(line_d, towers_data, ctx)
+    raw = raw_towers(line_d, towers_data, ctx, base_dir)
     n = len(raw)
-    if not 2 <= n <= MAX_TOWERS:
-        raise ctx.error("line", "towers_file" if line_d["towers_file"] else "towers",
-                        f"has {n} towers: expected 2 to {MAX_TOWERS} towers (1 to {MAX_TOWERS - 1} spans)")
     towers: list[Tower] = []
     for k, (d, tctx) in enumerate(raw):
         towers.append(_read_tower(d, tctx, k, n, line_d["insulator_length"], towers[-1] if towers else None))
-    _check_still_air_spans(towers, line_d["tension"], line_d["weight"], ctx)
-    return _derived_line(line_d, towers, ctx)
+    check_still_air_spans(towers, line_d["tension"], line_d["weight"], ctx)
+    return derived_line(line_d, towers, ctx)
 
 
-def _check_section_keys(line_d: dict[str, Any], towers_data: Any, ctx: ErrorContext) -> None:
-    """Refuse the equal-span keys, towers both inline and in a file, and a missing tension."""
+def check_section_keys(line_d: dict[str, Any], towers_data: Any, ctx: ErrorContext, needs_tension: bool = True) -> None:
+    """Refuse the equal-span keys, towers both inline and in a file, and (``needs_tension``) a
+    missing tension."""
     for key in EQUAL_SPAN_KEYS:
         if line_d[key] is not None:
             raise ctx.error("line", key, f"value {fmt_value(list(line_d[key]) if isinstance(line_d[key], tuple) else line_d[key])} "
@@ -123,14 +100,27 @@ def _check_section_keys(line_d: dict[str, Any], towers_data: Any, ctx: ErrorCont
     if towers_data is not None and line_d["towers_file"] is not None:
         raise ctx.error("line", "towers_file", f"value {fmt_value(line_d['towers_file'])} is not allowed together with "
                         "[[line.towers]]: give the towers either inline or in the file, not both")
-    if line_d["tension"] is None:
+    if needs_tension and line_d["tension"] is None:
         raise ctx.error("line", "tension", f"missing required key for a tower table: expected {field_spec('line', 'tension').allowed()} "
                         "(still-air horizontal tension H0 at clipping-in)")
 
 
-def _raw_towers(line_d: dict[str, Any], towers_data: Any, ctx: ErrorContext,
-                base_dir: Path | None) -> list[tuple[dict[str, Any], _TowerCtx]]:
-    """Each tower's raw keys (from the CSV file or the inline tables) with its error context."""
+def raw_towers(line_d: dict[str, Any], towers_data: Any, ctx: ErrorContext, base_dir: Path | None,
+               typed: bool = False) -> list[tuple[dict[str, Any], ErrorContext]]:
+    """Each tower's raw keys (from the CSV file or the inline tables) with its error context
+    (naming ``line.towers[k].key`` or the CSV row and column), 2 to :data:`MAX_TOWERS` of them.
+    ``typed``: the towers of a case with ``[[wires]]`` (a CSV needs the ``type`` column, not
+    ``height`` and ``support``)."""
+    raw = _raw_tower_list(line_d, towers_data, ctx, base_dir, typed)
+    n = len(raw)
+    if not 2 <= n <= MAX_TOWERS:
+        raise ctx.error("line", "towers_file" if line_d["towers_file"] else "towers",
+                        f"has {n} towers: expected 2 to {MAX_TOWERS} towers (1 to {MAX_TOWERS - 1} spans)")
+    return raw
+
+
+def _raw_tower_list(line_d: dict[str, Any], towers_data: Any, ctx: ErrorContext, base_dir: Path | None,
+                    typed: bool) -> list[tuple[dict[str, Any], ErrorContext]]:
     if line_d["towers_file"] is not None:
         path = Path(line_d["towers_file"])
         if not path.is_absolute() and base_dir is not None:
@@ -138,7 +128,7 @@ def _raw_towers(line_d: dict[str, Any], towers_data: Any, ctx: ErrorContext,
         if not path.exists():
             raise ctx.error("line", "towers_file", f"value {fmt_value(line_d['towers_file'])}: file {path} does not exist "
                             "(expected a CSV tower table, see docs/case-files.md)")
-        return [(d, _TowerCtx(ctx, k, str(path), row_no)) for k, (d, row_no) in enumerate(read_towers_csv(path))]
+        return [(d, _TowerCtx(ctx, k, str(path), row_no)) for k, (d, row_no) in enumerate(read_towers_csv(path, typed))]
     if towers_data is None:
         raise ctx.error("line", "towers", "missing: give one [[line.towers]] table per tower or towers_file = \"section.csv\"")
     if not isinstance(towers_data, list) or not all(isinstance(t, dict) for t in towers_data):
@@ -146,21 +136,22 @@ def _raw_towers(line_d: dict[str, Any], towers_data: Any, ctx: ErrorContext,
     return [(d, _TowerCtx(ctx, k, None, None)) for k, d in enumerate(towers_data)]
 
 
-def _read_tower(d: dict[str, Any], tctx: _TowerCtx, k: int, n: int, line_insulator: float,
+def _read_tower(d: dict[str, Any], tctx: ErrorContext, k: int, n: int, line_insulator: float,
                 previous: Tower | None) -> Tower:
     """Tower ``k`` (0-based) of ``n`` from its raw keys ``d``, checked against its place in the
     line (end tower or not) and the ``previous`` tower; ``line_insulator`` [m] is the line's
     default insulator length."""
     td = read_section(d, "line.towers", tctx)
+    if td["type"] is not None:
+        raise tctx.error("", "type", f"value {fmt_value(td['type'])} is not allowed without [[wires]] and [[tower_types]]: "
+                         "a tower type places the wires of a case that lists them (remove type, or add the wires)")
     if td["name"] is None:
         td["name"] = f"T{k + 1}"
     end = k in (0, n - 1)
     if end and td["support"] != "strain":
         raise tctx.error("", "support", f"value {fmt_value(td['support'])} is not allowed at an end tower: expected \"strain\" "
                          "(a suspension end leaves the section unrestrained along the line)")
-    if end and td["angle"] != 0.0:
-        raise tctx.error("", "angle", f"value {td['angle']!r} is not allowed at an end tower: expected 0 (the line "
-                         "deviates only at interior towers)")
+    check_end_angle(td, tctx, k, n)
     if td["insulator_length"] is not None and td["support"] != "suspension":
         raise tctx.error("", "insulator_length", f"value {td['insulator_length']!r} is not allowed at a strain tower: "
                          "expected it on suspension towers only (remove it)")
@@ -168,18 +159,32 @@ def _read_tower(d: dict[str, Any], tctx: _TowerCtx, k: int, n: int, line_insulat
     if td["support"] == "suspension" and v >= td["height"]:
         raise tctx.error("", "height", f"value {td['height']!r} is not allowed with insulator length {v!r}: expected "
                          "height > insulator_length (the insulator's top would be below its clamp's ground)")
-    if previous is not None and td["station"] <= previous.station:
-        raise tctx.error("", "station", f"value {td['station']!r} is not allowed: expected stations increasing along the "
-                         f"line (the previous tower is at {previous.station!r} m)")
-    if previous is not None:
-        span = td["station"] - previous.station
-        if not 10.0 <= span <= 3000.0:
-            raise tctx.error("", "station", f"value {td['station']!r} gives a span of {span:g} m: expected spans "
-                             "from 10 to 3000 m")
+    check_station(td, tctx, previous.station if previous is not None else None)
     return Tower(**td)
 
 
-def _check_still_air_spans(towers: list[Tower], H0: float, W: float, ctx: ErrorContext) -> None:
+def check_end_angle(td: dict[str, Any], tctx: ErrorContext, k: int, n: int) -> None:
+    """No angle at an end tower (tower ``k``, 0-based, of ``n``; validated keys ``td``)."""
+    if k in (0, n - 1) and td["angle"] != 0.0:
+        raise tctx.error("", "angle", f"value {td['angle']!r} is not allowed at an end tower: expected 0 (the line "
+                         "deviates only at interior towers)")
+
+
+def check_station(td: dict[str, Any], tctx: ErrorContext, previous_station: float | None) -> None:
+    """The tower's station [m] beyond the previous tower's (None: the first tower) by a span of
+    10 to 3000 m."""
+    if previous_station is None:
+        return
+    if td["station"] <= previous_station:
+        raise tctx.error("", "station", f"value {td['station']!r} is not allowed: expected stations increasing along the "
+                         f"line (the previous tower is at {previous_station!r} m)")
+    span = td["station"] - previous_station
+    if not 10.0 <= span <= 3000.0:
+        raise tctx.error("", "station", f"value {td['station']!r} gives a span of {span:g} m: expected spans "
+                         "from 10 to 3000 m")
+
+
+def check_still_air_spans(towers: list[Tower], H0: float, W: float, ctx: ErrorContext) -> None:
     """Every span's still-air parabola under tension ``H0`` [N] and weight ``W`` [N/m]: its sag
     below a quarter of the span and its lowest point above the straight ground line."""
     for i in range(len(towers) - 1):
@@ -198,7 +203,7 @@ def _check_still_air_spans(towers: list[Tower], H0: float, W: float, ctx: ErrorC
                             f"(lowest still-air clearance {clear.min():.3g} m): expected a higher tension or taller towers")
 
 
-def _derived_line(line_d: dict[str, Any], towers: list[Tower], ctx: ErrorContext) -> Line:
+def derived_line(line_d: dict[str, Any], towers: list[Tower], ctx: ErrorContext) -> Line:
     """The section's :class:`Line`, with the equal-span form's keys derived for display:
     ``span_length`` is Eq. 17's L_x, the mean of the spans adjacent to the tower of interest."""
     n = len(towers)

@@ -2,8 +2,8 @@
 
 :func:`load_case` reads the file safely (:mod:`.case_files`) and parses it; :func:`case_from_dict`
 validates every table against :data:`~.case_schema.SCHEMA` (:mod:`.case_validate`), builds the
-line (:mod:`.case_geometry`), the wind (with its downburst) and the analysis settings, and
-cross-checks them.  Every refusal is one :class:`~.errors.CaseError` line naming the file, the
+line (:mod:`.case_geometry`; with ``[[wires]]`` the wires and tower types too, :mod:`.case_wires`),
+the wind (with its downburst) and the analysis settings, and cross-checks them.  Every refusal is one :class:`~.errors.CaseError` line naming the file, the
 key (and its line), the value and what is allowed.
 """
 
@@ -18,9 +18,10 @@ from typing import Any
 
 from .case_files import MAX_CASE_BYTES, read_regular_file, read_text_file
 from .case_geometry import equal_span_line, section_line
-from .case_model import Analysis, Case, Codes, Downburst, Line, Wind
+from .case_model import Analysis, Case, Codes, Downburst, Line, TowerType, Wind, Wire
 from .case_schema import RING_MODELS
 from .case_validate import MAX_NESTING, ErrorContext, check_text, fmt_value, read_section
+from .case_wires import WIRE_LINE_KEYS, wires_line
 from .errors import CaseError
 
 
@@ -44,11 +45,17 @@ def case_from_dict(
             raise ctx.error("", required, f"missing required table [{required}]")
     line_data = dict(data["line"]) if isinstance(data["line"], dict) else data["line"]
     towers_data = line_data.pop("towers", None) if isinstance(line_data, dict) else None
-    line_d = read_section(line_data, "line", ctx)
+    with_wires = "wires" in data or "tower_types" in data  # docs/case-files.md "Every wire on the tower"
+    line_d = read_section(line_data, "line", ctx, optional=WIRE_LINE_KEYS if with_wires else ())
     wind_d = read_section(data["wind"], "wind", ctx)
     an_d = read_section(data.get("analysis", {}), "analysis", ctx)
 
-    if towers_data is not None or line_d["towers_file"] is not None or line_d["tension"] is not None:
+    wires: tuple[Wire, ...] = ()
+    tower_types: tuple[TowerType, ...] = ()
+    if with_wires:
+        line, wires, tower_types = wires_line(line_data, line_d, towers_data, data.get("wires"), data.get("tower_types"),
+                                              ctx, base_dir)
+    elif towers_data is not None or line_d["towers_file"] is not None or line_d["tension"] is not None:
         line = section_line(line_d, towers_data, ctx, base_dir)
     else:
         line = equal_span_line(line_d, ctx)
@@ -57,7 +64,7 @@ def case_from_dict(
     codes = Codes(**read_section(data.get("codes", {}), "codes", ctx))
     name = top["name"] or default_name
     return Case(name=name, description=top["description"] or "", line=line, wind=wind, analysis=analysis,
-                source=Path(file) if file else None, codes=codes)
+                source=Path(file) if file else None, codes=codes, wires=wires, tower_types=tower_types)
 
 
 def _build_wind(db_data: Any, wind_d: dict[str, Any], line: Line, ctx: ErrorContext, base_dir: Path | None) -> Wind:

@@ -1,4 +1,5 @@
-"""The case model: frozen dataclasses of one analysis case (line, towers, wind, analysis, codes).
+"""The case model: frozen dataclasses of one analysis case (line, towers, wires, tower types,
+wind, analysis, codes).
 
 A :class:`Case` is built and validated by :mod:`.case_load` from a TOML file; every field that
 has a :data:`~.case_schema.SCHEMA` default takes it from there (:func:`~.case_schema.schema_default`),
@@ -27,6 +28,7 @@ class Tower:
     support: str  # SUPPORT_TYPES
     angle: float = schema_default("line.towers.angle")  # [deg] line deviation, + = turning left
     insulator_length: float | None = None  # [m]; None = the line's default (suspension towers)
+    type: str | None = None  # with wires: the TowerType name (None: a single-wire case)
 
 
 @dataclass(frozen=True)
@@ -122,6 +124,8 @@ class Wind:
     profile_exponent: float = schema_default("wind.profile_exponent")  # [-] V(z) = v_ref (z / z_ref)^alpha
     reference_height: float | None = None  # [m]; None = mean clamp height above ground
     fft_length: str = schema_default("wind.fft_length")  # FFT_LENGTHS: the synthesis' transform length (docs/wind.md)
+    coherence_decay_y: float = schema_default("wind.coherence_decay_y")  # [-] C_y across the line (wires)
+    coherence_decay_z: float = schema_default("wind.coherence_decay_z")  # [-] C_z in height (wires)
 
 
 @dataclass(frozen=True)
@@ -163,6 +167,85 @@ class Codes:
 
 
 @dataclass(frozen=True)
+class Wire:
+    """One wire strung along the section (``[[wires]]``; docs/case-files.md "Every wire on the
+    tower"): a phase conductor or bundle, or a ground wire.  The conductor keys describe ONE
+    sub-conductor; a bundle of ``bundle`` sub-conductors acts as one wire (:attr:`weight_total`,
+    :attr:`area_total`, :attr:`ea`, :attr:`tension_total`, :attr:`drag_diameter`)."""
+
+    name: str
+    kind: str  # WIRE_KINDS
+    weight: float  # [N/m] one sub-conductor
+    diameter: float  # [m] one sub-conductor
+    area: float  # [m2] one sub-conductor
+    elastic_modulus: float  # [Pa]
+    tension: float  # [N] still-air H0 of one sub-conductor at clipping-in
+    drag_coefficient: float = schema_default("wires.drag_coefficient")  # [-]
+    bundle: int = schema_default("wires.bundle")  # [-] sub-conductors
+    bundle_spacing: float | None = None  # [m] recorded only
+    shielding: float = schema_default("wires.shielding")  # [-] bundle drag factor (1: none)
+
+    @property
+    def weight_total(self) -> float:
+        """Weight per unit length of the bundle, n W [N/m]."""
+        return self.bundle * self.weight
+
+    @property
+    def mass_per_length(self) -> float:
+        """Mass per unit length of the bundle, n W / g [kg/m] (g = 9.81 m/s2 as in paper Eq. 8)."""
+        return self.weight_total / GRAVITY
+
+    @property
+    def area_total(self) -> float:
+        """Cross-section of the bundle, n A [m2]."""
+        return self.bundle * self.area
+
+    @property
+    def ea(self) -> float:
+        """Axial stiffness of the bundle, n E A [N]."""
+        return self.elastic_modulus * self.area_total
+
+    @property
+    def tension_total(self) -> float:
+        """Still-air horizontal tension of the bundle, n H0 [N] (the sub-conductors' sag W L^2 / 8 H0 kept)."""
+        return self.bundle * self.tension
+
+    @property
+    def drag_diameter(self) -> float:
+        """Projected area per unit length the bundle's drag acts on, n D s [m] (s: ``shielding``;
+        1 = every sub-conductor loaded as if alone)."""
+        return self.bundle * self.diameter * self.shielding
+
+
+@dataclass(frozen=True)
+class Attachment:
+    """One wire's attachment on a tower type, in the tower frame (``attachments`` of a
+    ``[[tower_types]]`` table) [m]: ``y`` to the left of the line's centre, ``z`` above the
+    tower's ground at the point on the tower (a suspension insulator's top, a strain clamp)."""
+
+    wire: str
+    y: float  # [m] tower frame y, + = left looking along the line
+    z: float  # [m] above the tower's ground: the insulator's top (suspension) or the clamp (strain)
+    support: str  # SUPPORT_TYPES
+    insulator_length: float | None = None  # [m]; None = line.insulator_length (suspension only)
+
+
+@dataclass(frozen=True)
+class TowerType:
+    """One tower type (``[[tower_types]]``): where each wire hangs on it."""
+
+    name: str
+    attachments: tuple[Attachment, ...]
+
+    def attachment(self, wire: str) -> Attachment:
+        """The attachment carrying ``wire`` (KeyError when the type has none)."""
+        for a in self.attachments:
+            if a.wire == wire:
+                return a
+        raise KeyError(f"tower type {self.name!r} has no attachment of wire {wire!r}")
+
+
+@dataclass(frozen=True)
 class Case:
     """One analysis case: a line section, a wind and the analysis settings."""
 
@@ -173,6 +256,28 @@ class Case:
     description: str = schema_default("description")
     source: Path | None = None
     codes: Codes = field(default_factory=Codes)
+    wires: tuple[Wire, ...] = ()  # every wire of the section; () = the single wire of [line]
+    tower_types: tuple[TowerType, ...] = ()  # with wires: the types line.towers[k].type names
+
+    @property
+    def has_wires(self) -> bool:
+        """True when the case gives its wires (``[[wires]]``); its ``line`` is then the first
+        wire's single-wire line (:func:`~linecheck.core.case_wires.wire_case`)."""
+        return bool(self.wires)
+
+    def wire(self, name: str) -> Wire:
+        """The wire called ``name`` (KeyError when there is none)."""
+        for w in self.wires:
+            if w.name == name:
+                return w
+        raise KeyError(f"no wire {name!r}")
+
+    def tower_type(self, name: str) -> TowerType:
+        """The tower type called ``name`` (KeyError when there is none)."""
+        for t in self.tower_types:
+            if t.name == name:
+                return t
+        raise KeyError(f"no tower type {name!r}")
 
     @property
     def g_yp(self) -> float:

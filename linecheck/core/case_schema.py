@@ -9,7 +9,7 @@ public contract (``docs/case-files.md``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 SUPPORT_TYPES = ("strain", "suspension")
@@ -35,6 +35,12 @@ DRAG_DIRECTIONS = ("cross-flow", "horizontal-normal")
 # Conductor self-damping assumed with the quasi-steady model (ratio at the lowest mean-state
 # mode, stiffness-proportional): it damps the axial modes that no aerodynamic model damps.
 DEFAULT_STRUCTURAL_DAMPING = 0.002
+WIRE_KINDS = ("phase", "ground")  # [[wires]] kind
+# [wind] coherence_decay_y, coherence_decay_z (one wind for every wire): the decay constants C_y,
+# C_z of the exponential coherence across the line and in height (its form: docs/wind.md "Many
+# wires"); defaults C_y = 16, C_z = 10 as in Simiu & Scanlan, "Wind Effects on Structures" (3rd ed.,
+# Wiley 1996, Sect. 2.3, after Vellozzi & Cohen 1968) -- quoted as the literature quotes them, not
+# checked against the book's page.
 
 
 @dataclass(frozen=True)
@@ -87,6 +93,16 @@ def _i(name, unit, help, default=None, required=False, low=None, high=None):
     return FieldSpec(name, "int", unit, help, default, required, low, high)
 
 
+# The conductor keys of [line], declared once: [[wires]] (WIRE_SCHEMA) reuses their names, units
+# and ranges, so a range and its message live here only.
+_WEIGHT = _f("weight", "N/m", "conductor weight per unit length W", required=True, low=0.0, high=1000.0, low_open=True)
+_DIAMETER = _f("diameter", "m", "projected area per unit length D, i.e. the diameter of a single conductor (paper Table 1)", required=True, low=0.0, high=1.0, low_open=True)
+_DRAG_COEFFICIENT = _f("drag_coefficient", "-", "drag coefficient C_d", default=1.0, low=0.0, high=3.0, low_open=True)
+_AREA = _f("area", "m2", "conductor cross-section A", required=True, low=0.0, high=0.1, low_open=True)
+_ELASTIC_MODULUS = _f("elastic_modulus", "Pa", "elastic modulus E", required=True, low=1e8, high=1e12)
+_INSULATOR_LENGTH = _f("insulator_length", "m", "suspension insulator length v", default=4.0, low=0.0, high=20.0, low_open=True)
+_TENSION = _f("tension", "N", "section form: still-air horizontal tension H0 at clipping-in", low=0.0, high=1e7, low_open=True)
+
 SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
     "": (
         FieldSpec("name", "str", "", "case name (default: file stem)"),
@@ -96,17 +112,17 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         _i("spans", "-", "number of spans in the modelled section (equal-span form)", low=1, high=200),
         _f("span_length", "m", "span length L_x (equal-span form)", low=10.0, high=3000.0),
         _f("sag", "m", "still-air mid-span sag S (equal-span form)", low=0.0, high=None, low_open=True),
-        _f("weight", "N/m", "conductor weight per unit length W", required=True, low=0.0, high=1000.0, low_open=True),
-        _f("diameter", "m", "projected area per unit length D, i.e. the diameter of a single conductor (paper Table 1)", required=True, low=0.0, high=1.0, low_open=True),
-        _f("drag_coefficient", "-", "drag coefficient C_d", default=1.0, low=0.0, high=3.0, low_open=True),
-        _f("area", "m2", "conductor cross-section A", required=True, low=0.0, high=0.1, low_open=True),
-        _f("elastic_modulus", "Pa", "elastic modulus E", required=True, low=1e8, high=1e12),
+        _WEIGHT,
+        _DIAMETER,
+        _DRAG_COEFFICIENT,
+        _AREA,
+        _ELASTIC_MODULUS,
         _f("height", "m", "average conductor elevation (equal-span form)", low=1.0, high=500.0),
-        _f("insulator_length", "m", "suspension insulator length v", default=4.0, low=0.0, high=20.0, low_open=True),
+        _INSULATOR_LENGTH,
         FieldSpec("supports", "str_list", "-", 'one per tower: "strain" or "suspension"', choices=SUPPORT_TYPES),
         _i("tower_of_interest", "-", "1-based tower whose reactions are reported", default=1, low=1),
         _i("elements_per_span", "-", "cable finite elements per span (step 2)", default=10, low=2, high=200),
-        _f("tension", "N", "section form: still-air horizontal tension H0 at clipping-in", low=0.0, high=1e7, low_open=True),
+        _TENSION,
         FieldSpec("towers_file", "str", "", "section form: CSV tower table (same columns as [[line.towers]]), relative to the case file"),
     ),
     "line.towers": (  # one [[line.towers]] table (or CSV row) per tower, in line order (the section form)
@@ -117,6 +133,7 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         FieldSpec("support", "choice", "-", '"strain" or "suspension"; both end towers "strain"', required=True, choices=SUPPORT_TYPES),
         _f("angle", "deg", "horizontal deviation of the line at the tower, + = turning left; 0 at the end towers", default=0.0, low=-90.0, high=90.0, low_open=True),
         _f("insulator_length", "m", "suspension insulator length (default: line.insulator_length); suspension towers only", low=0.0, high=20.0, low_open=True),
+        FieldSpec("type", "str", "", "with [[wires]]: the tower's [[tower_types]] name (required then, and height, support and insulator_length are not given: the type's attachments place each wire)"),
     ),
     "wind": (
         FieldSpec("type", "choice", "-", "wind type", required=True, choices=WIND_TYPES),
@@ -124,6 +141,8 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         _f("turbulence_intensity", "-", "turbulence intensity I", default=0.12, low=0.0, high=0.6),
         _f("air_density", "kg/m3", "air density rho", default=1.25, low=0.5, high=2.0),
         _f("coherence_decay", "-", "Davenport coherence decay constant C", default=10.0, low=0.0, high=100.0, low_open=True),
+        _f("coherence_decay_y", "-", "with [[wires]]: exponential coherence decay constant C_y for separations across the line (tower frame y)", default=16.0, low=0.0, high=100.0, low_open=True),
+        _f("coherence_decay_z", "-", "with [[wires]]: exponential coherence decay constant C_z for separations in height", default=10.0, low=0.0, high=100.0, low_open=True),
         _f("length_scale", "m", "von Karman length scale L_u (default: synoptic 52/0.3, downburst D_j)", low=0.0, high=1e5, low_open=True),
         FieldSpec("span_speeds", "float_list", "m/s", "synoptic only: mean speed per span (default v_ref on every span)", low=0.0, high=150.0),
         _f("direction", "deg", "mean wind vector V (sin d, cos d, 0): 0 = +y, normal to the first span", default=0.0, low=-360.0, high=360.0),
@@ -172,13 +191,55 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
 }
 
 
+def _per_wire(spec: FieldSpec, help: str, **changes: Any) -> FieldSpec:
+    """A [line] key as a [[wires]] key: its name, unit and range kept, its help said per wire."""
+    return replace(spec, help=help, **changes)
+
+
+#: The multi-wire tables (docs/case-files.md "Every wire on the tower"): ``[[wires]]`` (one per
+#: wire), ``[[tower_types]]`` (one per tower type) and each type's ``attachments`` (one inline
+#: table per wire).  Arrays of tables, kept apart from :data:`SCHEMA` (whose tables the TUI
+#: parameter editor and the Excel inputs sheet list key by key); the loader, the dataclasses'
+#: defaults and ``docs/case-files.md`` read both.  The conductor keys are [line]'s specs.
+WIRE_SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
+    "wires": (
+        FieldSpec("name", "str", "", "wire label, unique; the attachments name it", required=True),
+        FieldSpec("kind", "choice", "-", '"phase" (a phase conductor or bundle) or "ground" (a ground or earth wire)', required=True, choices=WIRE_KINDS),
+        _per_wire(_WEIGHT, "weight per unit length W of one sub-conductor (the bundle: bundle x W)"),
+        _per_wire(_DIAMETER, "diameter D of one sub-conductor (the bundle's drag acts on bundle x D x shielding)"),
+        _DRAG_COEFFICIENT,
+        _per_wire(_AREA, "cross-section A of one sub-conductor (the bundle: bundle x A)"),
+        _ELASTIC_MODULUS,
+        _per_wire(_TENSION, "still-air horizontal tension H0 of one sub-conductor at clipping-in (the bundle: bundle x H0)", required=True),
+        _i("bundle", "-", "number of sub-conductors acting as one wire (1: a single conductor)", default=1, low=1, high=12),
+        _f("bundle_spacing", "m", "distance between neighbouring sub-conductors (recorded, not used by the analysis); bundles only", low=0.0, high=2.0, low_open=True),
+        _f("shielding", "-", "bundle drag factor: the bundle's drag is bundle x D x shielding times C_d (1: no shielding, each sub-conductor loaded as if alone); bundles only", default=1.0, low=0.0, high=1.0, low_open=True),
+    ),
+    "tower_types": (  # one [[tower_types]] table per type; its attachments: the next table
+        FieldSpec("name", "str", "", "tower type label, unique; [[line.towers]] type names it", required=True),
+    ),
+    "tower_types.attachments": (  # attachments = [{ wire = "A", y = ..., z = ..., support = ... }, ...]: one per wire
+        FieldSpec("wire", "str", "", "the [[wires]] name this attachment carries (every wire once per type)", required=True),
+        _f("y", "m", "attachment point to the left of the line's centre (tower frame y, + = left looking along the line)", required=True, low=-100.0, high=100.0),
+        _f("z", "m", "attachment point above the tower's ground: the insulator's top at a suspension attachment, the clamp at a strain one", required=True, low=0.0, high=500.0, low_open=True),
+        FieldSpec("support", "choice", "-", '"strain" or "suspension"; "strain" at both end towers', required=True, choices=SUPPORT_TYPES),
+        replace(_INSULATOR_LENGTH, default=None, help="suspension insulator length (default: line.insulator_length); suspension attachments only"),
+    ),
+}
+
 
 def field_spec(section: str, key: str) -> FieldSpec:
-    """The :class:`FieldSpec` of ``section.key`` (``section`` "" for top level)."""
-    for spec in SCHEMA[section]:
+    """The :class:`FieldSpec` of ``section.key`` (``section`` "" for top level; a
+    :data:`WIRE_SCHEMA` table such as ``"wires"`` too)."""
+    for spec in schema_table(section):
         if spec.name == key:
             return spec
     raise KeyError(f"{section}.{key}")
+
+
+def schema_table(section: str) -> tuple[FieldSpec, ...]:
+    """The key specs of one table of :data:`SCHEMA` or :data:`WIRE_SCHEMA`."""
+    return SCHEMA[section] if section in SCHEMA else WIRE_SCHEMA[section]
 
 
 def schema_default(dotted_key: str) -> Any:

@@ -26,6 +26,8 @@ from .errors import CaseError
 # is refused without quoting its content.
 _COLUMN_TOKEN = re.compile(r"[A-Za-z_][A-Za-z0-9_ .-]{0,31}")
 MAX_QUOTED_CELL = 40  # [characters] a longer cell is described by its length, not quoted
+#: the columns a tower table of a case with [[wires]] needs (height and support come from the type)
+TYPED_TOWER_COLUMNS = ("station", "type")
 
 
 def _not_a_tower_table(path: Path) -> CaseError:
@@ -55,8 +57,10 @@ def cell_text(cell: str) -> str:
 
 
 
-def read_towers_csv(path: Path) -> list[tuple[dict[str, Any], int]]:
+def read_towers_csv(path: Path, typed: bool = False) -> list[tuple[dict[str, Any], int]]:
     """Rows of a tower CSV as raw dicts (numbers parsed) with their 1-based CSV record numbers.
+    ``typed``: the towers of a case with ``[[wires]]``, whose required columns are ``station``
+    and ``type`` (the type's attachments give each wire's height and support).
 
     The same text rule as TOML strings (:data:`~.case_validate.CONTROL_CHARS`: no control
     characters, a quoted newline included) holds for every cell; a leading byte-order mark is
@@ -65,7 +69,7 @@ def read_towers_csv(path: Path) -> list[tuple[dict[str, Any], int]]:
     numbered = _csv_records(path)
     head_row, header = numbered[0]
     header = [h.strip() for h in header]
-    _check_tower_header(path, head_row, header)
+    _check_tower_header(path, head_row, header, typed)
     specs = {sp.name: sp for sp in SCHEMA["line.towers"]}
     return [(_tower_row(path, header, specs, row_no, r), row_no) for row_no, r in numbered[1:]]
 
@@ -85,9 +89,10 @@ def _csv_records(path: Path) -> list[tuple[int, list[str]]]:
     return numbered
 
 
-def _check_tower_header(path: Path, head_row: int, header: list[str]) -> None:
+def _check_tower_header(path: Path, head_row: int, header: list[str], typed: bool) -> None:
     """Refuse a header row that is not a tower header, or names an unknown column, repeats a
-    column or lacks a required one (``head_row``: its 1-based record number)."""
+    column or lacks a required one (``head_row``: its 1-based record number; ``typed``: the
+    towers of a case with ``[[wires]]``)."""
     if not _reads_as_tower_header(header):
         raise _not_a_tower_table(path)
     for h in header:
@@ -100,10 +105,12 @@ def _check_tower_header(path: Path, head_row: int, header: list[str]) -> None:
     if repeated:
         raise CaseError(f"header repeats column {fmt_value(repeated[0])}: expected each of {', '.join(TOWER_COLUMNS)} at most once",
                         file=str(path), key=f"row {head_row}")
-    for spec in SCHEMA["line.towers"]:
-        if spec.required and spec.name not in header:
-            raise CaseError(f"missing column {fmt_value(spec.name)}: expected the columns {', '.join(TOWER_COLUMNS)} "
-                            f"(required: station, height, support)", file=str(path), key=f"row {head_row}")
+    required = TYPED_TOWER_COLUMNS if typed else tuple(spec.name for spec in SCHEMA["line.towers"] if spec.required)
+    for name in required:
+        if name not in header:
+            raise CaseError(f"missing column {fmt_value(name)}: expected the columns {', '.join(TOWER_COLUMNS)} "
+                            f"(required: {', '.join(required)}{' with [[wires]]' if typed else ''})", file=str(path),
+                            key=f"row {head_row}")
 
 
 def _tower_row(path: Path, header: list[str], specs: dict[str, FieldSpec], row_no: int, r: list[str]) -> dict[str, Any]:

@@ -1,4 +1,5 @@
-"""Validation of a parsed case document against :data:`~.case_schema.SCHEMA`.
+"""Validation of a parsed case document against :data:`~.case_schema.SCHEMA`
+(and :data:`~.case_schema.WIRE_SCHEMA`).
 
 Checks each table's keys for name, type and range and fills the defaults (:func:`read_section`),
 refuses control characters and absurd nesting (:func:`check_text`), and builds the one-line
@@ -17,11 +18,13 @@ from pathlib import Path
 from typing import Any
 
 from .case_model import GRAVITY, Case
-from .case_schema import SCHEMA, FieldSpec
+from .case_schema import FieldSpec, schema_table
 from .errors import CaseError
 
 #: tables a table may hold (not keys of :data:`SCHEMA`): the top level's and ``[wind]``'s
 SUBTABLES = {"": ("line", "wind", "analysis", "codes"), "wind": ("downburst",)}
+#: arrays of tables a table may hold, checked by their own builders (:mod:`.case_wires`)
+ARRAY_TABLES = {"": ("tower_types", "wires")}
 
 
 #: Bulk density of a conductor, W / (g pi D^2 / 4) [kg/m3], outside which ``line.weight`` is
@@ -37,33 +40,48 @@ MAX_NESTING = 16  # deepest table/array nesting a case file needs is 3 ([wind.do
 
 def case_warnings(case: Case) -> list[str]:
     """One-line warnings about values the schema allows but that are probably mistyped: the
-    weight against the conductor's bulk density (:data:`DENSITY_RANGE`).  Names the file (and
-    line when the file is readable), key, value and what is expected.  Never prints."""
-    out: list[str] = []
-    ln = case.line
-    density = ln.weight / (GRAVITY * math.pi * ln.diameter**2 / 4.0)
-    low, high = DENSITY_RANGE
-    if not low <= density <= high:
-        text = None
-        if case.source is not None:
-            try:
-                text = Path(case.source).read_text(encoding="utf-8", errors="replace")
-            except OSError:
-                text = None
-        where = ""
-        if case.source is not None:
-            line_no = find_line(text, "line", "weight")
-            where = f"{case.source}" + (f":{line_no}" if line_no is not None else "") + ": "
-        if density < low:
-            hint = (f"a weight in kg/m? In N/m it would be {ln.weight:g} x {GRAVITY:g} = "
-                    f"{ln.weight * GRAVITY:.4g} N/m")
-        else:
-            hint = (f"a bundle's weight with one sub-conductor's diameter, or a unit slip? "
-                    f"{high:,.0f} kg/m3 would be a weight of {high * GRAVITY * math.pi * ln.diameter**2 / 4.0:.4g} N/m")
-        out.append(f"{where}line.weight: value {ln.weight:g} N/m with diameter {ln.diameter:g} m gives a "
-                   f"bulk density W/(g pi D^2/4) of {density:,.0f} kg/m3, outside {low:,.0f}-{high:,.0f} "
-                   f"(the paper's conductor: 4,805): {hint}")
+    weight against the conductor's bulk density (:data:`DENSITY_RANGE`), of ``[line]`` or, with
+    ``[[wires]]``, of each wire's sub-conductor.  Names the file (and line when the file is
+    readable), key, value and what is expected.  Never prints."""
+    if case.has_wires:
+        checks = [(f"wires[{k + 1}]", lambda text, k=k: array_table_line(text, "wires", k, "weight"), w.weight, w.diameter)
+                  for k, w in enumerate(case.wires)]
+    else:
+        checks = [("line", lambda text: find_line(text, "line", "weight"), case.line.weight, case.line.diameter)]
+    out = []
+    for table, line_of, weight, diameter in checks:
+        message = _density_warning(case, table, line_of, weight, diameter)
+        if message is not None:
+            out.append(message)
     return out
+
+
+def _density_warning(case: Case, table: str, line_of, weight: float, diameter: float) -> str | None:
+    """The bulk-density warning of ``table``'s ``weight`` [N/m] and ``diameter`` [m], or None;
+    ``line_of(text)``: the weight's file line."""
+    density = weight / (GRAVITY * math.pi * diameter**2 / 4.0)
+    low, high = DENSITY_RANGE
+    if low <= density <= high:
+        return None
+    text = None
+    if case.source is not None:
+        try:
+            text = Path(case.source).read_text(encoding="utf-8", errors="replace")
+        except OSError:
+            text = None
+    where = ""
+    if case.source is not None:
+        line_no = line_of(text)
+        where = f"{case.source}" + (f":{line_no}" if line_no is not None else "") + ": "
+    if density < low:
+        hint = (f"a weight in kg/m? In N/m it would be {weight:g} x {GRAVITY:g} = "
+                f"{weight * GRAVITY:.4g} N/m")
+    else:
+        hint = (f"a bundle's weight with one sub-conductor's diameter, or a unit slip? "
+                f"{high:,.0f} kg/m3 would be a weight of {high * GRAVITY * math.pi * diameter**2 / 4.0:.4g} N/m")
+    return (f"{where}{table}.weight: value {weight:g} N/m with diameter {diameter:g} m gives a "
+            f"bulk density W/(g pi D^2/4) of {density:,.0f} kg/m3, outside {low:,.0f}-{high:,.0f} "
+            f"(the paper's conductor: 4,805): {hint}")
 
 
 def find_line(text: str | None, section: str, key: str | None) -> int | None:
@@ -94,6 +112,41 @@ class ErrorContext:
     def error(self, section: str, key: str | None, message: str) -> CaseError:
         dotted = f"{section}.{key}" if section and key else (key or section or None)
         return CaseError(message, file=self.file, key=dotted, line=find_line(self.text, section, key))
+
+
+def array_table_line(text: str | None, array: str, k: int, key: str | None) -> int | None:
+    """1-based file line of ``key`` in the k-th (0-based) ``[[array]]`` table (``array`` dotted,
+    e.g. ``"line.towers"``, ``"wires"``), or of its header when key is None."""
+    if text is None:
+        return None
+    header = re.compile(r"^\[\[\s*" + r"\s*\.\s*".join(re.escape(p) for p in array.split(".")) + r"\s*\]\]")
+    count = -1
+    inside = False
+    for n, raw in enumerate(text.splitlines(), start=1):
+        stripped = raw.strip()
+        if stripped.startswith("["):
+            inside = header.match(stripped) is not None
+            if inside:
+                count += 1
+                if count == k and key is None:
+                    return n
+            continue
+        if inside and count == k and key is not None and re.match(rf"^\s*\"?{re.escape(key)}\"?\s*=", raw):
+            return n
+    return None
+
+
+class ItemContext(ErrorContext):
+    """Error context of the k-th (0-based) table of an array of tables: messages name
+    ``array[k+1].key`` (``wires[2].weight``) and the key's line in that table."""
+
+    def __init__(self, ctx: ErrorContext, array: str, k: int) -> None:
+        super().__init__(ctx.file, ctx.text)
+        self.array, self.k = array, k
+
+    def error(self, section: str, key: str | None, message: str) -> CaseError:
+        dotted = f"{self.array}[{self.k + 1}]" + (f".{key}" if key else "")
+        return CaseError(message, file=self.file, key=dotted, line=array_table_line(self.text, self.array, self.k, key))
 
 
 FMT_LIST_ITEMS = 5  # a list in a message shows its first items and its length, never the whole list
@@ -183,18 +236,23 @@ def check_value(spec: FieldSpec, v: Any, ctx: ErrorContext, section: str) -> Any
     raise ValueError(spec.kind)  # pragma: no cover - schema bug
 
 
-def read_section(data: dict, section: str, ctx: ErrorContext) -> dict[str, Any]:
-    """Validate the keys of one table against :data:`SCHEMA`; fill defaults."""
-    specs = {s.name: s for s in SCHEMA[section]}
+def read_section(data: dict, section: str, ctx: ErrorContext, optional: tuple[str, ...] = ()) -> dict[str, Any]:
+    """Validate the keys of one table against :data:`SCHEMA` (or :data:`WIRE_SCHEMA`); fill
+    defaults.  ``optional``: required keys this table may leave out here (their default, None,
+    is filled; the caller decides)."""
+    specs = {s.name: s for s in schema_table(section)}
     subtables = set(SUBTABLES.get(section, ()))
+    arrays = set(ARRAY_TABLES.get(section, ()))
     out: dict[str, Any] = {}
     for key, value in data.items():
         if key in subtables:
             if not isinstance(value, dict):
                 raise ctx.error(section, key, f"value {fmt_value(value)} is not allowed: expected a table [{(section + '.') if section else ''}{key}]")
             continue
+        if key in arrays:
+            continue
         if key not in specs:
-            candidates = list(specs) + sorted(subtables)
+            candidates = list(specs) + sorted(subtables | arrays)
             close = difflib.get_close_matches(key, candidates, n=1, cutoff=0.5)
             hint = f'; did you mean "{close[0]}"?' if close else ""
             where = f"[{section}]" if section else "the top level"
@@ -203,7 +261,7 @@ def read_section(data: dict, section: str, ctx: ErrorContext) -> dict[str, Any]:
         out[key] = check_value(specs[key], value, ctx, section)
     for name, spec in specs.items():
         if name not in out:
-            if spec.required:
+            if spec.required and name not in optional:
                 raise ctx.error(section, name, f"missing required key: expected {spec.allowed()}")
             out[name] = spec.default
     return out

@@ -15,6 +15,7 @@ from ..core.loads import synoptic_load_per_v, to_global_nodes
 from ..core.model import LinearModel, build_model
 from .record import record_mean_wind
 from .step1 import StaticResult
+from .uplift import require_tension
 
 
 def damping_matrices(case: Case, st: StaticResult, models: list[LinearModel], states: list[int] | None = None,
@@ -55,6 +56,7 @@ def synoptic_model(case: Case, st: StaticResult, *, vectors: bool = True, omega1
     frequency-domain check need them); ``omega1`` [rad/s]: see :func:`damping_matrices`."""
     from ..core.spectral import complex_modes
 
+    require_tension(st)
     system = st.system
     model = build_model(system, st.mean.state(0))
     damping = damping_matrices(case, st, [model], omega1=omega1)[0]

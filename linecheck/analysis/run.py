@@ -43,6 +43,7 @@ from .record import (
 )
 from .spectral_check import SpectralResult, spectral_analysis
 from .step1 import Progress, StaticResult, static_result
+from .uplift import require_tension
 from .windows import windowed
 
 if TYPE_CHECKING:  # names of annotations only
@@ -293,6 +294,7 @@ def plan_run(case: Case, *, realizations, interpolate_states: bool, spectral_che
     threads = _guard(case, n_real, threads, spectral_check, lambda m: (warned.append(m), warn(m) if warn else None))
     real = np.arange(n_real) if realizations is None else np.asarray(realizations, dtype=int)
     st = static_result(case, progress=progress, cancel=cancel)
+    require_tension(st)  # the models linearise about the mean states: every insulator hanging
     system, mean = st.system, st.mean
     models, damping, sm, burn, windows = _linearise(case, st)
     t = analysed = record_time(case)

@@ -18,6 +18,7 @@ from .burnin import synoptic_burn_in
 from .guard import Warn, check_budget
 from .record import record_mean_wind, record_time, with_burn_in
 from .step1 import StaticResult, static_analysis
+from .uplift import require_tension
 
 
 @dataclass(frozen=True)
@@ -146,6 +147,7 @@ def loads_from_field(case: Case, field: dict[str, np.ndarray]) -> tuple[np.ndarr
     Eq. 5) from a wind field's arrays (``WindField.to_npz_dict`` or :func:`read_wind_field`):
     loads [N] (n_t, 1, n_free) and the direct reactions [N] (n_t, 1, 3 n_towers)."""
     st = static_analysis(case)
+    require_tension(st)
     model = build_model(st.system, st.mean.state(0))
     u = field["u_mean"]
     if _wind_vectors(case, st.system):

@@ -6,7 +6,7 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from ..core.errors import CaseError
+from ..core.errors import CaseError, ConvergenceError
 from ..core.names import REACTIONS
 from ..io.atomic import check_target
 from ..io.display import kn
@@ -35,8 +35,24 @@ def check(cases: CasesArg) -> None:
                       highlight=False)
         if case.line.is_section:
             console.print(f"   section: {escape(section_line(case))}", highlight=False, soft_wrap=True)
+            _warn_uplift(case)
     if failed:
         raise typer.Exit(2)
+
+
+def _warn_uplift(case) -> None:
+    """Step 1 of a section (still air and the mean wind) for its uplift: one warning line when a
+    suspension insulator would be in compression (:func:`linecheck.analysis.uplift.uplift_warning`).
+    The equal-span form has level clamps and cannot lift."""
+    from ..analysis.step1 import static_result
+    from ..analysis.uplift import uplift_warning
+
+    try:
+        message = uplift_warning(static_result(case))
+    except ConvergenceError as err:
+        message = f"uplift not checked: step 1 found no equilibrium: {err}"
+    if message:
+        limits_warn(message)
 
 
 def section_line(case) -> str:
@@ -58,12 +74,13 @@ def static_table(doc: dict, name: str) -> Table:
     """The console table of a step-1 document (:func:`linecheck.io.jsonout.static_to_dict`): the
     same numbers as its JSON, every tower's reactions in its own frame (``heading``: its x axis
     from the global x, sections only).  Downburst: each row is the instant of that tower's
-    largest wind-induced |Ry|."""
+    largest wind-induced |Ry|.  ``weight span``: a suspension tower's R_z / W, ``!`` where its clamp
+    is held at its still-air point (uplift)."""
     towers = doc["towers"]
     section = "name" in towers[0]
     table = Table(title=f"{name}: step-1 mean reactions (kN), each tower in its own frame", title_justify="left")
     names = ("name", "station (m)", "heading (deg)") if section else ()
-    for col in ("tower", *names, "support", *REACTIONS, *(f"{r} wind" for r in REACTIONS)):
+    for col in ("tower", *names, "support", "weight span (m)", *REACTIONS, *(f"{r} wind" for r in REACTIONS)):
         table.add_column(col, justify="left" if col == "name" else "right")
     toi = doc["tower_of_interest"]
     for t in towers:
@@ -72,9 +89,19 @@ def static_table(doc: dict, name: str) -> Table:
         ident = (escape(t["name"]), f"{t['station']:g}", f"{t['heading']:.1f}") if section else ()
         table.add_row(
             f"{t['index']}{' *' if t['index'] == toi else ''}", *ident, t["support"],
+            _weight_span_cell(t.get("uplift"), k),
             *(f"{kn(_at(t[c], k)):.3f}" for c in (*REACTIONS, *(f"{r}_wind" for r in REACTIONS))),
         )
     return table
+
+
+def _weight_span_cell(u: dict | None, k: int) -> str:
+    """A tower's weight span [m] at instant ``k`` of a step-1 document, ``!`` when its clamp is held
+    (uplift); ``-`` at a strain tower."""
+    if u is None:
+        return "-"
+    held = u["held"][k] if isinstance(u["held"], list) else u["held"]
+    return f"{_at(u['weight_span'], k):.1f}{' !' if held else ''}"
 
 
 @app.command()
@@ -82,7 +109,7 @@ def static_table(doc: dict, name: str) -> Table:
 def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     """Step 1: non-linear static analysis under the (running-)mean wind."""
     from .. import service
-    from ..io.display import tower_frame_caption
+    from ..io.display import UPLIFT_CONSEQUENCE, tower_frame_caption, uplift_static_lines
     from ..io.jsonout import static_to_dict, write_json
 
     case = read_case(case_file)
@@ -96,7 +123,13 @@ def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     console.print(static_table(doc, case.name))
     console.print(f"[dim]* tower of interest (line.tower_of_interest = {case.line.tower_of_interest}); Rx, Ry, Rz total "
                   "reactions (conductor weight included), \"wind\" their wind-induced part (still air subtracted); "
-                  f"{escape(tower_frame_caption(straight=res.system.straight_in_plan))}.[/]", highlight=False)
+                  f"{escape(tower_frame_caption(straight=res.system.straight_in_plan))}; weight span: a "
+                  "suspension tower's Rz / W, the conductor length whose weight it carries.[/]", highlight=False)
+    lifted = uplift_static_lines(doc)
+    for line in lifted:
+        console.print(f"[bold yellow]{escape(line)}[/]", highlight=False, soft_wrap=True)
+    if lifted:
+        console.print(f"[yellow]! {escape(UPLIFT_CONSEQUENCE)}.[/]", highlight=False, soft_wrap=True)
     series = case.wind.type == "downburst"
     tens = ", ".join(f"{kn(h):.2f}" for h in (m.tension.max(axis=0) if series else m.tension[0]))
     console.print(f"span tensions H (kN{', largest over the event' if series else ''}): {tens}   "

@@ -13,7 +13,7 @@ from ..core.case import Case
 from ..core.extremes import CONT_R_THRESHOLD as CONT_R_FLAG  # Cont_R flag, paper Sect. 5 (one definition)
 from ..core.names import REACTIONS
 from ..io.atomic import check_target
-from ..io.display import STAT_ROWS, SUMMARY_STATS, number_text, stat_text
+from ..io.display import STAT_ROWS, SUMMARY_STATS, number_text, stat_text, uplift_run_text
 from ..io.document import RunDocument, StatDef
 from ..io.outputs import case_inputs, check_outputs
 from .common import CaseArg, JsonOpt, app, console, handle_errors, read_case
@@ -271,6 +271,9 @@ def _print_run(doc: RunDocument, case: Case, names: tuple[str, ...], no_check: b
     for note in stats_notes(doc):
         console.print(f"[dim]{note}[/]", highlight=False)
     print_legend(doc)
+    uplift = uplift_run_text(doc)
+    if uplift is not None:
+        console.print(f"[dim]{escape(uplift)}[/]", highlight=False)
     if names:
         console.print(models_table(doc))
     from .spectral_cmd import print_sanity

@@ -101,6 +101,7 @@ def _case_tables(cur: Cursor, doc: RunDocument, section: Line | None, threshold:
         _models_table(cur, doc)
     contrib_rows = _contributions_table(cur, doc, threshold, flagged)
     _towers_table(cur, doc, section)
+    _uplift_table(cur, doc, section)
     if doc.spectral is not None:
         _spectral(cur, doc, doc.spectral)
     elif doc.wind == "synoptic":
@@ -407,6 +408,34 @@ def _towers_table(cur: Cursor, doc: RunDocument, section: Line | None = None) ->
             cur.put(cur.row, 6 + k, kn(t.reactions[r]["mean_max"].mean), fmt=KN)
         cur.row += 1
     cur.note("* tower of interest; peaks are means over the realizations, wind-induced.")
+
+
+def _uplift_table(cur: Cursor, doc: RunDocument, section: Line | None = None) -> None:
+    """Every suspension tower's uplift (``towers[].uplift``): the vertical margin R_z [kN] and the
+    weight span R_z / W [m] in still air and at the mean state of the smallest margin."""
+    rows = [t for t in doc.towers if t.uplift is not None]
+    if not rows:
+        return
+    names = [r.name for r in tower_rows(section)] if section is not None else []
+    series = doc.wind == "downburst"
+    cur.section("Suspension towers: uplift margin (vertical force on the clamp) and weight span")
+    cur.header(["Tower", "", "margin still air", "weight span still air", "margin mean", "weight span mean",
+                "at t (s)" if series else ""])
+    cur.header(["", "", "(kN)", "(m)", "(kN)", "(m)", ""])
+    for t in rows:
+        u = t.uplift
+        name = f" {names[t.index - 1]}" if 0 < t.index <= len(names) else ""
+        cur.put(cur.row, 1, f"{t.index}{name}{' *' if t.index == doc.tower_of_interest else ''}", "lc_text")
+        cur.put(cur.row, 3, kn(u.still_air.get("margin")), fmt=KN3)
+        cur.put(cur.row, 4, u.still_air.get("weight_span"), fmt="0.0")
+        cur.put(cur.row, 5, kn(u.margin), fmt=KN3)
+        cur.put(cur.row, 6, u.weight_span, fmt="0.0")
+        if series and u.time is not None:
+            cur.put(cur.row, 7, u.time, fmt=SEC)
+        cur.row += 1
+    cur.note("margin: the conductor's downward vertical force on the clamp, R_z (mean: the smallest over the "
+             "step-1 mean states); negative would lift the insulator (uplift: a run refuses such a case, see "
+             "linecheck static). Weight span: R_z / W, the length of conductor whose weight the tower carries.")
 
 
 #: Davenport closed-form factors: key -> (unit, format); its GF_*/Cont_R use the statistics table.

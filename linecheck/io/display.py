@@ -144,3 +144,51 @@ def flag_state(doc: Any, reaction: str, threshold: float | None = None) -> str |
     if ci[0] > threshold:
         return "recommended"
     return "inconclusive" if ci[1] > threshold else None
+
+
+# --------------------------------------------------------------------------- uplift
+#: What step 1 does at an uplifting suspension tower and what it stops (docs/method.md, "Line sections").
+UPLIFT_CONSEQUENCE = ("a suspension insulator there would be in compression: step 1 holds the clamp at its "
+                      "still-air point in those states, and run, modes and spectral refuse the case")
+
+
+def _tower_name(t: Any) -> str:
+    """A run document tower's name (a section) or its 1-based index."""
+    return str((t.section or {}).get("name") or t.index)
+
+
+def uplift_run_text(doc: Any) -> str | None:
+    """One line on the smallest uplift margin of a run's suspension towers (a RunDocument's
+    ``towers[].uplift``), in kN and m; None when no tower records it."""
+    rows = [t for t in doc.towers if t.uplift is not None and t.uplift.margin is not None]
+    if not rows:
+        return None
+    t = min(rows, key=lambda r: r.uplift.margin)
+    u = t.uplift
+    when = f" at t = {u.time:.1f} s" if doc.wind == "downburst" and u.time is not None else ""
+    ws = "" if u.weight_span is None else f", weight span {u.weight_span:.1f} m"
+    return (f"uplift margin: smallest {kn_text(u.margin)} kN at tower {_tower_name(t)} under the mean wind{when}"
+            f"{ws} (still air {kn_text(u.still_air.get('margin'))} kN); every suspension insulator hangs in "
+            "tension (every tower: the JSON's towers[].uplift)")
+
+
+def uplift_static_lines(doc: dict[str, Any]) -> list[str]:
+    """One line per suspension tower of a step-1 JSON document (:func:`linecheck.io.jsonout.static_to_dict`)
+    whose clamp was held (uplift) in still air or in a mean state: its margins in kN and weight span in m."""
+    out = []
+    times = doc.get("time")
+    for t in doc["towers"]:
+        u = t.get("uplift")
+        if u is None:
+            continue
+        held = u["held"] if isinstance(u["held"], list) else [u["held"]]
+        margin = u["margin"] if isinstance(u["margin"], list) else [u["margin"]]
+        span = u["weight_span"] if isinstance(u["weight_span"], list) else [u["weight_span"]]
+        if not (any(held) or u["still_air"]["held"]):
+            continue
+        k = min(range(len(margin)), key=lambda i: margin[i] if margin[i] is not None else float("inf"))
+        when = f" at t = {times[k]:.1f} s" if times else ""
+        out.append(f"uplift at tower {t.get('name', t['index'])}: margin {kn_text(u['still_air']['margin'])} kN "
+                   f"in still air (weight span {u['still_air']['weight_span']:.1f} m), {kn_text(margin[k])} kN under "
+                   f"the mean wind{when} (weight span {span[k]:.1f} m)")
+    return out

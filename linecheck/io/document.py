@@ -46,6 +46,7 @@ from .result_blocks import (
     TimeHistories,
     TowerRecord,
     Until,
+    UpliftRecord,
     json_value,
     models_of,
     reactions_from_json,
@@ -71,8 +72,9 @@ __all__ = [
     "SECTION_TOWER_KEYS", "SPECTRAL_EXACT", "STAT_BY_NAME", "STAT_TABLE", "SUMMARY_KEYS", "BatchSource",
     "BurnInRecord", "CodeCheckRecord", "CodeTower", "CodeVerdict", "Davenport", "EnvelopeEntry", "FailedRun",
     "Gumbel", "ReactionResult", "RunDocument", "SanityCheckRow", "Spectral", "StatDef", "StatValue",
-    "StaticSeries", "StillAir", "TimeHistories", "TowerRecord", "Until", "document_of", "json_schema",
-    "load_document", "models_of", "reactions_of", "read_result_file", "section_tower", "stat_def",
+    "StaticSeries", "StillAir", "TimeHistories", "TowerRecord", "Until", "UpliftRecord", "document_of",
+    "json_schema", "load_document", "models_of", "reactions_of", "read_result_file", "section_tower", "stat_def",
+    "uplift_record",
 ]
 
 #: Optional typed blocks after ``"towers"``, in JSON order (absent from the JSON when None).
@@ -103,6 +105,20 @@ def section_tower(res: Any, k: int) -> dict[str, Any] | None:
         "global": {"still_air": {r: _f(still[c]) for c, r in enumerate(REACTIONS)},
                    "mean": {r: _f(total[big, c]) for c, r in enumerate(REACTIONS)}},
     }
+
+
+def uplift_record(res: Any, k: int) -> UpliftRecord | None:
+    """The uplift of tower k (0-based) of a run (:func:`linecheck.analysis.uplift.step1_uplift`):
+    the smallest margin [N] over the mean states, the weight span [m] and instant [s] there, and
+    the still-air values; None at a strain tower."""
+    from ..analysis.uplift import step1_uplift
+
+    u = step1_uplift(res.static)
+    if not u.suspension[k]:
+        return None
+    i = int(u.worst_state[k])
+    return UpliftRecord(_f(u.margin[i, k]), _f(u.weight_span[i, k]), _f(u.time[i]),
+                        {"margin": _f(u.margin_still_air[k]), "weight_span": _f(u.weight_span_still_air[k])})
 
 
 @dataclass(frozen=True)
@@ -199,7 +215,9 @@ class RunDocument:
             head = {k: d[k] for k, _ in HEADER_FIELDS}
             reactions = reactions_from_json(d["reactions"])
             towers = tuple(TowerRecord(int(t["index"]), t["support"], reactions_from_json(t["reactions"]),
-                                 {k: t[k] for k in SECTION_TOWER_KEYS if k in t} or None) for t in d["towers"])
+                                       {k: t[k] for k in SECTION_TOWER_KEYS if k in t} or None,
+                                       UpliftRecord.from_json(t["uplift"]) if "uplift" in t else None)
+                           for t in d["towers"])
             until = Until.from_json(d["until"]) if d.get("until") is not None else None
 
             def opt(key: str, read: Any) -> Any:
@@ -286,7 +304,8 @@ def document_of(res: Any, **blocks: Any) -> RunDocument:
         peak_window=case.analysis.peak_window, windows=int(res.windows),
         design_fractile=case.analysis.design_fractile,
         reactions=reactions_of(summary, j),
-        towers=tuple(TowerRecord(k + 1, case.line.supports[k], reactions_of(summary, k), section_tower(res, k))
+        towers=tuple(TowerRecord(k + 1, case.line.supports[k], reactions_of(summary, k), section_tower(res, k),
+                                 uplift_record(res, k))
                      for k in range(res.system.n_towers)),
         until=until, **blocks,
     )

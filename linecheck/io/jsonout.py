@@ -84,9 +84,22 @@ def _static_tower(case: Any, system: Any, m: Any, R: np.ndarray, R0: np.ndarray,
     return t
 
 
+def _static_uplift(u: Any, j: int, series: bool) -> dict[str, Any]:
+    """Suspension tower ``j``'s ``uplift`` in the step-1 JSON (a :class:`~linecheck.core.uplift.Uplift`):
+    ``margin`` [N] (R_z, negative: the insulator would be in compression), ``weight_span`` [m],
+    ``held`` (the clamp was held at its still-air point) and the same in ``still_air``; a downburst
+    lists margin, weight span and held over the step-1 instants."""
+    held = [bool(h) for h in u.held[:, j]]
+    return {"margin": _num(u.margin[:, j] if series else u.margin[0, j]),
+            "weight_span": _num(u.weight_span[:, j] if series else u.weight_span[0, j]),
+            "held": held if series else held[0],
+            "still_air": {"margin": _num(u.margin_still_air[j]), "weight_span": _num(u.weight_span_still_air[j]),
+                          "held": bool(u.held_still_air[j])}}
+
+
 def static_to_dict(res: StaticResult) -> dict[str, Any]:
     """Step-1 JSON: ``{"case", "units", "tower_of_interest", "towers": [...], "spans": [...],
-    "provenance"}``.
+    "provenance"}``; every suspension tower has ``"uplift"`` (:func:`_static_uplift`).
 
     Synoptic: one value per key.  Downburst: every value is a list over the
     step-1 instants and ``"time"`` lists them.
@@ -102,6 +115,11 @@ def static_to_dict(res: StaticResult) -> dict[str, Any]:
     R = system.to_tower_frames(m.reactions)
     R0 = system.to_tower_frames(still.reactions)
     towers = [_static_tower(case, system, m, R, R0, j, pick) for j in range(system.n_towers)]
+    from ..analysis.uplift import step1_uplift
+
+    u = step1_uplift(res)
+    for j in np.flatnonzero(u.suspension):
+        towers[j]["uplift"] = _static_uplift(u, int(j), series)
     spans = []
     for n in range(system.n_spans):
         sp = {

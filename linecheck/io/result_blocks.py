@@ -1,6 +1,6 @@
 """The typed values and blocks of a run-result document: statistics of a reaction, the Gumbel fit,
 the still-air, step-1, burn-in, spectral, design-code, time-history, batch-source and model-spread
-blocks, a tower's record and a failed run.
+blocks, a tower's record with its uplift and a failed run.
 
 Each has ``to_json()`` (the public JSON layout) and, where read back, ``from_json()``; values are
 kept exactly as read (a document read and written again is byte for byte the same).  Forces in
@@ -357,6 +357,19 @@ class EnvelopeEntry(_Block):
 
 
 @dataclass(frozen=True)
+class UpliftRecord(_Block):
+    """Uplift at a suspension tower (:mod:`linecheck.core.uplift`): ``margin`` [N], the smallest
+    vertical force of the conductor on the clamp (R_z, downward positive; negative: the insulator
+    would be in compression) over the step-1 mean states, ``weight_span`` [m] there (margin / W),
+    ``time`` [s] its instant, and ``still_air``: ``{"margin", "weight_span"}`` in still air."""
+
+    margin: float | None
+    weight_span: float | None
+    time: float | None
+    still_air: dict[str, float | None]
+
+
+@dataclass(frozen=True)
 class TowerRecord:
     """TowerRecord ``index`` (1-based): support type and its typed reaction blocks.
 
@@ -364,17 +377,22 @@ class TowerRecord:
     ``height``, ``angle`` [deg], ``insulator_length`` [m] (in force; null at strain towers),
     ``heading`` [deg] (its frame's x axis from the global x: the
     reactions are in that frame) and ``global``: the still-air and step-1 mean reactions in the
-    global frame (x along the first span, y to its left, z down)."""
+    global frame (x along the first span, y to its left, z down).  ``uplift``: a suspension
+    tower's :class:`UpliftRecord` (None, no ``"uplift"`` key: a strain tower, or a result saved
+    before it was recorded)."""
 
     index: int
     support: str
     reactions: dict[str, ReactionResult]
     section: dict[str, Any] | None = None
+    uplift: UpliftRecord | None = None
 
     def to_json(self) -> dict[str, Any]:
         d: dict[str, Any] = {"index": self.index, "support": self.support}
         if self.section is not None:
             d.update(self.section)
+        if self.uplift is not None:
+            d["uplift"] = self.uplift.to_json()
         d["reactions"] = reactions_to_json(self.reactions)
         return d
 

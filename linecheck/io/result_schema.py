@@ -149,8 +149,21 @@ def _towers_schema() -> dict[str, Any]:
                                   "step-1 mean reactions [N] in the global frame (x along the first span, "
                                   "y to its left, z down); the tower's reactions are in its own frame, "
                                   "x along heading"},
+                       "uplift": _uplift_schema(),
                        "reactions": {"$ref": "#/$defs/reactions"}},
         "required": ["index", "support", "reactions"], "additionalProperties": False}}
+
+
+def _uplift_schema() -> dict[str, Any]:
+    """Schema of a suspension tower's ``uplift`` (:class:`~linecheck.io.result_blocks.UpliftRecord`)."""
+    still = {"type": "object", "properties": {"margin": NUM_OR_NULL, "weight_span": NUM_OR_NULL},
+             "required": ["margin", "weight_span"], "additionalProperties": False}
+    return {"type": "object", "description": "suspension towers only (absent at strain towers): margin [N], the "
+            "smallest downward vertical force of the conductor on the clamp over the step-1 mean states "
+            "(negative: the insulator would be in compression, uplift), weight_span [m] = margin / conductor "
+            "weight per unit length there, time [s] its instant, and still_air: the same in still air",
+            "properties": {"margin": NUM_OR_NULL, "weight_span": NUM_OR_NULL, "time": NUM_OR_NULL, "still_air": still},
+            "required": ["margin", "weight_span", "time", "still_air"], "additionalProperties": False}
 
 
 def _properties() -> dict[str, Any]:

@@ -9,7 +9,7 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.widgets import DataTable, RadioButton, RadioSet, Static, TabbedContent, TabPane
 
-from ...io.display import STAT_ROWS, doc_frame_caption, kn_text, number_text
+from ...io.display import STAT_ROWS, doc_frame_caption, kn_text, number_text, uplift_run_text
 from ...io.document import RunDocument
 from .. import figures
 from ..formatting import (
@@ -158,6 +158,9 @@ class ResultsView(Vertical):
         if sa:
             notes.append("\nstill air: " + ", ".join(f"{r} {kn_text(v)} kN" for r, v in sa.items() if v is not None),
                          style="dim")
+        uplift = uplift_run_text(doc)
+        if uplift is not None:
+            notes.append("\n" + uplift, style="dim")
         self.query_one("#summary-notes", Static).update(notes)
 
     def _history(self) -> None:

@@ -133,8 +133,8 @@ tension = "linear"
 A real section is described by its towers instead of the equal-span keys: `[line] tension` (H0,
 the still-air horizontal tension at clipping-in) and either one `[[line.towers]]` table per
 tower, in line order, or `towers_file = "section.csv"` (a CSV with a header row and the same
-columns: `name, station, ground, height, support, angle, insulator_length`; blank cells take
-the default; `#` lines are comments). `spans`, `span_length`, `sag`, `height` and `supports`
+columns: `name, station, ground, height, support, angle, insulator_length`, and `type` with
+`[[wires]]`; blank cells take the default; `#` lines are comments). `spans`, `span_length`, `sag`, `height` and `supports`
 are then not given (the loader derives them for display: `span_length` is Eq. 17's L_x, the
 mean of the two spans adjacent to the tower of interest). `cases/examples/section-12span.toml`
 is a worked example. The definitions (plan geometry, clipping-in, loads, tower frames) are in

@@ -8,6 +8,7 @@ import sys
 import pytest
 
 CORE_MODULES = [
+    "linecheck.core.crossflow",
     "linecheck.core.case",
     "linecheck.core.case_schema",
     "linecheck.core.case_model",

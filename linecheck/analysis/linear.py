@@ -5,7 +5,7 @@ the burn-in, the frequency-domain check and the time domain share.  Nothing here
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -13,7 +13,7 @@ from ..core.case import Case
 from ..core.line_damping import damping_stack
 from ..core.loads import synoptic_load_per_v, to_global_nodes
 from ..core.model import LinearModel, build_model
-from .record import record_mean_wind
+from .record import record_mean_wind, states_cross_wind
 from .step1 import StaticResult
 from .uplift import require_tension
 
@@ -30,7 +30,9 @@ def damping_matrices(case: Case, st: StaticResult, models: list[LinearModel], st
     """
     states = list(range(len(models))) if states is None else list(states)
     vn = to_global_nodes(st.system, st.wind.normal)  # (n_k, n_nodes)
-    return damping_stack(case, st.system, st.mean, vn, models, states, omega1)
+    cross = states_cross_wind(case, st)
+    u = None if cross is None else (cross.perp_vectors, cross.directions)
+    return damping_stack(case, st.system, st.mean, vn, models, states, omega1, u)
 
 
 @dataclass(frozen=True)
@@ -61,11 +63,15 @@ def synoptic_model(case: Case, st: StaticResult, *, vectors: bool = True, omega1
     model = build_model(system, st.mean.state(0))
     damping = damping_matrices(case, st, [model], omega1=omega1)[0]
     vn = to_global_nodes(system, st.wind.normal)[0]
-    vl = None
-    if system.is_section or case.wind.direction != 0.0:
+    vl = perp = None
+    cross = states_cross_wind(case, st)
+    if cross is not None:  # cross-flow form: along each node's direction d_j, |V_perp| for |V_n|
+        model = replace(model, load_directions=cross.directions)
+        vn, vl, perp = cross.along[0], cross.rest[0], cross.perp[0]
+    elif system.is_section or case.wind.direction != 0.0:
         # the normal component of the along-wind fluctuation, v cos(phi), as the time domain
         vl = record_mean_wind(case, st, np.zeros(1))[1][0]
-    a = synoptic_load_per_v(case, model, vn, vl)
+    a = synoptic_load_per_v(case, model, vn, vl, perp)
     f_top = 0.75 / case.analysis.time_step
     modes = complex_modes(model, damping, max_hz=f_top, vectors=vectors)
     return SynopticModel(model, damping, a, modes)

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..core.case import Case
 from ..core.crossflow import NodeWind, applies, node_wind
-from ..core.damping import aerodynamic_damping, stiffness_proportional
+from ..core.damping import aerodynamic_damping, node_tangents, stiffness_proportional
 from ..core.line_damping import reference_state_index, structural_omega1
 from ..core.loads import to_global_nodes
 from ..core.model import LinearModel, build_model
@@ -69,31 +69,33 @@ def record_mean_wind(case: Case, st: StaticResult, t: np.ndarray) -> tuple[np.nd
 
 
 def states_cross_wind(case: Case, st: StaticResult) -> NodeWind | None:
-    """The cross-flow form's wind at the global nodes at the step-1 mean states
-    (:class:`~linecheck.core.crossflow.NodeWind`, (n_k, n_nodes) each), its load directions d_j
-    at each node's largest |V_perp| among the states; None where the horizontal-normal form
-    applies (:func:`~linecheck.core.crossflow.applies`)."""
+    """The cross-flow form's wind at the global nodes at the step-1 mean states, on each state's
+    deformed conductor axes (:class:`~linecheck.core.crossflow.NodeWind`, (n_k, n_nodes) each), its
+    load directions d_j at each node's largest |V_perp| among the states; None for the
+    horizontal-normal form (:func:`~linecheck.core.crossflow.applies`)."""
     if not applies(case, st.system):
         return None
-    return node_wind(st.system, mean_vector_at_nodes(case, st.system, st.mean.time))
+    return node_wind(st.system, mean_vector_at_nodes(case, st.system, st.mean.time), node_tangents(st.mean.nodes))
 
 
 def record_cross_wind(case: Case, st: StaticResult, t: np.ndarray) -> NodeWind | None:
-    """:func:`states_cross_wind` over the record ``t`` [s], (n_steps, n_nodes) each, with the mean
-    states' load directions (one direction per node for the whole record; synoptic: the held mean,
-    rows of stride 0)."""
+    """:func:`states_cross_wind` over the record ``t`` [s], (n_steps, n_nodes) each: the mean wind
+    at every step on the axes of its nearest mean state, with the states' load directions (one
+    per node for the whole record; synoptic: the held mean, rows of stride 0)."""
     states = states_cross_wind(case, st)
     if states is None:
         return None
     system, d = st.system, states.directions
+    axes = node_tangents(st.mean.nodes)  # (n_k, n_nodes, 3)
     if case.wind.type == "synoptic":
-        one = node_wind(system, mean_vector_at_nodes(case, system, t[:1]), d)
+        one = node_wind(system, mean_vector_at_nodes(case, system, t[:1]), axes[0], d)
 
         def held(a: np.ndarray) -> np.ndarray:
             return np.broadcast_to(a, (t.size,) + a.shape[1:])
 
         return NodeWind(held(one.along), held(one.rest), held(one.perp), held(one.perp_vectors), d)
-    return node_wind(system, mean_vector_at_nodes(case, system, t), d)
+    nearest = state_of_step(st.mean.time, t)[0]
+    return node_wind(system, mean_vector_at_nodes(case, system, t), axes[nearest], d)
 
 
 def record_wind(case: Case, st: StaticResult, t: np.ndarray) -> tuple[np.ndarray, np.ndarray | None, np.ndarray]:

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..core import budget, kernel
 from ..core.case import Case
+from ..core.crossflow import NodeWind
 from ..core.dynamics import DynamicResponse, integrate
 from ..core.errors import Cancelled
 from ..core.line_damping import reference_state_index, structural_omega1
@@ -36,6 +37,7 @@ from .record import (
     interpolated_models,
     mean_reactions,
     peak_window_steps,
+    record_cross_wind,
     record_time,
     record_wind,
     state_of_step,
@@ -136,8 +138,11 @@ class RunPlan:
             towers: the towers whose reactions are computed.
         vn, vl: [m/s] running-mean normal and longitudinal speeds at the nodes, (n_steps, n_nodes)
             (vl None: zero); a_turb: [m/s] the turbulence's modulation I V_m(x, t).
-        load_dirs: horizontal load directions of the free nodes of a section, (n_free, 2) (None:
-            straight line, y); threads: chunks at once; concurrent: whether threads are used
+        cross: the cross-flow form's wind over the record (:class:`~linecheck.core.crossflow.NodeWind`;
+            None: the horizontal-normal form).
+        load_dirs: load directions of the free nodes, (n_free, 3) (None: straight line, y; a
+            section: the node normals; the cross-flow form: its directions); threads: chunks at
+            once; concurrent: whether threads are used
             (the compiled step loop); chunk: realizations per chunk.
         synoptic: the synoptic mean state's model (None: downburst or long line); windows: a
             long line's window models, shared by the burn-in and the check; spectral_check:
@@ -163,6 +168,7 @@ class RunPlan:
     vn: np.ndarray
     vl: np.ndarray | None
     a_turb: np.ndarray
+    cross: NodeWind | None
     load_dirs: np.ndarray | None
     threads: int
     concurrent: bool
@@ -317,7 +323,10 @@ def plan_run(case: Case, *, realizations, interpolate_states: bool, spectral_che
         towers = slice(j, j + 1)
         M, still_air, gL = M[:, towers], still_air[towers], gL[towers] if np.ndim(gL) else gL
         models, second = _tower_rows(j, models, second)
+    cross = record_cross_wind(case, st, t)  # a section in cross-flow: every node's load direction
     load_dirs = None if system.straight_in_plan else system.node_normals[models[0].dofs.free_nodes]
+    if cross is not None:
+        load_dirs = cross.directions[models[0].dofs.free_nodes]
     model_at = interpolated_models(case, st, bracket, weights) if interpolate_states else None
     # realization threads only with the compiled step loop, which runs without the GIL (the numpy
     # step loop holds the GIL between its small calls: threads lose time)
@@ -327,7 +336,7 @@ def plan_run(case: Case, *, realizations, interpolate_states: bool, spectral_che
     if threads > 1:
         chunk = min(chunk, -(-real.size // threads))
     return RunPlan(case, st, real, t, keep, burn, models, damping, nearest, model_at, second, M[keep], still_air,
-                   gL, scale, towers, vn, vl, a_turb, load_dirs, threads, concurrent, chunk, sm, windows,
+                   gL, scale, towers, vn, vl, a_turb, cross, load_dirs, threads, concurrent, chunk, sm, windows,
                    spectral_check and case.wind.type == "synoptic", tower_only)
 
 
@@ -374,7 +383,7 @@ def run_chunk(plan: RunPlan, ci: int, stop: AnyEvent, reports: _ChunkProgress):
     # (n_real, n_steps, n_nodes), along-wind; the burn-in's steps lead the analysed record (common
     # random numbers: the analysed turbulence does not depend on the burn-in's length)
     v = fluctuating_velocity(case, system, t, list(rc), plan.a_turb, lead=int(np.argmax(plan.keep)), cancel=stop)
-    loads, direct = fluctuating_loads(case, system, plan.models[0], t, v, plan.vn, plan.vl)
+    loads, direct = fluctuating_loads(case, system, plan.models[0], t, v, plan.vn, plan.vl, plan.cross)
     direct = direct.reshape(direct.shape[:2] + (-1, 3))[:, :, towers].reshape(direct.shape[:2] + (-1,))
     reports.wind_done()
     if stop.is_set():

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.case import Case
-from ..core.loads import mean_loads
+from ..core.loads import mean_drag, mean_loads
 from ..core.static import MeanStates, solve_mean_states
 from ..core.system import LineSystem
 from ..core.wind.mean import MeanWind, mean_wind
@@ -66,5 +66,6 @@ def static_result(case: Case, *, progress: Progress | None = None,
     wind = mean_wind(case, system, mean_state_times(case))
     gy = mean_loads(case, wind)  # paper Eq. 1
     cb = None if progress is None else (lambda d, n: progress("step 1: mean states", d, n))
-    mean = solve_mean_states(system, wind.time, gy, progress=cb, cancel=cancel)
+    drag = mean_drag(case, system, wind)  # a section, cross-flow: the drag on the deformed conductor
+    mean = solve_mean_states(system, wind.time, gy, progress=cb, cancel=cancel, drag=drag)
     return StaticResult(case, system, wind, mean)

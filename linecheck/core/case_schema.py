@@ -28,9 +28,9 @@ CODE_TERRAINS = ("sea", "open", "suburban", "urban")  # [codes] terrain (docs/co
 DRAG_MODELS = ("linear", "quadratic")
 FFT_LENGTHS = ("record", "fast")  # turbulence synthesis: docs/wind.md "Synthesis length"
 TENSION_MODELS = ("linear", "second-order")
-# Direction of the drag on an inclined span (docs/method.md "Loads"): "cross-flow" loads each
-# element with the wind component normal to its own axis (Hoerner 1965, the cross-flow
-# principle); "horizontal-normal" the component along the span's horizontal normal only.
+# Direction of the drag on a section (docs/method.md "Loads"): "cross-flow" loads the conductor
+# with the wind component normal to its own deformed axis (Hoerner 1965, the cross-flow
+# principle); "horizontal-normal" the component along each span's horizontal normal only.
 DRAG_DIRECTIONS = ("cross-flow", "horizontal-normal")
 # Conductor self-damping assumed with the quasi-steady model (ratio at the lowest mean-state
 # mode, stiffness-proportional): it damps the axial modes that no aerodynamic model damps.
@@ -178,7 +178,7 @@ SCHEMA: dict[str, tuple[FieldSpec, ...]] = {
         _f("burn_in", "s", "synoptic: discarded start of the record (default: from the least-damped significant mode)", low=0.0, high=1e5),
         FieldSpec("drag", "choice", "-", 'fluctuating drag: "linear" (paper Eq. 5) or "quadratic" (the v^2 term kept, its mean I^2 in step 1)', default="quadratic", choices=DRAG_MODELS),
         FieldSpec("tension", "choice", "-", 'reactions: "linear" (paper) or "second-order" (+ the tension increment quadratic in the linear motion)', default="second-order", choices=TENSION_MODELS),
-        FieldSpec("drag_direction", "choice", "-", 'drag on an inclined span: "cross-flow" (the wind component normal to each element\'s axis) or "horizontal-normal" (only the component along the span\'s horizontal normal; identical on level spans)', default="cross-flow", choices=DRAG_DIRECTIONS),
+        FieldSpec("drag_direction", "choice", "-", 'section form: "cross-flow" (the drag on the wind component normal to the deformed conductor\'s axis, Hoerner 1965) or "horizontal-normal" (the component along each span\'s horizontal normal); the equal-span (paper) form always uses "horizontal-normal"', default="cross-flow", choices=DRAG_DIRECTIONS),
         _f("peak_window", "s", "peaks taken per window of the analysed record; statistics over windows x realizations (default: the whole record; a downburst's whole event)", low=0.0, high=1e5, low_open=True),
         _f("design_fractile", "-", "non-exceedance probability of the Gumbel design peak (0.5 = median peak)", default=0.5, low=0.0, high=0.999, low_open=True),
     ),

@@ -182,6 +182,17 @@ def solve_spans(chord: np.ndarray, p: np.ndarray, Lu: np.ndarray, EA: float, N0:
     return SpanSolution(N0, N0 - P_tot, np.linalg.inv(F), r, mid)
 
 
+def span_node_tangents(spans: SpanSolution, Lu: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """[-] unit tangent of every span's cable at its FE nodes, t = N/|N| with N(sigma_k) = N_0 - P(sigma_k)
+    (module docstring; P of the piecewise-linear load, exact by the trapezoid rule), shape
+    (..., n_spans, ne+1, 3); ``spans`` a solution for the loads p [N/m] (..., n_spans, ne+1, 3)."""
+    ne = p.shape[-2] - 1
+    inc = 0.5 * (Lu / ne)[:, None, None] * (p[..., :-1, :] + p[..., 1:, :])  # (..., n_spans, ne, 3)
+    P = np.concatenate([np.zeros_like(inc[..., :1, :]), np.cumsum(inc, axis=-2)], axis=-2)
+    N = spans.N0[..., None, :] - P
+    return N / np.linalg.norm(N, axis=-1, keepdims=True)
+
+
 def start_tension(chord: np.ndarray, p: np.ndarray, Lu: np.ndarray, H: np.ndarray) -> np.ndarray:
     """A start N_0 for :func:`solve_spans`: H along the chord's part normal to the resultant
     load, plus half the resultant (the mid-span tension of a symmetric cable is then H).

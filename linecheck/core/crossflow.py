@@ -1,27 +1,22 @@
-"""Cross-flow drag on inclined spans (docs/method.md "Loads").
+"""Cross-flow drag on a line section (docs/method.md "Loads").
 
 The drag on a yawed circular cylinder acts along the component of the wind normal to the
 cylinder's axis and scales with its square (the cross-flow, or independence, principle:
-Hoerner 1965, "Fluid-Dynamic Drag", ch. 3; used for conductors by e.g. Matheson & Holmes 1981).
-A span's axis here is its still-air CHORD c_i (clamp to clamp, so it includes the inclination
-theta_i of an inclined span but not the sag): with the horizontal mean wind V = V_n n_i + V_x e_i
-(n_i the span's horizontal normal, e_i its horizontal direction),
-
-    V_perp = V - (V . c_i) c_i = V_n n_i - V_x sin(theta_i) m_i,   m_i = -sin(theta_i) e_i + cos(theta_i) z,
-
-so an inclined span in oblique wind gets, besides the horizontal drag, a part in its vertical
-plane of size V_x sin(theta_i) (vertical part V_x sin(theta) cos(theta)).  On a level span c_i = e_i
-and V_perp = V_n n_i: the horizontal-normal form, which ``[analysis] drag_direction =
-"horizontal-normal"`` keeps everywhere.  The sag's slope is left out of the axis: its effect
-is antisymmetric within a span and cancels to second order in the tower reactions (measured
-against an independent FE with follower cross-flow loads on every deformed element,
-docs/validation.md).
+Hoerner 1965, "Fluid-Dynamic Drag", ch. 3).  For a conductor the axis is its own tangent t on
+the deformed cable: V_perp = V - (V . t) t and the drag per unit length is
+1/2 rho C_d D |V_perp| V_perp.  On an inclined span in oblique wind V_perp has a part in the
+span's vertical plane of size about V_x sin(theta) (V_x the along-span wind, theta the
+inclination), i.e. a vertical drag; on a blown-out span the tangent near the clamps leans with
+the wind and the drag there is smaller than on the horizontal normal.  Step 1 solves this
+follower load on the deformed cable (:func:`linecheck.core.static.solve_mean_states`); the
+horizontal-normal form, ``[analysis] drag_direction = "horizontal-normal"``, keeps V_n n_i
+(n_i the span's horizontal normal) as before, and the equal-span (paper) form always uses it.
 
 Steps 2-3 load every node along ONE direction d_j (the paper's scalar load machinery):
-d_j = V_perp / |V_perp| at the node.  A synoptic mean wind is constant, so this is exact; in a
-downburst the mean wind turns as the storm passes, and d_j is taken at the node's largest
-|V_perp| over the record (its largest mean load); the load's component along d_j is kept
-(docs/method.md "Loads" gives the bound on what this leaves out).  Nothing here prints.
+d_j = V_perp / |V_perp| on the mean state's deformed axes.  A synoptic mean wind is constant,
+so this is exact; in a downburst d_j is taken at the node's largest |V_perp| among the step-1
+mean states and the load's component along d_j is kept (docs/method.md "Loads" says what this
+leaves out).  Nothing here prints.
 """
 
 from __future__ import annotations
@@ -33,8 +28,6 @@ import numpy as np
 from .case import Case
 from .system import LineSystem
 
-INCLINED = 1e-9  # |sin(theta)| below this is a level span (clamp heights equal to ~1 um per km)
-
 
 def span_axes(system: LineSystem) -> np.ndarray:
     """[-] unit still-air chord c_i of every span, (n_spans, 3) (global frame, z up)."""
@@ -42,44 +35,32 @@ def span_axes(system: LineSystem) -> np.ndarray:
     return c / np.linalg.norm(c, axis=1)[:, None]
 
 
-def node_axes(system: LineSystem) -> np.ndarray:
-    """[-] conductor axis at every global FE node, (n_nodes, 3): its span's chord; a tower node
-    the normalised sum of its two spans' chords (one at an end tower)."""
-    c = span_axes(system)
-    span = system.span_of_node(np.arange(system.n_nodes))
-    a = c[span].copy()
-    inner = system.tower_nodes[1:-1]
-    s = c[:-1] + c[1:]
-    a[inner] = s / np.linalg.norm(s, axis=1)[:, None]
-    return a
-
-
 def applies(case: Case, system: LineSystem) -> bool:
-    """True when the cross-flow drag differs from the horizontal-normal form: ``drag_direction``
-    is "cross-flow", the section has an inclined span, and the wind can have a component along a
-    span (a downburst, an angle tower or an oblique synoptic direction)."""
-    if case.analysis.drag_direction != "cross-flow" or not system.is_section:
-        return False
-    if not np.any(np.abs(span_axes(system)[:, 2]) > INCLINED):
-        return False
-    return not (case.wind.type == "synoptic" and system.straight_in_plan and case.wind.direction == 0.0)
+    """True when the cross-flow drag is used: ``drag_direction`` "cross-flow" on a section (the
+    equal-span form is the paper's horizontal-normal idealisation)."""
+    return case.analysis.drag_direction == "cross-flow" and system.is_section
 
 
 def normal_part(v: np.ndarray, axes: np.ndarray) -> np.ndarray:
-    """[m/s] the part of the wind vectors v (..., n, 3) normal to the unit axes (n, 3):
-    v - (v . a) a (cross-flow principle, Hoerner 1965)."""
+    """[m/s] the part of the wind vectors v (..., 3) normal to the unit axes (broadcastable,
+    (..., 3)): v - (v . a) a (cross-flow principle, Hoerner 1965)."""
     return v - (v * axes).sum(axis=-1)[..., None] * axes
 
 
-def span_drag_vectors(case: Case, system: LineSystem, normal: np.ndarray, longitudinal: np.ndarray) -> np.ndarray:
-    """[m/s] V_perp at every span node, (..., n_spans, ne+1, 3), from the running-mean
-    components along the span's horizontal normal and direction (:class:`MeanWind` ``normal``,
+def span_wind_vectors(system: LineSystem, normal: np.ndarray, longitudinal: np.ndarray) -> np.ndarray:
+    """[m/s] the horizontal mean wind at every span node as vectors, (..., n_spans, ne+1, 3), from
+    its components along the span's horizontal normal and direction (:class:`MeanWind` ``normal``,
     ``longitudinal``, each (..., n_spans, ne+1))."""
     h = system.span_headings
     e = np.stack([np.cos(h), np.sin(h), np.zeros_like(h)], axis=1)
-    v = normal[..., None] * system.span_normals[:, None, :] + longitudinal[..., None] * e[:, None, :]
-    c = span_axes(system)[:, None, :]
-    return v - (v * c).sum(axis=-1)[..., None] * c
+    return normal[..., None] * system.span_normals[:, None, :] + longitudinal[..., None] * e[:, None, :]
+
+
+def span_drag_vectors(system: LineSystem, normal: np.ndarray, longitudinal: np.ndarray) -> np.ndarray:
+    """[m/s] V_perp on every span's still-air chord (the first pass of step 1's follower
+    iteration), (..., n_spans, ne+1, 3): V_n n_i - V_x sin(theta_i) m_i, m_i the chord's normal in
+    the span's vertical plane."""
+    return normal_part(span_wind_vectors(system, normal, longitudinal), span_axes(system)[:, None, :])
 
 
 @dataclass(frozen=True)
@@ -116,11 +97,12 @@ def load_directions(system: LineSystem, u: np.ndarray) -> np.ndarray:
     return d
 
 
-def node_wind(system: LineSystem, v: np.ndarray, directions: np.ndarray | None = None) -> NodeWind:
+def node_wind(system: LineSystem, v: np.ndarray, axes: np.ndarray, directions: np.ndarray | None = None) -> NodeWind:
     """:class:`NodeWind` from the running-mean wind vectors v [m/s] at the global nodes,
-    (n_t, n_nodes, 3) (:func:`~linecheck.core.wind.mean.mean_vector_at_nodes`); ``directions``
+    (n_t, n_nodes, 3) (:func:`~linecheck.core.wind.mean.mean_vector_at_nodes`), on the conductor's
+    unit axes there (the mean states' deformed tangents, broadcastable to v); ``directions``
     (n_nodes, 3) fixes d_j (default :func:`load_directions` over these instants)."""
-    u = normal_part(v, node_axes(system))
+    u = normal_part(v, axes)
     d = load_directions(system, u) if directions is None else directions
     along = (u * d).sum(axis=-1)
     speed2 = (v * v).sum(axis=-1)

@@ -45,7 +45,7 @@ def _add_node_blocks(ab: np.ndarray, first_dof: np.ndarray, blocks: np.ndarray) 
             ab[..., u - (b - a), first_dof + b] += blocks[..., a, b]
 
 
-def node_tangents(model: LinearModel, nodes: np.ndarray) -> np.ndarray:
+def node_tangents(nodes: np.ndarray) -> np.ndarray:
     """Unit conductor tangent at every global node (mean of the adjacent chords), (..., n_nodes, 3)
     for node coordinates [m] of shape (..., n_nodes, 3) (leading axes: mean states)."""
     seg = np.diff(nodes, axis=-2)
@@ -99,7 +99,7 @@ def aerodynamic_damping(case: Case, model: LinearModel, vn_nodes: np.ndarray, no
         if case.analysis.damping != "paper":
             if nodes is None:
                 raise ValueError("quasi-steady damping needs the mean-state node coordinates")
-            e = node_tangents(model, nodes)[free]
+            e = node_tangents(nodes)[free]
             P = np.eye(3)[None] - e[:, :, None] * e[:, None, :]
         _add_node_blocks(ab, first, _cross_blocks(c, u, dirs, P))
         return project_axial(model, ab)  # a rigid insulator carries the axial part
@@ -113,7 +113,7 @@ def aerodynamic_damping(case: Case, model: LinearModel, vn_nodes: np.ndarray, no
         return project_axial(model, ab)  # a rigid insulator carries the axial part
     if nodes is None:
         raise ValueError("quasi-steady damping needs the mean-state node coordinates")
-    e = node_tangents(model, nodes)[free]  # (n_free, 3)
+    e = node_tangents(nodes)[free]  # (n_free, 3)
     P = np.eye(3)[None] - e[:, :, None] * e[:, None, :]
     if system.straight_in_plan:
         w = P[:, :, 1]  # the wind (+y) projected normal to the axis
@@ -169,7 +169,7 @@ def aerodynamic_damping_stack(case: Case, models: list[LinearModel], vn_nodes: n
         if case.analysis.damping != "paper":
             if nodes is None:
                 raise ValueError("quasi-steady damping needs the mean-state node coordinates")
-            e = node_tangents(model, np.asarray(nodes))[:, free]
+            e = node_tangents(np.asarray(nodes))[:, free]
             P = np.eye(3) - e[..., :, None] * e[..., None, :]
         _add_node_blocks(ab, first, _cross_blocks(c, u, dirs, P))
         return project_axial_stack(model.axial_dof, axes, ab)  # a rigid insulator carries the axial part
@@ -183,7 +183,7 @@ def aerodynamic_damping_stack(case: Case, models: list[LinearModel], vn_nodes: n
         return project_axial_stack(model.axial_dof, axes, ab)  # a rigid insulator carries the axial part
     if nodes is None:
         raise ValueError("quasi-steady damping needs the mean-state node coordinates")
-    e = node_tangents(model, np.asarray(nodes))[:, free]  # (n_k, n_free, 3)
+    e = node_tangents(np.asarray(nodes))[:, free]  # (n_k, n_free, 3)
     P = np.eye(3) - e[..., :, None] * e[..., None, :]
     if system.straight_in_plan:
         w = P[..., :, 1]  # the wind (+y) projected normal to the axis

@@ -8,13 +8,14 @@ Span-local values (one row of ``ne + 1`` nodes per span) are mapped to the globa
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from . import kernel
 from .case import Case
-from .crossflow import applies, span_drag_vectors
+from .crossflow import applies, normal_part, span_wind_vectors
 from .static import drag_intensity
 from .system import LineSystem
 
@@ -65,21 +66,27 @@ def mean_loads(case: Case, wind: MeanWind) -> np.ndarray:
     return g
 
 
-def mean_drag_vectors(case: Case, system: LineSystem, wind: MeanWind) -> np.ndarray | None:
-    """Cross-flow form of :func:`mean_loads` on a section with inclined spans: the mean drag per
+def mean_drag(case: Case, system: LineSystem, wind: MeanWind) -> Callable[[np.ndarray], np.ndarray] | None:
+    """Cross-flow form of :func:`mean_loads` on a section: ``drag(tangents)`` -> the mean drag per
     unit length [N/m] as vectors, 1/2 rho C_d D |V_perp| V_perp (times 1 + sigma^2/|V|^2 with the
-    quadratic drag), V_perp the wind's part normal to the span's chord (cross-flow principle,
-    Hoerner 1965; :mod:`linecheck.core.crossflow`), shape (n_t, n_spans, ne+1, 3).  None where
-    it equals the horizontal-normal form (:func:`~linecheck.core.crossflow.applies`)."""
+    quadratic drag), V_perp the wind's part normal to the conductor's unit tangents [-] at the
+    span nodes (cross-flow principle, Hoerner 1965; :mod:`linecheck.core.crossflow`), both of
+    shape (n_t, n_spans, ne+1, 3): a follower load, which step 1 solves on the deformed conductor.
+    None for the horizontal-normal form (:func:`~linecheck.core.crossflow.applies`)."""
     if not applies(case, system):
         return None
     line = case.line
-    u = span_drag_vectors(case, system, wind.normal, wind.longitudinal)
-    size = np.linalg.norm(u, axis=-1)
-    g = 0.5 * case.wind.air_density * line.drag_coefficient * line.diameter * size  # 1/2 rho C_d D |V_perp|
-    if case.analysis.drag == "quadratic":
-        g = g * (1.0 + turbulence_variance_ratio(case, wind.normal, wind.longitudinal))
-    return g[..., None] * u
+    half = 0.5 * case.wind.air_density * line.drag_coefficient * line.diameter
+    factor = 1.0
+    if case.analysis.drag == "quadratic":  # the mean of the drag on the total wind (Quadratic drag)
+        factor = 1.0 + turbulence_variance_ratio(case, wind.normal, wind.longitudinal)[..., None]
+    v = span_wind_vectors(system, wind.normal, wind.longitudinal)
+
+    def drag(tangents: np.ndarray) -> np.ndarray:
+        u = normal_part(v, tangents)
+        return (half * np.linalg.norm(u, axis=-1))[..., None] * u * factor
+
+    return drag
 
 
 def synoptic_load_per_v(case: Case, model: LinearModel, vn: np.ndarray, vl: np.ndarray | None,

@@ -41,6 +41,8 @@ if TYPE_CHECKING:  # annotations only: the system solves its still-air state wit
     from .system import LineSystem
 
 MAX_STRAIN = 0.05  # conductor strain above this is not an admissible elastic state
+FOLLOWER_RTOL = 1e-10  # cross-flow drag: loads settled when they change by less than this (relative)
+FOLLOWER_MAX = 30  # passes of the follower substitution (it contracts by ~0.05 a pass on real sections)
 _dgtsv = lapack.dgtsv
 
 
@@ -189,7 +191,7 @@ def solve_static(
     tol: float = 1e-8,
     max_iter: int = 500,
     label: str = "mean state",
-    drag: np.ndarray | None = None,
+    drag: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> StaticState:
     """Non-linear static equilibrium under weight and the transverse mean-wind load.
 
@@ -203,9 +205,10 @@ def solve_static(
         tol: [m] convergence tolerance on the attachment displacements, relative to v.
         max_iter: limit on outer (Fig. 6) iterations.
         label: names the state in error messages (e.g. "mean state 37 (t = 120.0 s)").
-        drag: [N/m] the cross-flow form's drag vectors on a section with inclined spans
-            (:func:`~linecheck.core.loads.mean_drag_vectors`), (n_spans, ne+1, 3), in place of
-            gy along the span normals (gy still sets the solver's start).
+        drag: the cross-flow form on a section (:func:`~linecheck.core.loads.mean_drag`): the drag
+            vectors [N/m] (1, n_spans, ne+1, 3) as a function of the cable's unit tangents at the
+            span nodes (a follower load, :func:`_section_states`), in place of gy along the span
+            normals (gy still sets the solver's start).
 
     Raises:
         ConvergenceError: no convergence, non-finite values or an inadmissible strain.
@@ -219,7 +222,7 @@ def solve_static(
         raise ConvergenceError(f"{label}: non-finite mean-wind load")
     if system.is_section:
         return _section_states(system, gy[None], [label], tol=tol, max_iter=max_iter, initial=initial,
-                               drag=None if drag is None else drag[None])[0]
+                               drag=drag)[0]
     if initial is not None:
         d = initial.displacement.copy()
         H = initial.tension.copy()
@@ -435,16 +438,24 @@ def section_loads(system: LineSystem, gy: np.ndarray, drag: np.ndarray | None = 
 
 def _section_states(system: LineSystem, gy: np.ndarray, labels: list[str], *, tol: float, max_iter: int,
                     initial: StaticState | None = None, progress=None, cancel=None,
-                    drag: np.ndarray | None = None) -> list[StaticState]:
+                    drag: Callable[[np.ndarray], np.ndarray] | None = None) -> list[StaticState]:
     """Step 1 of the section form: exact elastic spans, Newton over the suspension
-    clamps (:mod:`linecheck.core.catenary`); the same StaticState as the paper's solver."""
-    from .catenary import equilibrium, start_tension
+    clamps (:mod:`linecheck.core.catenary`); the same StaticState as the paper's solver.
+
+    ``drag`` (the cross-flow form): the drag vectors [N/m] (n_s, n_spans, ne+1, 3) as a function of
+    the conductor's unit tangents at the span nodes (same shape): a follower load, solved by
+    successive substitution from the still-air tangents until the loads change by less than
+    :data:`FOLLOWER_RTOL` of their largest (docs/method.md "Loads")."""
+    from .catenary import equilibrium, span_node_tangents, start_tension
 
     n_s = gy.shape[0]
     line = system.line
     Lu = system.unstretched_lengths
     clamps = system.clamp_points
-    p = section_loads(system, gy, drag)
+    # first pass on the span chords (the still-air axes of a straight cable)
+    chord = system.span_chords / np.linalg.norm(system.span_chords, axis=1)[:, None]
+    dv = None if drag is None else drag(np.broadcast_to(chord[None, :, None, :], gy.shape + (3,)))
+    p = section_loads(system, gy, dv)
     if initial is not None:
         pos = np.broadcast_to(clamps + initial.displacement, (n_s,) + clamps.shape).copy()
         H = np.broadcast_to(initial.tension, (n_s, system.n_spans))
@@ -453,9 +464,24 @@ def _section_states(system: LineSystem, gy: np.ndarray, labels: list[str], *, to
         wres = np.hypot(line.weight, np.abs(gy).mean(axis=-1))  # resultant-load start (as the paper solver)
         H = system.tension_nominal * wres / line.weight
     N0 = start_tension(np.diff(pos, axis=1), p, Lu, H)
-    eq = equilibrium(clamps, system.insulator_tops, system.insulator_lengths, system.suspension,
-                     system.tower_along, p, Lu, line.ea, pos, N0, labels=labels, tol=tol, max_iter=max_iter,
-                     progress=progress, cancel=cancel)
+    for _ in range(FOLLOWER_MAX):
+        eq = equilibrium(clamps, system.insulator_tops, system.insulator_lengths, system.suspension,
+                         system.tower_along, p, Lu, line.ea, pos, N0, labels=labels, tol=tol, max_iter=max_iter,
+                         progress=progress, cancel=cancel)
+        if drag is None:
+            break
+        new = drag(span_node_tangents(eq.spans, Lu, p))  # the drag on the deformed axes (follower)
+        change = np.abs(new - dv).max() / max(float(np.abs(new).max()), 1e-300)
+        dv, p = new, section_loads(system, gy, new)
+        pos, N0 = eq.p.copy(), eq.spans.N0.copy()  # warm start from the last equilibrium
+        if change <= FOLLOWER_RTOL:
+            eq = equilibrium(clamps, system.insulator_tops, system.insulator_lengths, system.suspension,
+                             system.tower_along, p, Lu, line.ea, pos, N0, labels=labels, tol=tol,
+                             max_iter=max_iter, cancel=cancel)
+            break
+    else:
+        raise ConvergenceError(f"{labels[0]}: the cross-flow drag on the deformed conductor did not settle in "
+                               f"{FOLLOWER_MAX} passes (last change {change:.2g})")
     e_span = np.stack([np.cos(system.span_headings), np.sin(system.span_headings), np.zeros(system.n_spans)], axis=1)
     out = []
     for j in range(n_s):
@@ -520,7 +546,7 @@ def solve_static_batch(
     max_iter: int = 500,
     progress: Callable[[int, int], None] | None = None,
     cancel: threading.Event | None = None,
-    drag: np.ndarray | None = None,
+    drag: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> list[StaticState]:
     """:func:`solve_static` for many load cases at once (the downburst's mean states).
 
@@ -533,7 +559,7 @@ def solve_static_batch(
         gy: [N/m] transverse loads, shape (n_states, n_spans, ne+1).
         labels: names of the states for error messages, length n_states.
         progress: ``progress(converged, n_states)`` once per outer iteration.
-        drag: [N/m] the cross-flow form's drag vectors, (n_states, n_spans, ne+1, 3) (:func:`solve_static`).
+        drag: the cross-flow form's drag as a function of the tangents (:func:`solve_static`).
     """
     nt = system.n_towers
     gy = np.asarray(gy, dtype=float)
@@ -608,7 +634,7 @@ def solve_mean_states(
     *,
     progress: Callable[[int, int], None] | None = None,
     cancel: threading.Event | None = None,
-    drag: np.ndarray | None = None,
+    drag: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> MeanStates:
     """Step 1 at every instant of ``time`` (several instants: :func:`solve_static_batch`).
 
@@ -617,7 +643,7 @@ def solve_mean_states(
         gy: [N/m] mean transverse loads, shape (n_t, n_spans, ne+1).
         progress: called as ``progress(done, total)``.
         cancel: set it to stop; raises :class:`Cancelled`.
-        drag: [N/m] the cross-flow form's drag vectors, (n_t, n_spans, ne+1, 3) (:func:`solve_static`).
+        drag: the cross-flow form's drag as a function of the tangents (:func:`solve_static`).
     """
     still = still_air_state(system)
     n_t = len(time)
@@ -627,7 +653,7 @@ def solve_mean_states(
     else:
         if cancel is not None and cancel.is_set():
             raise Cancelled("step 1 cancelled")
-        states = [solve_static(system, gy[0], initial=still, label=labels[0], drag=None if drag is None else drag[0])]
+        states = [solve_static(system, gy[0], initial=still, label=labels[0], drag=drag)]
         if progress is not None:
             progress(1, 1)
     return MeanStates(

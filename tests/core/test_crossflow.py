@@ -8,17 +8,17 @@ limit (bit-identical to the horizontal-normal form).
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 import numpy as np
 import pytest
 
 from linecheck import service
+from linecheck.analysis.record import record_cross_wind
 from linecheck.core.case import case_from_dict
-from linecheck.core.crossflow import applies, node_wind, span_drag_vectors
-from linecheck.core.loads import fluctuating_loads, mean_drag_vectors
-from linecheck.core.wind.mean import mean_vector_at_nodes
+from linecheck.core.crossflow import applies, span_drag_vectors
+from linecheck.core.damping import node_tangents
+from linecheck.core.loads import fluctuating_loads
 
 W = 15.97  # [N/m]
 RHO, CD, D = 1.25, 1.0, 0.022
@@ -50,7 +50,7 @@ def test_normal_wind_on_an_inclined_chord_has_the_closed_form_vertical_part():
     case = _case(HILLY, direction=30.0)
     st = service.static_analysis(case)
     system = st.system
-    u = span_drag_vectors(case, system, st.wind.normal, st.wind.longitudinal)[0]  # (n_spans, ne+1, 3)
+    u = span_drag_vectors(system, st.wind.normal, st.wind.longitudinal)[0]  # (n_spans, ne+1, 3)
     v = 30.0
     vn, vx = v * math.cos(math.radians(30.0)), v * math.sin(math.radians(30.0))
     for i, (g0, g1, L) in enumerate(((0.0, 45.0, 300.0), (45.0, 80.0, 350.0), (80.0, 130.0, 330.0))):
@@ -60,18 +60,19 @@ def test_normal_wind_on_an_inclined_chord_has_the_closed_form_vertical_part():
         assert u[i, :, 1] == pytest.approx(vn, rel=1e-12)  # the horizontal normal part is V_n (first span along +x)
 
 
-def test_step1_towers_carry_exactly_the_applied_cross_flow_drag():
-    """Global equilibrium of the section under uniform wind: the wind-induced reactions summed over
-    the towers (global frame, R_z down) equal the drag per unit length times each span's
-    unstretched length, 1/2 rho C_d D |V_perp| V_perp L_u (an independent sum of the applied loads);
-    the horizontal-normal form has no vertical drag (sum of R_z ~ 0)."""
-    for dd in ("cross-flow", "horizontal-normal"):
+def test_step1_towers_carry_the_applied_drag():
+    """Global equilibrium under uniform wind: horizontal-normal, the wind-induced reactions summed
+    over the towers (global, R_z down) equal 1/2 rho C_d D |V_n| V_n n_i L_u summed over the spans
+    (exact: no vertical drag); cross-flow, the summed vertical reaction is the vertical drag, whose
+    chord estimate -1/2 rho C_d D |V_perp| V_x sin(theta) cos(theta) L_u it matches within 20 %
+    (the sag and the blow-out turn the tangents away from the chord: the independent FE
+    reference measures 13 % on its inclined section, tests/integration/test_inclined_crossflow.py)."""
+    for dd in ("horizontal-normal", "cross-flow"):
         case = _case(HILLY, drag_direction=dd)
         st = service.static_analysis(case)
         system = st.system
         Lu = system.unstretched_lengths
-        v = 30.0
-        V = v * np.array([math.sin(math.radians(30.0)), math.cos(math.radians(30.0)), 0.0])
+        V = 30.0 * np.array([math.sin(math.radians(30.0)), math.cos(math.radians(30.0)), 0.0])
         total = np.zeros(3)
         for i in range(system.n_spans):
             c = system.span_chords[i] / np.linalg.norm(system.span_chords[i])
@@ -79,11 +80,11 @@ def test_step1_towers_carry_exactly_the_applied_cross_flow_drag():
             total += 0.5 * RHO * CD * D * np.linalg.norm(up) * up * Lu[i]
         R = st.mean.reactions_wind[0].sum(axis=0) * np.array([1.0, 1.0, -1.0])  # z up, as the loads
         scale = np.abs(total).max()
-        np.testing.assert_allclose(R, total, atol=1e-6 * scale)
-        if dd == "cross-flow":
-            assert abs(total[2]) > 0.03 * scale  # a real vertical drag (15 % slopes, 30 deg wind)
+        if dd == "horizontal-normal":
+            np.testing.assert_allclose(R, total, atol=1e-6 * scale)
         else:
-            assert abs(R[2]) < 1e-6 * scale
+            assert total[2] < -0.03 * scale  # a real vertical drag (slopes 10-15 %, 30 deg wind), downward
+            assert R[2] == pytest.approx(total[2], rel=0.2)
 
 
 def _fluct(case, u_along: float):
@@ -91,7 +92,7 @@ def _fluct(case, u_along: float):
     system = st.system
     sm = service.synoptic_model(case, st, vectors=False)
     t = service.record_time(case)[:3]
-    nw = node_wind(system, mean_vector_at_nodes(case, system, t))
+    nw = record_cross_wind(case, st, t)
     v = np.full((1, t.size, system.n_nodes), u_along)
     loads, direct = fluctuating_loads(case, system, sm.model, t, v, None, None, nw)
     return st, sm, nw, loads, direct
@@ -102,17 +103,17 @@ def test_fluctuating_loads_are_the_exact_cross_flow_drag_of_the_gust(drag):
     """A gust u along the mean wind: the node's load along d is (F(u) - F_mean) . d with
     F(u) = 1/2 rho C_d D L |W_perp| W_perp, W = V (1 + u/|V|) (exact drag of the total wind) and
     F_mean = F(0)(1 + sigma^2/|V|^2) (quadratic) or F(0); linear: its derivative at u = 0 (central
-    difference, error O(h^2) ~ 1e-10 relative)."""
+    difference, error O(h^2) ~ 1e-10 relative); the axis is the mean state's deformed tangent."""
     case = _case(HILLY, drag=drag)
     u = 4.0
     st, sm, nw, loads, _ = _fluct(case, u)
     system, model = st.system, sm.model
     free = model.dofs.free_nodes
-    axes_c = system.span_chords / np.linalg.norm(system.span_chords, axis=1)[:, None]
+    axes = node_tangents(st.mean.nodes[0])  # the mean state's deformed conductor axes
     V = 30.0 * np.array([math.sin(math.radians(30.0)), math.cos(math.radians(30.0)), 0.0])
     sig2 = (0.15 * 30.0) ** 2
     for node in (3, system.ne + 4, 2 * system.ne + 5):  # an interior node of every span
-        c = axes_c[system.span_of_node(node)]
+        c = axes[node]
         L = model.tributary[node]
 
         def F(w, c=c, L=L):
@@ -155,31 +156,20 @@ def test_pinned_node_loads_go_to_the_strain_tower_along_d_with_z_down():
                                rtol=1e-12, atol=1e-12 * f)
 
 
-def test_level_section_is_the_horizontal_normal_form_bit_for_bit():
-    """Level spans: V_perp = V_n n exactly, so the cross-flow form takes the horizontal-normal
-    path (applies() False) and every result is the same bits; the same on inclined spans in wind
-    normal to a straight line (no along-span component)."""
-    level = _case([0.0, 0.0, 0.0, 0.0])
-    assert not applies(level, service.static_analysis(level).system)
-    normal = _case(HILLY, direction=0.0)
-    assert not applies(normal, service.static_analysis(normal).system)
-    assert applies(_case(HILLY), service.static_analysis(_case(HILLY)).system)
-    hn = dataclasses.replace(level, analysis=dataclasses.replace(level.analysis, drag_direction="horizontal-normal"))
-    a, b = service.run_case(level, spectral_check=False), service.run_case(hn, spectral_check=False)
+def test_the_equal_span_form_and_horizontal_normal_keep_the_paper_path_bit_for_bit(cases_dir):
+    """The equal-span (paper) form never takes the cross-flow path (its default drag_direction
+    changes nothing: the same bits), nor does a section with drag_direction = "horizontal-normal"."""
+    from linecheck.core.case import load_case, with_values
+
+    paper = with_values(load_case(cases_dir / "paper" / "case01-six.toml"),
+                        {"analysis.realizations": 1, "analysis.duration": 60.0})
+    cf = with_values(paper, {"analysis.drag_direction": "cross-flow"})
+    assert not applies(cf, service.static_analysis(cf).system)
+    a, b = service.run_case(paper, spectral_check=False), service.run_case(cf, spectral_check=False)
     np.testing.assert_array_equal(a.resonant, b.resonant)
-    np.testing.assert_array_equal(a.mean, b.mean)
-
-
-def test_mean_drag_vectors_reduce_to_the_horizontal_normal_intensity_without_slope_effects():
-    """On the hilly case the cross-flow drag's horizontal-normal component is 1/2 rho C_d D |V_perp| V_n:
-    larger than the horizontal-normal form's 1/2 rho C_d D |V_n| V_n by |V_perp|/|V_n| (closed form)."""
-    case = _case(HILLY, drag="linear")
-    st = service.static_analysis(case)
-    p = mean_drag_vectors(case, st.system, st.wind)[0]
-    vn, vx = 30.0 * math.cos(math.radians(30.0)), 30.0 * math.sin(math.radians(30.0))
-    theta = math.atan2(45.0, 300.0)
-    perp = math.hypot(vn, vx * math.sin(theta))
-    assert p[0, :, 1] == pytest.approx(0.5 * RHO * CD * D * perp * vn, rel=1e-12)
+    section = _case(HILLY)
+    assert applies(section, service.static_analysis(section).system)
+    assert not applies(_case(HILLY, drag_direction="horizontal-normal"), service.static_analysis(section).system)
 
 
 def test_downburst_on_an_inclined_section_runs_with_frozen_directions():
@@ -216,7 +206,6 @@ def test_aerodynamic_damping_follows_the_normal_wind(damping):
     from linecheck.analysis.linear import damping_matrices
     from linecheck.analysis.record import states_cross_wind
     from linecheck.core.case import with_values
-    from linecheck.core.damping import node_tangents
     from linecheck.core.model import band_to_dense, build_model
 
     case = with_values(_case(HILLY), {"analysis.damping": damping, "analysis.structural_damping": 0.0})
@@ -233,7 +222,7 @@ def test_aerodynamic_damping_follows_the_normal_wind(damping):
         d = cross.directions[node]
         np.testing.assert_allclose(B, c * np.outer(d, d), rtol=1e-12, atol=1e-12 * c)
         return
-    e = node_tangents(model, st.mean.nodes[0])[node]
+    e = node_tangents(st.mean.nodes[0])[node]
     w = u - (u @ e) * e
     w /= np.linalg.norm(w)
     np.testing.assert_allclose(B @ w, c * w, atol=1e-12 * c)

@@ -119,7 +119,9 @@ def test_window_of_a_strain_section_is_exact(monkeypatch, tower):
     """Strain towers are pinned: the window that is the tower of interest's whole strain section
     gives the whole line's estimate (the 12-span example has a strain tower at T5; towers 2 and
     9 lie in the sections T1-T5 and T5-T13).  The two grids differ (the other section's poles
-    are refined only in the whole line), hence the 2e-4 tolerance (measured <= 5e-5 and 9e-5)."""
+    are refined only in the whole line), hence the 5e-4 tolerance: measured 3.1e-4 (R_z r.m.s.,
+    tower 2, with the cross-flow drag's vertical load), and 2.0e-5 when both grids are 4x denser
+    (n_log 1200, n_peak 65), so the difference is the grid's, not the window's."""
     case = load_case(CASES / "examples/section-12span.toml")
     case = dataclasses.replace(case, line=dataclasses.replace(case.line, tower_of_interest=tower))
     st = service.static_analysis(case)
@@ -131,7 +133,7 @@ def test_window_of_a_strain_section_is_exact(monkeypatch, tower):
     assert win.window is not None and np.all(win.window.estimated_error == 0.0)
     assert win.window.spans == (4 if tower == 2 else 8)
     for key in ("peak_dynamic", "rms_fluctuating", "rms_background"):
-        np.testing.assert_allclose(getattr(win.exact, key), getattr(whole.exact, key), rtol=2e-4)
+        np.testing.assert_allclose(getattr(win.exact, key), getattr(whole.exact, key), rtol=5e-4)
     np.testing.assert_array_equal(win.exact.mean, whole.exact.mean)  # the whole line's step 1
 
 

@@ -199,8 +199,9 @@ def test_frequency_domain_load_is_the_time_domain_load_on_an_oblique_section():
 
     towers = [_tower(0.0, support="strain"), _tower(300.0, angle=12.0), _tower(640.0, support="strain")]
     case = _case(towers, wind={"direction": 25.0})
-    case = case.__class__(**{**case.__dict__, "analysis": case.analysis.__class__(
-        **{**case.analysis.__dict__, "drag": "linear", "duration": 20.0})})
+    case = case.__class__(**{**case.__dict__, "analysis": case.analysis.__class__(  # the cross-flow form:
+        **{**case.analysis.__dict__, "drag": "linear", "duration": 20.0,  # tests/core/test_crossflow.py
+           "drag_direction": "horizontal-normal"})})
     st = service.static_analysis(case)
     sm = service.synoptic_model(case, st, vectors=False)
     t = service.record_time(case)[:8]

@@ -314,7 +314,9 @@ def test_downburst_point_series_and_table_heights_on_a_section():
 def test_wind_field_on_a_section_is_global_vectors_and_loads_use_node_normals():
     base = load_case(SECTION)
     # the paper's damping has no burn-in, keeping this short (20 s record)
-    case = replace(base, analysis=replace(base.analysis, damping="paper", duration=20.0))
+    # the horizontal-normal drag (the cross-flow form's loads: tests/core/test_crossflow.py)
+    case = replace(base, analysis=replace(base.analysis, damping="paper", duration=20.0,
+                                          drag_direction="horizontal-normal"))
     wf = service.wind_field(case)
     s = LineSystem(case.line)
     np.testing.assert_array_equal(wf.x_node, s.node_xyz0)

@@ -159,8 +159,8 @@ def test_static_table_shows_tower_names_and_stations():
 
 def test_static_table_is_in_each_towers_frame_as_the_json(tmp_path):
     """Every number of the static console table equals the JSON's (each tower's own frame, not the
-    global frame: T13's Ry 1.870 kN, global -4.050 kN; T5's wind Ry 5.631 kN, as the Excel), and a
-    caption names the frame."""
+    global frame: T13's Ry 1.975 kN, global -3.880 kN; T5's wind Ry 5.678 kN, as the Excel; the
+    cross-flow drag's values), and a caption names the frame."""
     out = tmp_path / "s.json"
     r = CliRunner(env={"COLUMNS": "250"}).invoke(app, ["static", str(EXAMPLE), "--json", str(out)])
     assert r.exit_code == 0, r.output
@@ -172,8 +172,8 @@ def test_static_table_is_in_each_towers_frame_as_the_json(tmp_path):
         assert float(cells[3]) == pytest.approx(t["heading"], abs=0.05)
         assert [float(c) for c in cells[-6:]] == [round(t[k] / 1e3, 3) for k in keys], t["name"]
     t13, t5 = doc["towers"][12], doc["towers"][4]
-    assert round(t13["Ry"] / 1e3, 3) == 1.870 and round(t13["global"]["Ry"] / 1e3, 3) == -4.050
-    assert round(t5["Ry_wind"] / 1e3, 3) == 5.631
+    assert round(t13["Ry"] / 1e3, 3) == 1.975 and round(t13["global"]["Ry"] / 1e3, 3) == -3.880
+    assert round(t5["Ry_wind"] / 1e3, 3) == 5.678
     assert "own frame" in r.output and "tower frame: x along the line bisector" in r.output
 
 

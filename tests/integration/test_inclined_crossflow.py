@@ -377,7 +377,6 @@ def test_linecheck_horizontal_normal_matches_reference(tmp_path):
 REFERENCE_AXES = "current"
 
 
-@pytest.mark.skip(reason="linecheck cross-flow loads not yet wired")
 def test_linecheck_crossflow_matches_reference(tmp_path):
     """Acceptance: linecheck ``static`` with ``[analysis] drag_direction = "cross-flow"`` on the
     inclined case: every tower's wind-induced Rx, Ry, Rz (mean wind minus still air, tower frame)

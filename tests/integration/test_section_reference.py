@@ -17,6 +17,7 @@ import json
 import math
 import re
 import shutil
+import tomllib
 from functools import cache
 from pathlib import Path
 
@@ -36,6 +37,17 @@ N_EL = 100  # reference elements per span: discretisation error ~3e-5 of the rea
 def _ref(stem: str, n_el: int = N_EL) -> fe.Solution:
     """FE reference solution of tests/data/sections/<stem>.toml (cached per session)."""
     return fe.solve(DATA / f"{stem}.toml", n_el=n_el)
+
+
+def _drag_direction(path: Path) -> str:
+    """The case's ``[analysis] drag_direction`` as linecheck reads it (default "cross-flow"): the
+    reference loads the same way (cross-flow: the follower drag on its deformed elements)."""
+    return tomllib.loads(path.read_text(encoding="utf-8")).get("analysis", {}).get("drag_direction", "cross-flow")
+
+
+def _ref_as_linecheck(path: Path, n_el: int = N_EL) -> fe.Solution:
+    """FE reference of the case at ``path`` with linecheck's drag model for it."""
+    return fe.solve(path, n_el=n_el, drag_direction=_drag_direction(path))
 
 
 # =============================================================================== A. the reference
@@ -287,7 +299,7 @@ def test_static_reactions_match_reference(stem, tmp_path):
     largest reaction component at that tower (the acceptance check).  The reference mesh error
     (~3e-5) is negligible against the tolerance."""
     doc = _linecheck_json("static", stem, tmp_path)
-    sol = _ref(stem)
+    sol = _ref_as_linecheck(DATA / f"{stem}.toml")
     state = sol.wind if sol.wind is not None else sol.still
     tw, gl = _lc_reactions(doc)
     assert tw.shape == state.reactions.shape, f"{tw.shape[0]} towers in the JSON, {state.reactions.shape[0]} in the case"
@@ -375,7 +387,7 @@ def test_shipped_section_examples_match_reference(example, still, tmp_path):
     r = CliRunner(env={"COLUMNS": "250"}).invoke(app, ["static", str(case), "--json", str(out)])
     assert r.exit_code == 0, r.output
     tw, gl = _lc_reactions(json.loads(out.read_text(encoding="utf-8")))
-    sol = fe.solve(case, n_el=N_EL)
+    sol = _ref_as_linecheck(case)
     state = sol.still if still else sol.wind
     for name, lc, ref in (("tower frame", tw, state.reactions_tower), ("global", gl, state.reactions)):
         err = np.abs(lc - ref) / np.abs(ref).max(axis=1, keepdims=True)

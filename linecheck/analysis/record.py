@@ -78,24 +78,32 @@ def states_cross_wind(case: Case, st: StaticResult) -> NodeWind | None:
     return node_wind(st.system, mean_vector_at_nodes(case, st.system, st.mean.time), node_tangents(st.mean.nodes))
 
 
-def record_cross_wind(case: Case, st: StaticResult, t: np.ndarray) -> NodeWind | None:
-    """:func:`states_cross_wind` over the record ``t`` [s], (n_steps, n_nodes) each: the mean wind
-    at every step on the axes of its nearest mean state, with the states' load directions (one
-    per node for the whole record; synoptic: the held mean, rows of stride 0)."""
+def record_cross_wind(case: Case, st: StaticResult, t: np.ndarray, vn: np.ndarray,
+                      vl: np.ndarray | None) -> NodeWind | None:
+    """:func:`states_cross_wind` over the record ``t`` [s], (n_steps, n_nodes) each, from the
+    record's running-mean normal and along-line speeds ``vn``, ``vl`` [m/s] (:func:`record_wind`,
+    (n_steps, n_nodes); the horizontal wind vn n + vl e at each node, n its normal and e its
+    along-line direction): the mean wind at every step on the axes of its nearest mean state,
+    with the states' load directions (one per node for the whole record; a synoptic record holds
+    its mean, rows of stride 0)."""
     states = states_cross_wind(case, st)
     if states is None:
         return None
     system, d = st.system, states.directions
     axes = node_tangents(st.mean.nodes)  # (n_k, n_nodes, 3)
-    if case.wind.type == "synoptic":
-        one = node_wind(system, mean_vector_at_nodes(case, system, t[:1]), axes[0], d)
+    n, e = system.node_normals, system.node_frames[:, :, 0]
+    held = case.wind.type == "synoptic"
+    rows = slice(0, 1) if held else slice(None)
+    vl = np.zeros_like(vn) if vl is None else vl
+    v = vn[rows, :, None] * n + vl[rows, :, None] * e
+    if held:
+        one = node_wind(system, v, axes[0], d)
 
-        def held(a: np.ndarray) -> np.ndarray:
+        def over(a: np.ndarray) -> np.ndarray:
             return np.broadcast_to(a, (t.size,) + a.shape[1:])
 
-        return NodeWind(held(one.along), held(one.rest), held(one.perp), held(one.perp_vectors), d)
-    nearest = state_of_step(st.mean.time, t)[0]
-    return node_wind(system, mean_vector_at_nodes(case, system, t), axes[nearest], d)
+        return NodeWind(over(one.along), over(one.rest), over(one.perp), over(one.perp_vectors), d)
+    return node_wind(system, v, axes[state_of_step(st.mean.time, t)[0]], d)
 
 
 def record_wind(case: Case, st: StaticResult, t: np.ndarray) -> tuple[np.ndarray, np.ndarray | None, np.ndarray]:

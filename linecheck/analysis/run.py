@@ -323,7 +323,7 @@ def plan_run(case: Case, *, realizations, interpolate_states: bool, spectral_che
         towers = slice(j, j + 1)
         M, still_air, gL = M[:, towers], still_air[towers], gL[towers] if np.ndim(gL) else gL
         models, second = _tower_rows(j, models, second)
-    cross = record_cross_wind(case, st, t)  # a section in cross-flow: every node's load direction
+    cross = record_cross_wind(case, st, t, vn, vl)  # a section in cross-flow: every node's load direction
     load_dirs = None if system.straight_in_plan else system.node_normals[models[0].dofs.free_nodes]
     if cross is not None:
         load_dirs = cross.directions[models[0].dofs.free_nodes]

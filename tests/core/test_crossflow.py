@@ -92,7 +92,7 @@ def _fluct(case, u_along: float):
     system = st.system
     sm = service.synoptic_model(case, st, vectors=False)
     t = service.record_time(case)[:3]
-    nw = record_cross_wind(case, st, t)
+    nw = record_cross_wind(case, st, t, *service.record_mean_wind(case, st, t))
     v = np.full((1, t.size, system.n_nodes), u_along)
     loads, direct = fluctuating_loads(case, system, sm.model, t, v, None, None, nw)
     return st, sm, nw, loads, direct

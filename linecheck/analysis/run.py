@@ -179,6 +179,11 @@ class RunPlan:
     tower_only: bool
 
     @property
+    def lead(self) -> int:
+        """Steps of the burn-in, which precede the analysed record."""
+        return int(np.argmax(self.keep))
+
+    @property
     def n_chunks(self) -> int:
         """Chunks of :attr:`chunk` realizations."""
         return -(-self.realizations.size // self.chunk)
@@ -371,38 +376,62 @@ class _ChunkProgress:
         return cb
 
 
-def run_chunk(plan: RunPlan, ci: int, stop: AnyEvent, reports: _ChunkProgress):
-    """Chunk ``ci`` of a run: its realizations' turbulence, fluctuating loads (paper Eq. 5),
-    steps 2-3 and statistics (Eqs 15-17).  Returns the statistics and B(t), R(t) [N] at the tower
-    of interest over the kept steps, (n_chunk_real, n_keep, 3) each."""
+def chunk_velocity(plan: RunPlan, realizations: np.ndarray, stop: AnyEvent | threading.Event | None) -> np.ndarray:
+    """The fluctuating along-wind velocity [m/s] of ``realizations`` (0-based) over the plan's
+    record, (n, n_steps, n_nodes): the burn-in's :attr:`RunPlan.lead` steps lead the analysed
+    record (common random numbers: the analysed turbulence does not depend on the burn-in's
+    length, docs/wind.md).  ``stop`` is checked before each realization."""
     from ..core.wind.turbulence import fluctuating_velocity
 
+    return fluctuating_velocity(plan.case, plan.static.system, plan.time, list(realizations), plan.a_turb,
+                                lead=plan.lead, cancel=stop)
+
+
+def chunk_response(plan: RunPlan, v: list[np.ndarray], stop: AnyEvent | threading.Event,
+                   loads_done: Callable[[], None] | None = None,
+                   steps: Callable[[int, int], None] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Steps 2-3 of a chunk given its turbulence: the fluctuating loads (paper Eq. 5), the Newmark
+    integration and the quasi-static background (Eqs 6, 14).  Returns B(t), R(t) [N] at every
+    computed tower (:attr:`RunPlan.towers`) in its own frame over the kept steps, (n, n_keep,
+    n_towers', 3) each.
+
+    ``v``: a one-item list holding the chunk's velocity [m/s], (n, n_steps, n_nodes) over the
+    plan's record; it is emptied, so the velocity is freed once the loads are built (when the
+    caller holds no other reference).  ``loads_done()`` is called once the loads are built,
+    ``steps(done, total)`` reports the integration; ``stop`` set: Cancelled."""
     case, system, t, towers = plan.case, plan.static.system, plan.time, plan.towers
-    rc = plan.realizations[ci * plan.chunk:(ci + 1) * plan.chunk]
-    reports.report("wind", reports.winds_done, plan.n_chunks)
-    # (n_real, n_steps, n_nodes), along-wind; the burn-in's steps lead the analysed record (common
-    # random numbers: the analysed turbulence does not depend on the burn-in's length)
-    v = fluctuating_velocity(case, system, t, list(rc), plan.a_turb, lead=int(np.argmax(plan.keep)), cancel=stop)
-    loads, direct = fluctuating_loads(case, system, plan.models[0], t, v, plan.vn, plan.vl, plan.cross)
+    loads, direct = fluctuating_loads(case, system, plan.models[0], t, v.pop(), plan.vn, plan.vl, plan.cross)
     direct = direct.reshape(direct.shape[:2] + (-1, 3))[:, :, towers].reshape(direct.shape[:2] + (-1,))
-    reports.wind_done()
+    if loads_done is not None:
+        loads_done()
     if stop.is_set():
         raise Cancelled("run cancelled")
-    del v
     resp = integrate(plan.models, plan.damping, plan.nearest, loads, case.analysis.time_step, direct=direct,
-                     model_at=plan.model_at, second_order=plan.second_order,
-                     second_order_start=int(np.argmax(plan.keep)), progress=reports.steps(ci), cancel=stop,
-                     load_dirs=plan.load_dirs)
+                     model_at=plan.model_at, second_order=plan.second_order, second_order_start=plan.lead,
+                     progress=steps, cancel=stop, load_dirs=plan.load_dirs)
     del loads, direct
     # every reaction from here on in its tower's own frame (a straight line: the global frame)
     resp = DynamicResponse(system.to_tower_frames(resp.fluctuating, towers),
                            system.to_tower_frames(resp.background, towers))
-    Bk, Rk = resp.background[:, plan.keep], resp.resonant[:, plan.keep]
-    del resp
-    jr = 0 if plan.tower_only else case.line.tower_of_interest - 1  # the tower of interest among the computed
-    stats = compute_statistics(plan.mean, Bk, Rk, plan.still_air, plan.gL, window=peak_window_steps(case),
-                               scale=plan.scale)
-    return stats, Bk[:, :, jr, :].copy(), Rk[:, :, jr, :].copy()
+    return resp.background[:, plan.keep], resp.resonant[:, plan.keep]
+
+
+def chunk_statistics(plan: RunPlan, background: np.ndarray, resonant: np.ndarray) -> Statistics:
+    """The statistics of Eqs 15-17 of a chunk's B(t), R(t) [N] (:func:`chunk_response`, (n, n_keep,
+    n_towers', 3)) with the plan's mean, still-air reactions, g_yp L and peak window."""
+    return compute_statistics(plan.mean, background, resonant, plan.still_air, plan.gL,
+                              window=peak_window_steps(plan.case), scale=plan.scale)
+
+
+def run_chunk(plan: RunPlan, ci: int, stop: AnyEvent, reports: _ChunkProgress):
+    """Chunk ``ci`` of a run: its realizations' turbulence (:func:`chunk_velocity`), steps 2-3
+    (:func:`chunk_response`) and statistics (Eqs 15-17).  Returns the statistics and B(t), R(t)
+    [N] at the tower of interest over the kept steps, (n_chunk_real, n_keep, 3) each."""
+    rc = plan.realizations[ci * plan.chunk:(ci + 1) * plan.chunk]
+    reports.report("wind", reports.winds_done, plan.n_chunks)
+    Bk, Rk = chunk_response(plan, [chunk_velocity(plan, rc, stop)], stop, reports.wind_done, reports.steps(ci))
+    jr = 0 if plan.tower_only else plan.case.line.tower_of_interest - 1  # the tower of interest among the computed
+    return chunk_statistics(plan, Bk, Rk), Bk[:, :, jr, :].copy(), Rk[:, :, jr, :].copy()
 
 
 def execute(plan: RunPlan, *, progress: Progress | None, cancel: threading.Event | None):

@@ -216,6 +216,15 @@ needs the columns `station` and `type`).
   and 10 as in Simiu & Scanlan, "Wind Effects on Structures" (3rd ed., 1996, Sect. 2.3, after
   Vellozzi & Cohen 1968; quoted as the literature quotes them, not checked against the book's
   page). Only a case with `[[wires]]` reads them.
+- **Jobs.** A case with `[[wires]]` runs `check` and `static`. Every other job (`run`,
+  `spectral`, `modes`, `wind`, `codes`, `scan`, a batch's run, the TUI's run) analyses one wire
+  and refuses it in one line before any work (exit 2; a batch fails that case and runs the
+  others):
+
+  ```
+  error: c.toml: wires: a case with several wires runs `check` and `static` (every attachment and
+  the tower totals); `run` of several wires is not available yet: run each wire as a single-wire case
+  ```
 
 Cross-checks (one line naming the file, key and line or CSV row and column, the value and what
 is allowed; exit 2): `[[wires]]` and `[[tower_types]]` both given; wire and type names unique

@@ -16,6 +16,7 @@ from ..core.case import Case
 from ..core.codes import CODES_COMPARED, CODES_PEAK  # what is compared: one text for every front end
 from ..core.static import solve_static_batch
 from ..core.system import LineSystem
+from .guard import require_one_wire
 
 if TYPE_CHECKING:  # names of annotations only
     from .run import RunResult
@@ -98,6 +99,7 @@ def code_loads(case: Case, *, strict: bool = True) -> list:
     from ..core import codes as C
     from ..core.errors import CaseError
 
+    require_one_wire(case, "codes")  # the codes' loads are of the case's line: one wire
     line, wind, cc = case.line, case.wind, case.codes
     src = str(case.source) if case.source else None
     if wind.type == "downburst":

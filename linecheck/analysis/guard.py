@@ -1,9 +1,11 @@
-"""The resource guard and the checks of ``linecheck check`` beyond the case schema.
+"""The resource guard, the one-wire guard and the checks of ``linecheck check`` beyond the case
+schema.
 
-Every job calls :func:`check_budget` before it allocates anything; :func:`check_case` adds what
-``check`` verifies without running (field file, V_ref at point p, record length).  Imports only
-the case model, the budget and (for downbursts) the mean-wind module: ``linecheck check`` answers
-without loading the solvers.  Nothing here prints.
+Every job calls :func:`check_budget` before it allocates anything; it refuses first a case with
+``[[wires]]`` for a job that analyses one wire (:func:`require_one_wire`).  :func:`check_case`
+adds what ``check`` verifies without running (field file, V_ref at point p, record length).
+Imports only the case model, the budget and (for downbursts) the mean-wind module: ``linecheck
+check`` answers without loading the solvers.  Nothing here prints.
 """
 
 from __future__ import annotations
@@ -16,11 +18,28 @@ from ..core.errors import CaseError
 
 Warn = Callable[[str], None]
 
+#: The jobs a case with ``[[wires]]`` runs: every other job analyses one wire (the case's
+#: ``line`` is only its first wire's) and :func:`require_one_wire` refuses it.
+WIRES_JOBS = frozenset({"static"})
+
+
+def require_one_wire(case: Case, job: str) -> None:
+    """Refuse ``job`` on a case with ``[[wires]]`` unless it is one of :data:`WIRES_JOBS`: one
+    :class:`~linecheck.core.errors.CaseError` line (exit 2) naming the file, what such a case
+    runs and what to do.  :func:`check_budget` calls it, so every job meets it before any work;
+    the few entry points without a resource guard (code loads, scan, batch) call it themselves."""
+    if case.has_wires and job not in WIRES_JOBS:
+        raise CaseError(f"a case with several wires runs `check` and `static` (every attachment and the tower "
+                        f"totals); `{job}` of several wires is not available yet: run each wire as a single-wire case",
+                        file=str(case.source) if case.source else None, key="wires")
+
 
 def check_budget(case: Case, job: str = "run", *, warn: Warn | None = None, **kwargs) -> budget.Estimate:
     """Estimated peak memory and time of ``job`` (:mod:`linecheck.core.budget`); raises
-    :class:`~linecheck.core.errors.CaseError` (exit 2) above the memory limit and calls
-    ``warn(message)`` above the warning thresholds.  Every job calls it first."""
+    :class:`~linecheck.core.errors.CaseError` (exit 2) for a job a case with ``[[wires]]`` does
+    not run (:func:`require_one_wire`) and above the memory limit, and calls ``warn(message)``
+    above the warning thresholds.  Every job calls it first."""
+    require_one_wire(case, job)
     return budget.guard(case, job, warn, **kwargs)
 
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..core import budget
+from ..analysis.guard import check_budget
 from ..core.case import Case, case_hash, load_case
 from ..core.errors import CaseError, LinecheckError
 from .report import CaseOutcome, RunJob
@@ -145,7 +145,8 @@ def guard(st: CaseState, until: tuple[float, int] | None) -> None:
 
     Each task checks its own chunk, but the merged result keeps every realization's histories,
     so a case above the memory limit fails here alone (its one-line estimate, a CaseError) and
-    the others run; above half the limit or about 10 minutes it runs with a warning
+    the others run, as does a case with ``[[wires]]`` (a run analyses one wire:
+    :func:`~linecheck.analysis.guard.require_one_wire`); above half the limit or about 10 minutes it runs with a warning
     (``outcome.warning``, the ``case_warning`` event).
     """
     o = st.outcome
@@ -153,7 +154,7 @@ def guard(st: CaseState, until: tuple[float, int] | None) -> None:
         return
     n = max(2, min(o.realizations, int(until[1]))) if until is not None else o.realizations  # run_until's start
     try:
-        budget.guard(st.case, "run", realizations=n, warn=lambda m, o=o: setattr(o, "warning", m))
+        check_budget(st.case, "run", realizations=n, warn=lambda m, o=o: setattr(o, "warning", m))
     except CaseError as err:
         o.status, o.error, o.error_kind = "failed", str(err), type(err).__name__
         st.done = o.realizations  # its own progress complete; none of it in the overall count

@@ -528,9 +528,12 @@ def scan_estimate(case: Case, points: int, *, dynamic_realizations: int = 0, wor
                   warn: Callable[[str], None] | None = None) -> Any:
     """The resource guard of a scan (:func:`linecheck.core.budget.estimate_scan`): CaseError
     (exit 2) when one position is above the memory limit; ``warn(message)`` above half of it or
-    when the scan is estimated to take longer than about 10 minutes on ``workers``."""
+    when the scan is estimated to take longer than about 10 minutes on ``workers``; CaseError for a
+    case with ``[[wires]]`` (:func:`~linecheck.analysis.guard.require_one_wire`)."""
+    from ..analysis.guard import require_one_wire
     from ..core import budget
 
+    require_one_wire(case, "scan")
     return budget.check(budget.estimate_scan(case, points, dynamic_realizations=dynamic_realizations,
                                              workers=workers), case, warn)
 

@@ -415,6 +415,7 @@ def _assemble(case: Case, names: tuple[str, ...], ctx: _Wires, parts: list) -> W
         arms=ctx.arms, attachments=tuple(join([s[w] for s in stats]) for w in range(len(plans))),
         attachment_moments=tuple(join([s[w] for s in mstats]) for w in range(len(plans))),
         still_air=np.stack([p.still_air for p in plans]), forces=join(forces), moments=join(moments),
-        totals_still_air=ctx.still_totals, load_trees=trees[0] if len(trees) == 1 else LoadTrees.concatenate(list(trees)),
+        totals_still_air=ctx.still_totals,
+        load_trees=trees[0] if len(trees) == 1 else LoadTrees.concatenate(list(trees)),
         station_spread=spread,
     )

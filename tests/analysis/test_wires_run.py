@@ -284,3 +284,29 @@ def test_progress_and_cancel(three):
     cancel.set()
     with pytest.raises(Cancelled):
         run_wires(three, realizations=[0], cancel=cancel)
+
+
+def test_load_trees_at_the_totals_peaks_with_peak_windows(three):
+    """With 30 s peak windows every statistic and tree is per window (3 realizations x 4 windows of
+    the 120 s record): each governing total's value is its peak with still air (max |total|:
+    peak_dynamic_total up to the sign; uplift: the least F_z, at most F_z at the other instants),
+    its instant lies in its window, and its attachments' loads add up to it (forces: the sum;
+    moments: tower_moments of the loads)."""
+    case = dataclasses.replace(three, analysis=dataclasses.replace(three.analysis, peak_window=30.0))
+    r = run_wires(case, realizations=REALIZATIONS)
+    trees, n_win = r.load_trees, 4
+    assert r.forces.n_samples == trees.value.shape[0] == 3 * n_win
+    six = r.totals("peak_dynamic_total")
+    for c, (k, sense) in enumerate(GOVERNING.values()):
+        if sense == "abs":
+            np.testing.assert_allclose(np.abs(trees.value[..., c]), six[..., k], rtol=1e-12)
+    window = np.arange(trees.time.shape[0]) % n_win  # the sample's window in its realization
+    start = r.time[0] + window * 30.0
+    assert np.all((trees.time >= start[:, None, None] - 1e-9) & (trees.time < start[:, None, None] + 30.0 - 1e-9))
+    forces = trees.loads.sum(axis=3)  # (n_s, n_towers, n_cases, 3)
+    moments = tower_moments(trees.loads, r.arms[None, :, None, :, 0], r.arms[None, :, None, :, 1]).sum(axis=3)
+    totals = np.concatenate([forces, moments], axis=-1)
+    for c, (k, _) in enumerate(GOVERNING.values()):
+        np.testing.assert_allclose(totals[..., c, k], trees.value[..., c], rtol=1e-9, atol=1e-6)
+    # the least F_z of a window is at most its F_z at any other case's instant in that window
+    assert np.all(trees.value[..., 4] <= totals[..., :4, 2].min(axis=-1) + 1e-9)

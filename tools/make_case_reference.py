@@ -216,10 +216,13 @@ needs the columns `station` and `type`).
   and 10 as in Simiu & Scanlan, "Wind Effects on Structures" (3rd ed., 1996, Sect. 2.3, after
   Vellozzi & Cohen 1968; quoted as the literature quotes them, not checked against the book's
   page). Only a case with `[[wires]]` reads them.
-- **Jobs.** A case with `[[wires]]` runs `check` and `static`. Every other job (`run`,
-  `spectral`, `modes`, `wind`, `codes`, `scan`, a batch's run, the TUI's run) analyses one wire
-  and refuses it in one line before any work (exit 2; a batch fails that case and runs the
-  others):
+- **One wind.** Every wire is loaded by the case's wind, with V_ref at the case's
+  `reference_height` (default: the case's mean clamp height, which with `[[wires]]` is the
+  first wire's); a wire's single-wire case carries that height (docs/wires.md "One wind").
+- **Jobs.** A case with `[[wires]]` runs `check` and `static` (every attachment's reactions and
+  each tower's totals: docs/wires.md). Every other job (`run`, `spectral`, `modes`, `wind`,
+  `codes`, `scan`, a batch's run, the TUI's run) analyses one wire and refuses it in one line
+  before any work (exit 2; a batch fails that case and runs the others):
 
   ```
   error: c.toml: wires: a case with several wires runs `check` and `static` (every attachment and

@@ -61,7 +61,12 @@ def static_result(case: Case, *, progress: Progress | None = None,
                   cancel: threading.Event | None = None) -> StaticResult:
     """:func:`static_analysis` without the case's warnings and the resource guard: for jobs that
     ran the guard themselves.  ``progress(stage, done, total)`` over the mean states; a set
-    ``cancel`` stops with :class:`~linecheck.core.errors.Cancelled`."""
+    ``cancel`` stops with :class:`~linecheck.core.errors.Cancelled`.  ValueError for a case with
+    ``[[wires]]``: its ``line`` is only the first wire's (every wire:
+    :func:`~linecheck.analysis.wires_static.wires_static_analysis`)."""
+    if case.has_wires:
+        raise ValueError(f"{case.name}: step 1 analyses one wire: a case with [[wires]] goes through "
+                         "wires_static_analysis (each wire's wire_case)")
     system = LineSystem(case.line)
     wind = mean_wind(case, system, mean_state_times(case))
     gy = mean_loads(case, wind)  # paper Eq. 1

@@ -42,17 +42,20 @@ def check(cases: CasesArg) -> None:
 
 def _warn_uplift(case) -> None:
     """Step 1 of a section (still air and the mean wind) for its uplift: one warning line when a
-    suspension insulator would be in compression (:func:`linecheck.analysis.uplift.uplift_warning`).
-    The equal-span form has level clamps and cannot lift."""
+    suspension insulator would be in compression (:func:`linecheck.analysis.uplift.uplift_warning`;
+    with [[wires]] one line per wire with uplift).  The equal-span form has level clamps and
+    cannot lift."""
     from ..analysis.step1 import static_result
     from ..analysis.uplift import uplift_warning
+    from ..analysis.wires_static import wires_uplift_warnings
 
     try:
-        message = uplift_warning(static_result(case))
+        messages = wires_uplift_warnings(case) if case.has_wires else [uplift_warning(static_result(case))]
     except ConvergenceError as err:
-        message = f"uplift not checked: step 1 found no equilibrium: {err}"
-    if message:
-        limits_warn(message)
+        messages = [f"uplift not checked: step 1 found no equilibrium: {err}"]
+    for message in messages:
+        if message:
+            limits_warn(message)
 
 
 def section_line(case) -> str:
@@ -107,7 +110,7 @@ def _weight_span_cell(u: dict | None, k: int) -> str:
 @app.command()
 @handle_errors
 def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
-    """Step 1: non-linear static analysis under the (running-)mean wind."""
+    """Step 1: non-linear static analysis under the (running-)mean wind (with [[wires]]: every attachment and the tower totals)."""
     from .. import service
     from ..io.display import UPLIFT_CONSEQUENCE, tower_frame_caption, uplift_static_lines
     from ..io.jsonout import static_to_dict, write_json
@@ -116,6 +119,9 @@ def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     check_outputs([("--json", json_out)], case_inputs(case))
     if json_out is not None:
         check_target(json_out, what="JSON")
+    if case.has_wires:
+        _static_wires(case, json_out)
+        return
     with progress_bar() as cb:
         res = service.static_analysis(case, progress=cb, warn=limits_warn)
     doc = static_to_dict(res)
@@ -139,6 +145,22 @@ def static(case_file: CaseArg, json_out: JsonOpt = None) -> None:
     if case.wind.type == "downburst":
         console.print(f"[dim]{m.time.size} mean states over t = {m.time[0]:.0f} to {m.time[-1]:.0f} s; "
                       "rows show the instant of peak wind-induced Ry at each tower.[/]")
+    if json_out is not None:
+        write_json(json_out, doc)
+        console.print(f"wrote {json_out}")
+
+
+def _static_wires(case, json_out) -> None:
+    """`static` of a case with [[wires]]: step 1 of every wire, each attachment's reactions and the
+    tower totals (:func:`linecheck.service.wires_static_analysis`)."""
+    from .. import service
+    from ..io.jsonout import wires_static_to_dict, write_json
+    from .wires_view import print_wires_static
+
+    with progress_bar() as cb:
+        res = service.wires_static_analysis(case, progress=cb, warn=limits_warn)
+    doc = wires_static_to_dict(res)
+    print_wires_static(doc, straight=res.wires[0].system.straight_in_plan)
     if json_out is not None:
         write_json(json_out, doc)
         console.print(f"wrote {json_out}")

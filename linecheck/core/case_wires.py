@@ -92,7 +92,11 @@ def wire_case(case: Case, wire_name: str) -> Case:
     bundle-equivalent wire (module docstring) on the towers its attachments give, with no wires
     and no tower types (a case today's analysis runs and the loader accepts: ``case_to_dict``
     of it loads to it again).  Name, description, source, wind, analysis and codes are the
-    case's.  KeyError when the case has no wire ``wire_name`` (or no wires)."""
+    case's, and so is the reference height of V_ref: one wind for every wire.  Without
+    ``wind.reference_height`` the case's default is its line's mean clamp height (the first
+    wire's); a wire whose own mean clamp height differs gets that height written in, where its
+    own default would scale the profile (and a downburst) at its own height.  KeyError when the
+    case has no wire ``wire_name`` (or no wires)."""
     wire = case.wire(wire_name)
     frames = [{"name": t.name, "station": t.station, "ground": t.ground, "angle": t.angle, "type": t.type}
               for t in case.line.towers]
@@ -100,7 +104,10 @@ def wire_case(case: Case, wire_name: str) -> Case:
     line_d = {spec.name: getattr(case.line, spec.name) for spec in SCHEMA["line"]}
     line_d["towers_file"] = None  # the wire's towers are its own: held inline
     line = _wire_line(line_d, towers, wire, ErrorContext(None, None))
-    return dataclasses.replace(case, line=line, wires=(), tower_types=())
+    wind = case.wind
+    if wind.reference_height is None and line.height != case.line.height:  # V_ref at the case's z_ref
+        wind = dataclasses.replace(wind, reference_height=float(case.line.height))
+    return dataclasses.replace(case, line=line, wind=wind, wires=(), tower_types=())
 
 
 def clamp_height(attachment: Attachment, line_insulator: float) -> float:

@@ -17,7 +17,7 @@ from .atomic import write_text_atomic
 from .stat_table import SPECTRAL_EXACT
 
 if TYPE_CHECKING:  # annotations only: importing the service loads the numerical core
-    from ..service import StaticResult
+    from ..service import StaticResult, WiresStatic
 
 
 def _num(x: Any) -> Any:
@@ -97,6 +97,25 @@ def _static_uplift(u: Any, j: int, series: bool) -> dict[str, Any]:
                           "held": bool(u.held_still_air[j])}}
 
 
+def _static_spans(system: Any, m: Any, pick: Any) -> list[dict[str, Any]]:
+    """The ``spans`` of the step-1 JSON: each span's mean tension H [N] (``pick``: one value, or a
+    list over a downburst's instants), in still air and at clipping-in, and on a section its
+    length, unstretched length [m] and heading [deg]."""
+    spans = []
+    for n in range(system.n_spans):
+        sp = {
+            "index": n + 1,
+            "tension": pick(m.tension[:, n]),
+            "tension_still_air": _num(m.still_air.tension[n]),
+            "tension_nominal": _num(system.tension_nominal),
+        }
+        if system.is_section:
+            sp.update(length=_num(system.span_lengths[n]), unstretched_length=_num(system.unstretched_lengths[n]),
+                      heading=_num(np.degrees(system.span_headings[n])))
+        spans.append(sp)
+    return spans
+
+
 def static_to_dict(res: StaticResult) -> dict[str, Any]:
     """Step-1 JSON: ``{"case", "units", "tower_of_interest", "towers": [...], "spans": [...],
     "provenance"}``; every suspension tower has ``"uplift"`` (:func:`_static_uplift`).
@@ -120,27 +139,75 @@ def static_to_dict(res: StaticResult) -> dict[str, Any]:
     u = step1_uplift(res)
     for j in np.flatnonzero(u.suspension):
         towers[j]["uplift"] = _static_uplift(u, int(j), series)
-    spans = []
-    for n in range(system.n_spans):
-        sp = {
-            "index": n + 1,
-            "tension": pick(m.tension[:, n]),
-            "tension_still_air": _num(still.tension[n]),
-            "tension_nominal": _num(system.tension_nominal),
-        }
-        if system.is_section:
-            sp.update(length=_num(system.span_lengths[n]), unstretched_length=_num(system.unstretched_lengths[n]),
-                      heading=_num(np.degrees(system.span_headings[n])))
-        spans.append(sp)
     doc: dict[str, Any] = {
         **_header(case),
         # the equal-span form's L_u; a section: the total (every span's in "spans")
         "unstretched_length": _num(system.unstretched_lengths.sum() if system.is_section else system.unstretched_length),
         "towers": towers,
-        "spans": spans,
+        "spans": _static_spans(system, m, pick),
     }
     if series:
         doc["time"] = _num(m.time)
+    return with_provenance(doc)
+
+
+#: Keys of a step-1 tower that place the tower: a case with [[wires]] gives them once per tower,
+#: and each attachment the rest of a tower's step-1 keys for its wire.
+_TOWER_PLACE_KEYS = ("index", "name", "station", "ground", "angle", "heading")
+
+
+def wires_static_to_dict(res: WiresStatic) -> dict[str, Any]:
+    """Step-1 JSON of a case with ``[[wires]]`` (a :class:`~linecheck.service.WiresStatic`;
+    docs/wires.md): ``{"case", ..., "wires": [...], "towers": [...], "provenance"}``.
+
+    ``wires[k]``: ``name``, ``kind``, ``bundle``, ``unstretched_length`` [m] and ``spans`` (as
+    the single-wire ``spans``).  ``towers[i]``: its place (``index``, ``name``, ``station``,
+    ``ground``, ``angle``, ``heading``, ``type``); ``attachments[j]`` = ``{"wire", "kind", "y",
+    "z", ...}`` with the single-wire tower's keys for that wire (``support``, ``height`` (its
+    clamp), ``Rx``, ``Ry``, ``Rz``, their ``_wind`` and ``_still_air`` parts [N] in the tower
+    frame, ``dx``, ``dy``, ``dz`` [m], ``global``, and ``uplift`` at a suspension attachment);
+    ``totals``: ``Fx``, ``Fy``, ``Fz`` [N] and ``Mx``, ``My``, ``Mz`` [N m] about the tower's
+    base with their ``_wind`` and ``_still_air`` parts (:func:`~linecheck.analysis.wires_static.tower_totals`);
+    and the single-wire tower's ``Rx``, ``Ry``, ``Rz`` (and their parts) = the totals' forces, so
+    a reader of single-wire documents sees the tower's whole load.  Synoptic: one value per key;
+    downburst: lists over the step-1 instants, and ``"time"`` lists them."""
+    from ..analysis.wires_static import TOTALS
+
+    case = res.case
+    series = case.wind.type == "downburst"
+
+    def pick(a: np.ndarray) -> Any:
+        return _num(a if series else a[0])
+
+    tot, tot0 = res.totals, res.totals_still_air
+    uplifts = [res.uplift(w) for w in range(len(res.wires))]
+    towers = []
+    for j, tw in enumerate(case.line.towers):
+        place = res.wires[0].system
+        t: dict[str, Any] = {"index": j + 1, "name": tw.name, "station": _num(place.stations[j]), "ground": tw.ground,
+                             "angle": tw.angle, "heading": _num(np.degrees(place.tower_headings[j])), "type": tw.type}
+        for c, r in enumerate(("Rx", "Ry", "Rz")):  # the totals' forces under the single-wire keys
+            t.update({r: pick(tot[:, j, c]), f"{r}_wind": pick(tot[:, j, c] - tot0[j, c]),
+                      f"{r}_still_air": _num(tot0[j, c])})
+        attachments = []
+        for w, (wire, st) in enumerate(zip(case.wires, res.wires)):
+            one = _static_tower(st.case, st.system, st.mean, res.reactions[:, :, w], res.still_air[:, w], j, pick)
+            a = {"wire": wire.name, "kind": wire.kind, "y": _num(res.y[j, w]), "z": _num(res.z[j, w]),
+                 **{k: v for k, v in one.items() if k not in _TOWER_PLACE_KEYS}}
+            if uplifts[w].suspension[j]:
+                a["uplift"] = _static_uplift(uplifts[w], j, series)
+            attachments.append(a)
+        t["attachments"] = attachments
+        t["totals"] = {**{k: pick(tot[:, j, c]) for c, k in enumerate(TOTALS)},
+                       **{f"{k}_wind": pick(tot[:, j, c] - tot0[j, c]) for c, k in enumerate(TOTALS)},
+                       **{f"{k}_still_air": _num(tot0[j, c]) for c, k in enumerate(TOTALS)}}
+        towers.append(t)
+    wires = [{"name": wire.name, "kind": wire.kind, "bundle": wire.bundle,
+              "unstretched_length": _num(st.system.unstretched_lengths.sum()),
+              "spans": _static_spans(st.system, st.mean, pick)} for wire, st in zip(case.wires, res.wires)]
+    doc: dict[str, Any] = {**_header(case), "wires": wires, "towers": towers}
+    if series:
+        doc["time"] = _num(res.time)
     return with_provenance(doc)
 
 

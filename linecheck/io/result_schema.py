@@ -166,6 +166,57 @@ def _uplift_schema() -> dict[str, Any]:
             "required": ["margin", "weight_span", "time", "still_air"], "additionalProperties": False}
 
 
+#: A step-1 value: a number, or a list over a downburst's step-1 instants (null where undefined).
+STEP1_VALUE = {"type": ["number", "null", "array"], "items": NUM_OR_NULL}
+
+
+def _static_wires_schemas() -> tuple[dict[str, Any], dict[str, Any]]:
+    """Schemas of ``towers[i].attachments[j]`` and ``towers[i].totals`` of the step-1 document of
+    a case with ``[[wires]]`` (``linecheck static --json``, docs/wires.md; not a run result)."""
+    reactions = ("Rx", "Ry", "Rz")
+    held = {"type": ["boolean", "array"], "items": {"type": "boolean"}}
+    still = {"type": "object", "properties": {"margin": NUM_OR_NULL, "weight_span": NUM_OR_NULL,
+                                              "held": {"type": "boolean"}},
+             "required": ["margin", "weight_span", "held"], "additionalProperties": False}
+    uplift = {"type": "object", "description": "suspension attachments only: margin [N] (R_z, negative: the "
+              "insulator would be in compression), weight_span [m] = margin / the wire's weight per length, held "
+              "(the clamp held at its still-air point), in each step-1 state and in still_air",
+              "properties": {"margin": STEP1_VALUE, "weight_span": STEP1_VALUE, "held": held, "still_air": still},
+              "required": ["margin", "weight_span", "held", "still_air"], "additionalProperties": False}
+    attachment = {
+        "type": "object",
+        "description": "`linecheck static --json` of a case with [[wires]]: towers[i].attachments[j], wire j's "
+                       "attachment on tower i: its point y (to the left of the line's centre) and z (above the "
+                       "tower's ground) [m], the wire's support and clamp height [m], its reactions Rx, Ry, Rz [N] "
+                       "in the tower frame (x along the tower's heading, y to its left, z down), their wind-induced "
+                       "(_wind) and still-air (_still_air) parts, the clamp's displacements dx, dy, dz [m], the "
+                       "reactions in the global frame, and uplift at a suspension attachment; a downburst lists "
+                       "each value over the step-1 instants",
+        "properties": {"wire": {"type": "string"}, "kind": {"enum": ["phase", "ground"]}, "y": {"type": "number"},
+                       "z": {"type": "number"}, "support": {"enum": ["strain", "suspension"]},
+                       "height": {"type": "number"},
+                       **{r: STEP1_VALUE for r in reactions}, **{f"{r}_wind": STEP1_VALUE for r in reactions},
+                       **{f"{r}_still_air": NUM_OR_NULL for r in reactions},
+                       **{d: STEP1_VALUE for d in ("dx", "dy", "dz")},
+                       "global": {"type": "object"}, "uplift": uplift},
+        "required": ["wire", "kind", "y", "z", "support", *reactions, *(f"{r}_wind" for r in reactions)],
+        "additionalProperties": False}
+    totals = ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
+    tot = {
+        "type": "object",
+        "description": "`linecheck static --json` of a case with [[wires]]: towers[i].totals, the tower's "
+                       "resultant [N] of its attachments' reactions (Fx, Fy, Fz: tower frame, z down) and its "
+                       "moment [N m] about the tower's base (0, 0, 0), M = sum r x F with r = (0, y, z) and F = "
+                       "(Rx, Ry, -Rz) in the right-handed frame x along the line, y to its left, z up: Mx = -sum (z "
+                       "Ry + y Rz), My = sum z Rx, Mz = -sum y Rx; with the wind-induced (_wind) and still-air "
+                       "(_still_air) parts; a downburst lists each value over the step-1 instants",
+        "properties": {**{k: STEP1_VALUE for k in totals}, **{f"{k}_wind": STEP1_VALUE for k in totals},
+                       **{f"{k}_still_air": NUM_OR_NULL for k in totals}},
+        "required": [*totals, *(f"{k}_wind" for k in totals), *(f"{k}_still_air" for k in totals)],
+        "additionalProperties": False}
+    return attachment, tot
+
+
 def _properties() -> dict[str, Any]:
     """The document's top-level properties: header, ``until``, reactions, towers, blocks."""
     return {
@@ -189,9 +240,11 @@ def _properties() -> dict[str, Any]:
 
 
 def _definitions() -> dict[str, Any]:
-    """The schema's ``$defs``: Gumbel fit, confidence interval, reactions, provenance, statistics."""
+    """The schema's ``$defs``: Gumbel fit, confidence interval, reactions, provenance, statistics,
+    and the step-1 blocks of a case with ``[[wires]]`` (``static_attachment``, ``static_totals``)."""
     reaction, reactions = _reaction_schemas()
     blas, provenance = _provenance_schemas()
+    static_attachment, static_totals = _static_wires_schemas()
     return {
         "gumbel": {"type": "object", "description": "method-of-moments Gumbel (EV-I) fit of the peak; "
                    "design = value at non-exceedance probability design_fractile",
@@ -203,6 +256,8 @@ def _definitions() -> dict[str, Any]:
         "reactions": reactions,
         "blas": blas,
         "provenance": provenance,
+        "static_attachment": static_attachment,
+        "static_totals": static_totals,
         **{f"stat_{s.name}": _stat_schema(s) for s in STAT_TABLE},
     }
 
@@ -222,6 +277,8 @@ def json_schema() -> dict[str, Any]:
                         f"Everywhere in the document (linecheck checks it on read): numbers finite and of magnitude "
                         f"at most {MAX_MAGNITUDE:g}, integers of magnitude at most {MAX_INTEGER}, arrays and "
                         f"objects nested at most {MAX_DEPTH} levels. "
+                        "$defs static_attachment and static_totals describe the per-tower blocks of `linecheck "
+                        "static --json` of a case with [[wires]] (docs/wires.md). "
                         "Generated by tools/make_result_schema.py from linecheck/io/document.py."),
         "type": "object",
         "properties": _properties(),

@@ -380,7 +380,12 @@ def test_each_wire_hangs_at_its_attachment(tmp_path):
         assert [(t.name, t.station, t.ground, t.angle) for t in towers] == [
             ("T1", 0.0, 0.0, 0.0), ("T2", 300.0, 2.0, 0.0), ("T3", 600.0, 0.0, 0.0)]
         assert single.line.insulator_length == 3.6 and single.line.towers_file is None
-        assert (single.name, single.wind, single.analysis) == (case.name, case.wind, case.analysis)
+        assert (single.name, single.analysis) == (case.name, case.analysis)
+        # one wind: V_ref at the case's reference height (the first wire's mean clamp height),
+        # written in where the wire's own default would differ
+        pinned = None if wire == "A" else case.line.height
+        assert single.wind == dataclasses.replace(case.wind, reference_height=pinned)
+    assert case.line.height == pytest.approx((28.0 + 27.4 + 28.0) / 3)
     assert [t.insulator_length for t in wire_case(case, "G").line.towers] == [None, 0.3, None]
     assert clamp_height(Attachment(wire="A", y=0.0, z=31.0, support="suspension"), 3.6) == 31.0 - 3.6
     assert clamp_height(Attachment(wire="A", y=0.0, z=31.0, support="strain"), 3.6) == 31.0

@@ -65,17 +65,18 @@ chunk as :func:`~linecheck.core.budget.realization_chunk` counts them with these
 
 from __future__ import annotations
 
+import contextlib
 import threading
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..core import budget
+from ..core import budget, kernel
 from ..core.case import Case, clamp_height, wire_case
 from ..core.results import ResultSummary, Statistics, compute_statistics, summarise_statistics
 from ..core.wind.wires import CrossCoherence, fluctuating_velocity_wires
 from .burnin import BurnIn
-from .concurrency import AnyEvent
+from .concurrency import AnyEvent, map_chunks, short_switch_interval
 from .record import peak_window_steps
 from .run import RunPlan, chunk_response, chunk_statistics, plan_run
 from .step1 import Progress, StaticResult
@@ -237,7 +238,7 @@ class _Wires:
 
 
 def run_wires(case: Case, *, realizations: list[int] | np.ndarray | None = None, progress: Progress | None = None,
-              cancel: threading.Event | None = None) -> WiresRun:
+              cancel: threading.Event | None = None, threads: int = 1) -> WiresRun:
     """Steps 1-3 of every wire of ``case`` (a case with ``[[wires]]``) in one correlated wind, the
     statistics of each attachment's reactions and of the tower's totals from the summed histories,
     and the load trees (module docstring).
@@ -247,6 +248,10 @@ def run_wires(case: Case, *, realizations: list[int] | np.ndarray | None = None,
         progress: ``progress(stage, done, total)`` (step 1 of each wire, then "wind" per chunk and
             "steps 2-3: dynamics" over every wire's steps).
         cancel: when set the run stops with ``Cancelled``.
+        threads: chunks of realizations run at once on threads (with the compiled step loop, which
+            runs without the GIL; else one), each chunk then at most 1/threads of the chunks'
+            memory.  Every realization's arithmetic is its own and the wires are summed in their
+            order, so the result is bit-identical whatever ``threads`` and the chunking.
     Raises ValueError for a case without wires or wires whose meshes differ in size or frames.
     """
     if not case.has_wires:
@@ -255,42 +260,49 @@ def run_wires(case: Case, *, realizations: list[int] | np.ndarray | None = None,
     plans = tuple(plan_run(wire_case(case, w), realizations=realizations, interpolate_states=False,
                            spectral_check=False, progress=progress, cancel=cancel, warn=None, threads=1,
                            tower_only=False) for w in names)
-    ctx = _context(case, plans)
-    stop = AnyEvent(cancel)
+    threads = max(1, int(threads)) if threads > 1 and kernel.use("newmark") else 1
+    ctx = _context(case, plans, threads)
+    stop = AnyEvent(cancel)  # the user's cancel, or a failed sibling chunk
     real = plans[0].realizations
     n_chunks = -(-real.size // ctx.chunk)
-    steps = _Steps(progress, n_chunks * sum(p.time.size for p in plans))
-    parts = []
-    for ci in range(n_chunks):
-        if progress is not None:
-            progress("wind", ci, n_chunks)
-        parts.append(_run_chunk(ctx, real[ci * ctx.chunk:(ci + 1) * ctx.chunk], stop, steps))
-    if progress is not None:
-        progress("wind", n_chunks, n_chunks)
+    reports = _Reports(progress, n_chunks, [p.time.size for p in plans])
+    switch = short_switch_interval() if threads > 1 else contextlib.nullcontext()  # GIL hand-offs
+    with switch:
+        parts = map_chunks(lambda ci: _run_chunk(ctx, real[ci * ctx.chunk:(ci + 1) * ctx.chunk], stop, reports, ci),
+                           n_chunks, threads, stop)
     return _assemble(case, names, ctx, parts)
 
 
-class _Steps:
-    """The steps 2-3 progress summed over chunks and wires."""
+class _Reports:
+    """The progress of the chunks, one call at a time whichever thread reports: the field
+    ("wind", chunks done) and steps 2-3 (steps summed over chunks and wires)."""
 
-    def __init__(self, progress: Progress | None, total: int) -> None:
-        self.progress, self.total, self.done = progress, total, 0
+    def __init__(self, progress: Progress | None, n_chunks: int, steps: list[int]) -> None:
+        self.progress, self.n_chunks = progress, n_chunks
+        self.total = n_chunks * sum(steps)
+        self.lock = threading.Lock()
+        self.winds, self.done = 0, [[0] * len(steps) for _ in range(n_chunks)]
 
-    def callback(self):
+    def wind_done(self) -> None:
+        if self.progress is not None:
+            with self.lock:
+                self.winds += 1
+                self.progress("wind", self.winds, self.n_chunks)
+
+    def steps(self, ci: int, w: int):
+        """The step callback of wire ``w`` in chunk ``ci`` (None without a progress callback)."""
         if self.progress is None:
             return None
-        base = self.done
 
         def cb(d: int, n: int) -> None:
-            self.progress("steps 2-3: dynamics", base + d, self.total)
+            with self.lock:
+                self.done[ci][w] = d
+                self.progress("steps 2-3: dynamics", sum(map(sum, self.done)), self.total)
 
         return cb
 
-    def finished(self, n: int) -> None:
-        self.done += n
 
-
-def _context(case: Case, plans: tuple[RunPlan, ...]) -> _Wires:
+def _context(case: Case, plans: tuple[RunPlan, ...], threads: int) -> _Wires:
     """The chunks' shared data (:class:`_Wires`), after checking that the wires' meshes agree."""
     systems = [p.static.system for p in plans]
     s0 = systems[0]
@@ -314,37 +326,40 @@ def _context(case: Case, plans: tuple[RunPlan, ...]) -> _Wires:
     longest = int(np.argmax([p.lead for p in plans]))
     cross = CrossCoherence(case.wind.coherence_decay_y, case.wind.coherence_decay_z)
     return _Wires(plans, plans[longest].time, plans[longest].lead, offsets, cross, arms, mean_m, still_m, mean_t,
-                  still_t, sum(p.gL for p in plans), peak_window_steps(case), wires_chunk(plans))
+                  still_t, sum(p.gL for p in plans), peak_window_steps(case), wires_chunk(plans, threads))
 
 
-def wires_chunk(plans: tuple[RunPlan, ...] | list[RunPlan]) -> int:
+def wires_chunk(plans: tuple[RunPlan, ...] | list[RunPlan], threads: int = 1) -> int:
     """Realizations per chunk of :func:`run_wires` [-]: whole-record arrays per step and
     realization of about n_w n_nodes (the field) + 3 n_nodes + 24 n_towers (one wire's steps
     2-3, as :func:`~linecheck.core.budget.realization_chunk`) + 12 n_towers (the totals' B and R)
     + 3 n_w n_towers (each wire's B + R for the load trees) doubles, within
-    :data:`~linecheck.core.budget.RUN_CHUNK_BYTES`; at most the realizations run."""
+    :data:`~linecheck.core.budget.RUN_CHUNK_BYTES` shared by the ``threads`` chunks in flight;
+    at most the realizations run, and with threads at most their share."""
     s = plans[0].static.system
-    n_w, n_steps = len(plans), max(p.time.size for p in plans)
+    n_w, n_steps, n_real = len(plans), max(p.time.size for p in plans), int(plans[0].realizations.size)
     per = n_steps * budget.F8 * (n_w * s.n_nodes + 3 * s.n_nodes + 36 * s.n_towers + 3 * n_w * s.n_towers)
-    return max(1, min(int(plans[0].realizations.size), int(budget.RUN_CHUNK_BYTES // per)))
+    chunk = max(1, min(n_real, int(budget.RUN_CHUNK_BYTES / threads // per)))
+    return min(chunk, -(-n_real // threads))
 
 
-def _run_chunk(ctx: _Wires, rc: np.ndarray, stop: AnyEvent, steps: _Steps) -> tuple:
-    """Steps 2-3 of realizations ``rc`` for every wire in one field.  Returns each wire's
-    statistics and moment statistics, the totals' force and moment statistics and the load trees."""
+def _run_chunk(ctx: _Wires, rc: np.ndarray, stop: AnyEvent, reports: _Reports, ci: int) -> tuple:
+    """Steps 2-3 of realizations ``rc`` (chunk ``ci``) for every wire in one field.  Returns each
+    wire's statistics and moment statistics, the totals' force and moment statistics and the load
+    trees."""
     p0 = ctx.plans[0]
     # (n_w, n_c, lead + n_keep, n_nodes): the unit field with the longest burn-in (a = 1)
     v = fluctuating_velocity_wires(p0.case, p0.static.system, ctx.offsets, ctx.time, list(rc), a=_ONE,
                                    lead=ctx.lead, cancel=stop, cross=ctx.cross)
+    reports.wind_done()
     n_keep, n_towers = ctx.mean_totals.shape[:2]
     fb, fr, mb, mr = (np.zeros((len(rc), n_keep, n_towers, 3)) for _ in range(4))
     stats, mstats, hist = [], [], []
     for w, plan in enumerate(ctx.plans):
         vw = v[w, :, ctx.lead - plan.lead:]  # this wire's burn-in and the analysed record
         vw *= plan.a_turb  # a = I V_m(x, t) of this wire (as turbulence.fluctuating_velocity)
-        B, R = chunk_response(plan, [np.ascontiguousarray(vw)], stop, steps=steps.callback())
+        B, R = chunk_response(plan, [np.ascontiguousarray(vw)], stop, steps=reports.steps(ci, w))
         del vw
-        steps.finished(plan.time.size)
         stats.append(chunk_statistics(plan, B, R))
         y, z = ctx.arms[:, w, 0], ctx.arms[:, w, 1]
         mB, mR = tower_moments(B, y, z), tower_moments(R, y, z)

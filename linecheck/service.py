@@ -56,13 +56,7 @@ from .analysis.wind_export import (
     wind_field,
 )
 from .analysis.windows import CHECK_WINDOW_MIN_SPANS, window_case, windowed
-from .analysis.wires_static import (
-    TOTALS,
-    WiresStatic,
-    tower_totals,
-    wires_static_analysis,
-    wires_uplift_warnings,
-)
+from .analysis.wires_static import WiresStatic, wires_static_analysis, wires_uplift_warnings
 from .core.codes import CODES_PEAK
 from .core.damping import aerodynamic_damping_stack, stiffness_proportional_stack
 from .core.dynamics import integrate
@@ -70,6 +64,7 @@ from .core.line_damping import reference_state_index, structural_omega1
 from .core.loads import fluctuating_loads, mean_loads, to_global_nodes, turbulence_variance_ratio
 from .core.model import build_model, build_models
 from .core.system import LineSystem
+from .core.tower_totals import TOTALS, tower_totals
 
 __all__ = [  # the names front ends, tests and benchmarks use
     "BUILTIN_DOWNBURST_MODELS", "CHECK_WINDOW_HALVES", "CHECK_WINDOW_MIN_SPANS", "CHECK_WINDOW_RTOL",

@@ -17,6 +17,7 @@ CORE_MODULES = [
     "linecheck.core.case_towers",
     "linecheck.core.case_geometry",
     "linecheck.core.case_wires",
+    "linecheck.core.tower_totals",
     "linecheck.core.case_load",
     "linecheck.core.errors",
     "linecheck.core.names",

@@ -34,6 +34,21 @@ def require_one_wire(case: Case, job: str) -> None:
                         file=str(case.source) if case.source else None, key="wires")
 
 
+def warn_once(warn: Warn | None) -> Warn | None:
+    """``warn`` passing each distinct message once (a job over several wires meets the same
+    resource warning for each wire); None without ``warn``."""
+    if warn is None:
+        return None
+    told: set[str] = set()
+
+    def once(message: str) -> None:
+        if message not in told:
+            told.add(message)
+            warn(message)
+
+    return once
+
+
 def check_budget(case: Case, job: str = "run", *, warn: Warn | None = None, **kwargs) -> budget.Estimate:
     """Estimated peak memory and time of ``job`` (:mod:`linecheck.core.budget`); raises
     :class:`~linecheck.core.errors.CaseError` (exit 2) for a job a case with ``[[wires]]`` does

@@ -28,20 +28,10 @@ share is the wind:
 
 Frames and signs.  Reactions are the forces of the wire on the tower, in each tower's own frame
 (docs/method.md "Line sections": x along the tower's mean heading, y = x turned +90 deg in plan,
-z DOWN).  The tower's totals are
-
-* forces: F_x = sum_a R_x,a, F_y = sum_a R_y,a, F_z = sum_a R_z,a (z down, as the reactions);
-* moments about the tower's base (the point (0, 0, 0) on the tower's ground), each reaction acting
-  at its attachment point r_a = (0, y_a, z_a) (y_a, z_a the attachment's keys: y to the left,
-  z UP above the tower's ground; the point on the tower, an insulator's top or a strain clamp):
-  M = sum_a r_a x F_a (the moment of a force about a point, Meriam & Kraige, Engineering
-  Mechanics: Statics, sect. 2/8) with F_a = (R_x, R_y, -R_z) the reaction in the right-handed
-  frame (x, y, z up), so (right-hand rule about the tower frame's axes with z up; the convention
-  of the multi-wire static totals)
-
-      M_x = -sum_a (y_a R_z,a + z_a R_y,a)   overturning about the line's direction (transverse)
-      M_y =  sum_a z_a R_x,a                 overturning across the line (longitudinal)
-      M_z = -sum_a y_a R_x,a                 torsion about the vertical
+z DOWN), each acting at its attachment point (0, y, z) (z UP above the tower's ground).  The
+tower's totals are their resultant F = (F_x, F_y, F_z) and their moment M = (M_x, M_y, M_z) about
+the tower's base, M = sum r x F with z up, as :mod:`linecheck.core.tower_totals` defines them
+(:data:`~linecheck.core.tower_totals.TOTALS`; the static totals' convention, docs/wires.md).
 
 Every history is summed before its statistics: M(t) + B(t) + R(t) of the total is the sum of the
 attachments' (the same for each moment), so the wires' correlation is in the totals' peaks, r.m.s.
@@ -51,9 +41,9 @@ realization); :meth:`WiresRun.peak_sum` gives that sum and :meth:`WiresRun.peak_
 largest attachment's, so the designer sees what the correlation saves.  Eq. 17's normalising
 force of a total force is the wires' sum of g*_yp L_x; the moments have none (NaN).
 
-Load trees (:class:`LoadTrees`): for each tower and each governing total -- max |F_y|
-(transverse), max |F_x| (longitudinal), max |M_x| (overturning), max |M_z| (torsion), min F_z
-(uplift: the least downward force) -- the instant it is reached in each sample (a realization, or
+Load trees (:class:`LoadTrees`): for each tower and each governing total (:data:`GOVERNING`) --
+max |F_y| (transverse), max |F_x| (longitudinal), max |M_x| (overturning), max |M_z| (torsion),
+min F_z (the least downward force: uplift) -- the instant it is reached in each sample (a realization, or
 a peak window), the total there and every attachment's R_x, R_y, R_z at that instant, all with the
 still-air reactions (the loads a tower design applies).
 
@@ -73,39 +63,29 @@ import numpy as np
 
 from ..core import budget, kernel
 from ..core.case import Case, clamp_height, wire_case
-from ..core.results import ResultSummary, Statistics, compute_statistics, summarise_statistics
+from ..core.extremes import gumbel_fit, summarise
+from ..core.results import ResultSummary, Statistics, StatisticSummary, compute_statistics, summarise_statistics
+from ..core.tower_totals import reaction_moments
 from ..core.wind.wires import CrossCoherence, fluctuating_velocity_wires
 from .burnin import BurnIn
 from .concurrency import AnyEvent, map_chunks, short_switch_interval
+from .guard import Warn, warn_once
 from .record import peak_window_steps
 from .run import RunPlan, chunk_response, chunk_statistics, plan_run
 from .step1 import Progress, StaticResult
+from .wires_static import wire_progress
 
-#: the tower's totals, tower frame: forces [N] (z down) and moments about the base [N m] (z up)
-TOTALS = ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
-#: the governing totals of the load trees: name -> (index in :data:`TOTALS`, "abs": max |total|,
-#: "min": min total)
+#: The governing totals of the load trees, in their order: load case -> (index of the total in
+#: :data:`~linecheck.core.tower_totals.TOTALS`, "abs": the instant of the largest |total|, "min":
+#: of the least total).  ``min_vertical`` is the least downward force (uplift).
 GOVERNING = {
-    "transverse": (1, "abs"),
-    "longitudinal": (0, "abs"),
-    "overturning": (3, "abs"),
-    "torsion": (5, "abs"),
-    "uplift": (2, "min"),
+    "max_transverse": (1, "abs"),
+    "max_longitudinal": (0, "abs"),
+    "max_overturning": (3, "abs"),
+    "max_torsion": (5, "abs"),
+    "min_vertical": (2, "min"),
 }
 _ONE = np.ones((1, 1))  # the unit modulation: each wire's own is applied to its tail of the field
-
-
-def tower_moments(R: np.ndarray, y: np.ndarray | float, z: np.ndarray | float) -> np.ndarray:
-    """Moments about the tower's base [N m] of reactions R [N] (..., n_towers, 3) in the tower
-    frame (z down) acting at (0, y, z) [m] (z up; y, z (n_towers,) or numbers): (..., n_towers, 3)
-    = (M_x, M_y, M_z) = (-(y R_z + z R_y), z R_x, -y R_x), the right-hand rule about the tower
-    frame's axes with z up (module docstring): M = r x F, the moment of a force about a point
-    (Meriam & Kraige, Engineering Mechanics: Statics, sect. 2/8), r = (0, y, z), F = (R_x, R_y, -R_z)."""
-    out = np.empty(np.shape(R))
-    out[..., 0] = -(y * R[..., 2] + z * R[..., 1])
-    out[..., 1] = z * R[..., 0]
-    out[..., 2] = -(y * R[..., 0])
-    return out
 
 
 @dataclass(frozen=True)
@@ -205,6 +185,14 @@ class WiresRun:
         """The largest attachment's peak ``name`` per sample, (n_samples, n_towers, 6)."""
         return self.attachment_totals(name).max(axis=0)
 
+    def bounds_summary(self, name: str = "peak_dynamic") -> tuple[StatisticSummary, StatisticSummary]:
+        """:meth:`peak_sum` and :meth:`peak_largest` summarised over the samples like a peak
+        statistic (mean, std, fractiles and the Gumbel fit with its design value at
+        ``analysis.design_fractile``), arrays (n_towers, 6) in :data:`~linecheck.core.tower_totals.TOTALS` order."""
+        p = self.case.analysis.design_fractile
+        return tuple(StatisticSummary(summarise(v), gumbel_fit(v, p))  # type: ignore[return-value]
+                     for v in (self.peak_sum(name), self.peak_largest(name)))
+
     def attachment_summary(self, wire: int) -> ResultSummary:
         """Wire ``wire``'s (0-based) reactions summarised as a single-wire run's."""
         return summarise_statistics(self.attachments[wire], self.still_air[wire], self.case.analysis.design_fractile)
@@ -238,28 +226,34 @@ class _Wires:
 
 
 def run_wires(case: Case, *, realizations: list[int] | np.ndarray | None = None, progress: Progress | None = None,
-              cancel: threading.Event | None = None, threads: int = 1) -> WiresRun:
+              cancel: threading.Event | None = None, threads: int = 1, warn: Warn | None = None) -> WiresRun:
     """Steps 1-3 of every wire of ``case`` (a case with ``[[wires]]``) in one correlated wind, the
     statistics of each attachment's reactions and of the tower's totals from the summed histories,
     and the load trees (module docstring).
 
     Args:
         realizations: which realizations (0-based; default all ``analysis.realizations``).
-        progress: ``progress(stage, done, total)`` (step 1 of each wire, then "wind" per chunk and
-            "steps 2-3: dynamics" over every wire's steps).
+        progress: ``progress(stage, done, total)`` (step 1 of each wire, its stage naming the
+            wire, then "wind" per chunk and "steps 2-3: dynamics" over every wire's steps).
         cancel: when set the run stops with ``Cancelled``.
         threads: chunks of realizations run at once on threads (with the compiled step loop, which
             runs without the GIL; else one), each chunk then at most 1/threads of the chunks'
             memory.  Every realization's arithmetic is its own and the wires are summed in their
             order, so the result is bit-identical whatever ``threads`` and the chunking.
+        warn: ``warn(message)`` receives the resource warnings of each wire's run (its
+            single-wire case's :func:`~linecheck.analysis.guard.check_budget`), each distinct
+            one once; above the memory limit a wire's run is refused before its work
+            (:class:`~linecheck.core.errors.CaseError`).  The case's own warnings
+            (:func:`~linecheck.analysis.guard.warn_case`) are the caller's.
     Raises ValueError for a case without wires or wires whose meshes differ in size or frames.
     """
     if not case.has_wires:
         raise ValueError(f"case {case.name!r} has no [[wires]]: run it with run_case")
     names = tuple(w.name for w in case.wires)
+    once = warn_once(warn)
     plans = tuple(plan_run(wire_case(case, w), realizations=realizations, interpolate_states=False,
-                           spectral_check=False, progress=progress, cancel=cancel, warn=None, threads=1,
-                           tower_only=False) for w in names)
+                           spectral_check=False, progress=wire_progress(progress, w), cancel=cancel, warn=once,
+                           threads=1, tower_only=False) for w in names)
     threads = max(1, int(threads)) if threads > 1 and kernel.use("newmark") else 1
     ctx = _context(case, plans, threads)
     stop = AnyEvent(cancel)  # the user's cancel, or a failed sibling chunk
@@ -319,8 +313,8 @@ def _context(case: Case, plans: tuple[RunPlan, ...], threads: int) -> _Wires:
                         for w in case.wires])
     arms = np.array([[(t.attachment(w.name).y, t.attachment(w.name).z) for w in case.wires]
                      for t in (case.tower_type(tw.type) for tw in case.line.towers)])
-    mean_m = tuple(tower_moments(p.mean, arms[:, w, 0], arms[:, w, 1]) for w, p in enumerate(plans))
-    still_m = tuple(tower_moments(p.still_air, arms[:, w, 0], arms[:, w, 1]) for w, p in enumerate(plans))
+    mean_m = tuple(reaction_moments(p.mean, arms[:, w, 0], arms[:, w, 1]) for w, p in enumerate(plans))
+    still_m = tuple(reaction_moments(p.still_air, arms[:, w, 0], arms[:, w, 1]) for w, p in enumerate(plans))
     mean_t = np.concatenate([sum(p.mean for p in plans), sum(mean_m)], axis=-1)
     still_t = np.concatenate([sum(p.still_air for p in plans), sum(still_m)], axis=-1)
     longest = int(np.argmax([p.lead for p in plans]))
@@ -362,7 +356,7 @@ def _run_chunk(ctx: _Wires, rc: np.ndarray, stop: AnyEvent, reports: _Reports, c
         del vw
         stats.append(chunk_statistics(plan, B, R))
         y, z = ctx.arms[:, w, 0], ctx.arms[:, w, 1]
-        mB, mR = tower_moments(B, y, z), tower_moments(R, y, z)
+        mB, mR = reaction_moments(B, y, z), reaction_moments(R, y, z)
         mstats.append(compute_statistics(ctx.mean_moments[w], mB, mR, ctx.still_moments[w], 0.0, window=ctx.window))
         fb += B
         fr += R

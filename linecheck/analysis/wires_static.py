@@ -8,7 +8,8 @@ under the case's one wind).  At tower j the attachment of wire w is the point
 r = (0, y, z) of the tower frame (x along the line, y to its left, z up from the tower's
 ground; docs/wires.md), where the wire's reaction R = (R_x, R_y, R_z) acts (z down, as every
 reaction: docs/method.md).  The tower's totals are the resultant of its attachments' reactions
-and its moment about the base point (0, 0, 0) (:func:`tower_totals`).  Nothing here prints.
+and its moment about the base point (0, 0, 0)
+(:func:`~linecheck.core.tower_totals.tower_totals`).  Nothing here prints.
 """
 
 from __future__ import annotations
@@ -20,44 +21,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.case import Case, wire_case
+from ..core.tower_totals import tower_totals
 from ..core.uplift import Uplift
-from .guard import Warn, check_budget, warn_case
+from .guard import Warn, check_budget, warn_case, warn_once
 from .step1 import Progress, StaticResult, static_result
 from .uplift import step1_uplift, uplift_warning
-
-#: The tower totals' components, in the order of :func:`tower_totals`'s last axis: the forces
-#: [N] (tower frame, z down) and the moments [N m] about the tower's base (right-hand rule about
-#: x, y and z up).
-TOTALS = ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
-
-
-def tower_totals(R: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
-    """The totals of every tower from its attachments' reactions.
-
-    Args:
-        R: [N] reactions (..., n_towers, n_wires, 3) in the tower frames (x along the line, y to
-            its left, z down).
-        y, z: [m] attachment points (n_towers, n_wires): y to the left of the line's centre, z
-            above the tower's ground.
-
-    Returns:
-        (..., n_towers, 6) in the order of :data:`TOTALS`: F = sum of the reactions [N] (z down,
-        as R); M = sum of r x F [N m] with r = (0, y, z) and F = (R_x, R_y, -R_z) in the
-        right-handed frame x, y, z up, i.e. M_x = -sum (z R_y + y R_z) (the transverse
-        overturning moment), M_y = sum z R_x (the longitudinal one), M_z = -sum y R_x (torsion).
-    """
-    R = np.asarray(R, dtype=float)
-    y, z = np.asarray(y, dtype=float), np.asarray(z, dtype=float)
-    rx, ry, rz = R[..., 0], R[..., 1], R[..., 2]
-    out = np.empty(R.shape[:-2] + (6,))
-    out[..., :3] = R.sum(axis=-2)
-    # M = r x F (the moment of a force about a point, e.g. Meriam & Kraige, Engineering Mechanics:
-    # Statics, Sect. 2/8), r = (0, y, z), F = (R_x, R_y, -R_z) with z turned up:
-    # M_x = y F_z - z F_y, M_y = z F_x - 0 F_z, M_z = 0 F_y - y F_x
-    out[..., 3] = -(z * ry + y * rz).sum(axis=-1)
-    out[..., 4] = (z * rx).sum(axis=-1)
-    out[..., 5] = -(y * rx).sum(axis=-1)
-    return out
 
 
 @dataclass(frozen=True)
@@ -88,7 +56,7 @@ class WiresStatic:
 
     @property
     def totals(self) -> np.ndarray:
-        """[N, N m] every tower's totals in every mean state, (n_t, n_towers, 6) (:func:`tower_totals`)."""
+        """[N, N m] every tower's totals in every mean state, (n_t, n_towers, 6) (:func:`~linecheck.core.tower_totals.tower_totals`)."""
         return tower_totals(self.reactions, self.y, self.z)
 
     @property
@@ -121,7 +89,8 @@ def wires_result(case: Case, results: list[StaticResult] | tuple[StaticResult, .
     return WiresStatic(case, tuple(results), y, z, R, R0)
 
 
-def _wire_progress(progress: Progress | None, name: str) -> Progress | None:
+def wire_progress(progress: Progress | None, name: str) -> Progress | None:
+    """``progress`` with each stage named for wire ``name`` ("step 1, wire P"), or None."""
     return None if progress is None else (lambda stage, done, total: progress(f"{stage}, wire {name}", done, total))
 
 
@@ -135,18 +104,12 @@ def wires_static_analysis(case: Case, *, progress: Progress | None = None, cance
     if not case.has_wires:
         raise ValueError(f"{case.name}: no [[wires]]: step 1 of its one wire is static_analysis")
     warn_case(case, warn)
-    told: set[str] = set()
-
-    def once(message: str) -> None:  # the same resource warning of every wire: once
-        if warn is not None and message not in told:
-            told.add(message)
-            warn(message)
-
+    once = warn_once(warn)  # the same resource warning of every wire: once
     results = []
     for w in case.wires:
         single = wire_case(case, w.name)
         check_budget(single, "static", warn=once)
-        results.append(static_result(single, progress=_wire_progress(progress, w.name), cancel=cancel))
+        results.append(static_result(single, progress=wire_progress(progress, w.name), cancel=cancel))
     return wires_result(case, results)
 
 

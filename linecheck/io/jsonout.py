@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..core.names import REACTIONS
+from ..core.tower_totals import TOTALS
 from .atomic import write_text_atomic
 from .stat_table import SPECTRAL_EXACT
 
@@ -167,12 +168,10 @@ def wires_static_to_dict(res: WiresStatic) -> dict[str, Any]:
     clamp), ``Rx``, ``Ry``, ``Rz``, their ``_wind`` and ``_still_air`` parts [N] in the tower
     frame, ``dx``, ``dy``, ``dz`` [m], ``global``, and ``uplift`` at a suspension attachment);
     ``totals``: ``Fx``, ``Fy``, ``Fz`` [N] and ``Mx``, ``My``, ``Mz`` [N m] about the tower's
-    base with their ``_wind`` and ``_still_air`` parts (:func:`~linecheck.analysis.wires_static.tower_totals`);
+    base with their ``_wind`` and ``_still_air`` parts (:func:`~linecheck.core.tower_totals.tower_totals`);
     and the single-wire tower's ``Rx``, ``Ry``, ``Rz`` (and their parts) = the totals' forces, so
     a reader of single-wire documents sees the tower's whole load.  Synoptic: one value per key;
     downburst: lists over the step-1 instants, and ``"time"`` lists them."""
-    from ..analysis.wires_static import TOTALS
-
     case = res.case
     series = case.wind.type == "downburst"
 

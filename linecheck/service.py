@@ -56,6 +56,7 @@ from .analysis.wind_export import (
     wind_field,
 )
 from .analysis.windows import CHECK_WINDOW_MIN_SPANS, window_case, windowed
+from .analysis.wires_run import LoadTrees, WiresRun, run_wires
 from .analysis.wires_static import WiresStatic, wires_static_analysis, wires_uplift_warnings
 from .core.codes import CODES_PEAK
 from .core.damping import aerodynamic_damping_stack, stiffness_proportional_stack
@@ -67,17 +68,18 @@ from .core.system import LineSystem
 from .core.tower_totals import TOTALS, tower_totals
 
 __all__ = [  # the names front ends, tests and benchmarks use
-    "BUILTIN_DOWNBURST_MODELS", "CHECK_WINDOW_HALVES", "CHECK_WINDOW_MIN_SPANS", "CHECK_WINDOW_RTOL",
-    "CODES_PEAK", "TOTALS", "BurnIn", "CheckWindow", "CodeCheck", "CodesResult", "LineSystem", "ModesResult",
+    "BUILTIN_DOWNBURST_MODELS", "CHECK_WINDOW_HALVES", "CHECK_WINDOW_MIN_SPANS", "CHECK_WINDOW_RTOL", "CODES_PEAK",
+    "TOTALS", "BurnIn", "CheckWindow", "CodeCheck", "CodesResult", "LineSystem", "LoadTrees", "ModesResult",
     "Progress", "ReactionCheck", "RunResult", "SanityItem", "SpectralResult", "StaticResult", "SynopticModel",
-    "TowerCheck", "TowerRun", "UntilInfo", "Warn", "WindAtP", "WindField", "WiresStatic", "aerodynamic_damping_stack",
-    "build_model", "build_models", "burn_in", "case_with_model", "check_budget", "check_case",
-    "closed_form_not_applicable", "code_loads", "codes_analysis", "damping_matrices", "design_peaks",
+    "TowerCheck", "TowerRun", "UntilInfo", "Warn", "WindAtP", "WindField", "WiresRun", "WiresStatic",
+    "aerodynamic_damping_stack", "build_model", "build_models", "burn_in", "case_with_model", "check_budget",
+    "check_case", "closed_form_not_applicable", "code_loads", "codes_analysis", "damping_matrices", "design_peaks",
     "fluctuating_loads", "integrate", "join_runs", "loads_from_field", "mean_loads", "mean_state_times",
     "model_changes", "modes_analysis", "parse_models", "peak_window_steps", "read_wind_field", "record_grid",
-    "record_mean_wind", "record_time", "record_wind", "reference_state_index", "relative_standard_error", "run_case",
-    "run_models", "run_threads", "run_tower", "run_until", "sanity_check", "spectral_analysis", "spread_models",
-    "static_analysis", "static_result", "stiffness_proportional_stack", "structural_omega1", "synoptic_burn_in",
-    "synoptic_model", "to_global_nodes", "tower_totals", "turbulence_variance_ratio", "warn_case", "wind_at_p",
-    "wind_field", "window_case", "windowed", "wires_static_analysis", "wires_uplift_warnings"
+    "record_mean_wind", "record_time", "record_wind", "reference_state_index", "relative_standard_error",
+    "run_case", "run_models", "run_threads", "run_tower", "run_until", "run_wires", "sanity_check",
+    "spectral_analysis", "spread_models", "static_analysis", "static_result", "stiffness_proportional_stack",
+    "structural_omega1", "synoptic_burn_in", "synoptic_model", "to_global_nodes", "tower_totals",
+    "turbulence_variance_ratio", "warn_case", "wind_at_p", "wind_field", "window_case", "windowed",
+    "wires_static_analysis", "wires_uplift_warnings"
 ]

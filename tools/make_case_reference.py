@@ -219,14 +219,16 @@ needs the columns `station` and `type`).
 - **One wind.** Every wire is loaded by the case's wind, with V_ref at the case's
   `reference_height` (default: the case's mean clamp height, which with `[[wires]]` is the
   first wire's); a wire's single-wire case carries that height (docs/wires.md "One wind").
-- **Jobs.** A case with `[[wires]]` runs `check` and `static` (every attachment's reactions and
-  each tower's totals: docs/wires.md). Every other job (`run`, `spectral`, `modes`, `wind`,
+- **Jobs.** A case with `[[wires]]` runs `check`, `static` (every attachment's reactions and
+  each tower's totals) and `linecheck run` (every wire in one correlated wind: each attachment,
+  the tower totals and load trees; docs/wires.md). Every other job (`spectral`, `modes`, `wind`,
   `codes`, `scan`, a batch's run, the TUI's run) analyses one wire and refuses it in one line
   before any work (exit 2; a batch fails that case and runs the others):
 
   ```
-  error: c.toml: wires: a case with several wires runs `check` and `static` (every attachment and
-  the tower totals); `run` of several wires is not available yet: run each wire as a single-wire case
+  error: c.toml: wires: a case with several wires runs `check`, `static` and `linecheck run` (every
+  attachment, the tower totals and load trees); `modes` of several wires is not available yet: run
+  each wire as a single-wire case
   ```
 
 Cross-checks (one line naming the file, key and line or CSV row and column, the value and what

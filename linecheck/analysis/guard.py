@@ -18,8 +18,11 @@ from ..core.errors import CaseError
 
 Warn = Callable[[str], None]
 
-#: The jobs a case with ``[[wires]]`` runs: every other job analyses one wire (the case's
-#: ``line`` is only its first wire's) and :func:`require_one_wire` refuses it.
+#: The jobs a case with ``[[wires]]`` runs through :func:`check_budget`: every other job analyses
+#: one wire (the case's ``line`` is only its first wire's) and :func:`require_one_wire` refuses
+#: it.  Its dynamic run is :func:`~linecheck.analysis.wires_run.run_wires` (``linecheck run``),
+#: which guards each wire's single-wire case instead; the one-wire run (``run_case``: a batch's
+#: run, the TUI's) stays refused.
 WIRES_JOBS = frozenset({"static"})
 
 
@@ -27,11 +30,16 @@ def require_one_wire(case: Case, job: str) -> None:
     """Refuse ``job`` on a case with ``[[wires]]`` unless it is one of :data:`WIRES_JOBS`: one
     :class:`~linecheck.core.errors.CaseError` line (exit 2) naming the file, what such a case
     runs and what to do.  :func:`check_budget` calls it, so every job meets it before any work;
-    the few entry points without a resource guard (code loads, scan, batch) call it themselves."""
-    if case.has_wires and job not in WIRES_JOBS:
-        raise CaseError(f"a case with several wires runs `check` and `static` (every attachment and the tower "
-                        f"totals); `{job}` of several wires is not available yet: run each wire as a single-wire case",
-                        file=str(case.source) if case.source else None, key="wires")
+    the few entry points without a resource guard (code loads, scan, batch) call it themselves.
+    ``job`` "run" is the one-wire run (``run_case``), which a batch and the TUI call."""
+    if not case.has_wires or job in WIRES_JOBS:
+        return
+    what = ("a batch's or the TUI's run of several wires is not available yet: run the case with `linecheck run`"
+            if job == "run" else
+            f"`{job}` of several wires is not available yet: run each wire as a single-wire case")
+    raise CaseError(f"a case with several wires runs `check`, `static` and `linecheck run` (every attachment, the "
+                    f"tower totals and load trees); {what}",
+                    file=str(case.source) if case.source else None, key="wires")
 
 
 def warn_once(warn: Warn | None) -> Warn | None:

@@ -65,7 +65,7 @@ from ..core import budget, kernel
 from ..core.case import Case, clamp_height, wire_case
 from ..core.extremes import gumbel_fit, summarise
 from ..core.results import ResultSummary, Statistics, StatisticSummary, compute_statistics, summarise_statistics
-from ..core.tower_totals import reaction_moments
+from ..core.tower_totals import LOAD_CASES, TOTALS, reaction_moments
 from ..core.wind.wires import CrossCoherence, fluctuating_velocity_wires
 from .burnin import BurnIn
 from .concurrency import AnyEvent, map_chunks, short_switch_interval
@@ -75,16 +75,10 @@ from .run import RunPlan, chunk_response, chunk_statistics, plan_run
 from .step1 import Progress, StaticResult
 from .wires_static import wire_progress
 
-#: The governing totals of the load trees, in their order: load case -> (index of the total in
-#: :data:`~linecheck.core.tower_totals.TOTALS`, "abs": the instant of the largest |total|, "min":
-#: of the least total).  ``min_vertical`` is the least downward force (uplift).
-GOVERNING = {
-    "max_transverse": (1, "abs"),
-    "max_longitudinal": (0, "abs"),
-    "max_overturning": (3, "abs"),
-    "max_torsion": (5, "abs"),
-    "min_vertical": (2, "min"),
-}
+#: The governing totals of the load trees: load case -> (index of its total in
+#: :data:`~linecheck.core.tower_totals.TOTALS`, "abs" or "min"), from
+#: :data:`~linecheck.core.tower_totals.LOAD_CASES`.
+GOVERNING = {case: (TOTALS.index(total), sense) for case, (total, sense) in LOAD_CASES.items()}
 _ONE = np.ones((1, 1))  # the unit modulation: each wire's own is applied to its tail of the field
 
 

@@ -33,6 +33,7 @@ from .limits import warn as limits_warn
 from .progress import progress_bar
 from .stats_view import MaxRealOpt, UntilOpt, design_table, parse_until
 from .stats_view import notes as stats_notes
+from .wires_cmd import LoadTreesOpt, refuse_options, require_wires, run_wires_command
 
 ModelsOpt = Annotated[str | None, typer.Option(
     "--models", help='Downburst model spread: run the case under "all" built-in running-mean models '
@@ -193,8 +194,10 @@ def run(
         "--jobs", "-j", min=1, show_default=False,
         help="Threads integrating realizations at once (default: the number of cores; the results are the "
              "same bits whatever the number).")] = None,
+    load_trees: LoadTreesOpt = None,
 ) -> None:
-    """Steps 1-3: mean, background and resonant reactions, gust factors and contributions."""
+    """Steps 1-3: mean, background and resonant reactions, gust factors and contributions (with [[wires]]: every
+    wire in one correlated wind, each attachment, the tower totals and load trees)."""
     from .. import service  # here, not at import: the service loads the numerical core (start-up time)
     from ..batch.executors import default_jobs
 
@@ -202,6 +205,12 @@ def run(
     apply_max_memory(max_memory)
     threads = default_jobs() if jobs is None else jobs
     case = override(read_case(case_file), realizations, seed)
+    require_wires(case, load_trees)
+    if case.has_wires:
+        refuse_options(case, {"--excel": excel, "--template": template, "--models": models, "--until": until,
+                              "--full-histories": full_histories})
+        run_wires_command(case, json_out=json_out, load_trees=load_trees, threads=threads)
+        return
     target = parse_until(until)
     _check_run_outputs(case, json_out, excel, template, force)
     names = service.parse_models(case, models) if models is not None else ()

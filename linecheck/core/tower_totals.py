@@ -32,6 +32,17 @@ TOTALS = ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
 FORCES = TOTALS[:3]
 MOMENTS = TOTALS[3:]
 
+#: The load cases of a tower's load trees (docs/wires.md "Load trees"), in their order: name ->
+#: (the governing total of :data:`TOTALS`, "abs": the instant of its largest magnitude, "min": of
+#: its least value).  ``min_vertical`` is the least downward force, the case of uplift.
+LOAD_CASES: dict[str, tuple[str, str]] = {
+    "max_transverse": ("Fy", "abs"),
+    "max_longitudinal": ("Fx", "abs"),
+    "max_overturning": ("Mx", "abs"),
+    "max_torsion": ("Mz", "abs"),
+    "min_vertical": ("Fz", "min"),
+}
+
 
 def reaction_moments(R: np.ndarray, y: np.ndarray | float, z: np.ndarray | float) -> np.ndarray:
     """The moment about the tower's base of each reaction at its own attachment point.

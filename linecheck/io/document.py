@@ -66,19 +66,20 @@ from .stat_table import (
     StatDef,
     stat_def,
 )
+from .wires_blocks import AttachmentRun, WireRecord, load_trees_from_json, totals_from_json
 
 __all__ = [
     "BLOCK_FIELDS", "FLAG_STATES", "GUMBEL_KEYS", "HEADER_FIELDS", "REACTIONS", "RESULT_FILE", "SCHEMA_VERSION",
     "SECTION_TOWER_KEYS", "SPECTRAL_EXACT", "STAT_BY_NAME", "STAT_TABLE", "SUMMARY_KEYS", "BatchSource",
     "BurnInRecord", "CodeCheckRecord", "CodeTower", "CodeVerdict", "Davenport", "EnvelopeEntry", "FailedRun",
     "Gumbel", "ReactionResult", "RunDocument", "SanityCheckRow", "Spectral", "StatDef", "StatValue",
-    "StaticSeries", "StillAir", "TimeHistories", "TowerRecord", "Until", "UpliftRecord", "document_of",
+    "StaticSeries", "StillAir", "TimeHistories", "TowerRecord", "Until", "UpliftRecord", "WireRecord", "document_of",
     "json_schema", "load_document", "models_of", "reactions_of", "read_result_file", "section_tower", "stat_def",
-    "uplift_record",
+    "stat_value", "tower_from_json", "uplift_of", "uplift_record",
 ]
 
 #: Optional typed blocks after ``"towers"``, in JSON order (absent from the JSON when None).
-BLOCK_FIELDS = ("still_air", "static", "parameters", "burn_in", "damping", "structural_damping", "spectral",
+BLOCK_FIELDS = ("still_air", "static", "parameters", "burn_in", "damping", "structural_damping", "wires", "spectral",
                 "codes", "time_histories", "batch", "model", "models", "models_envelope", "models_failed",
                 "provenance")
 _BATCH_KEYS = ("case_file", "case_hash", "changes")
@@ -108,12 +109,18 @@ def section_tower(res: Any, k: int) -> dict[str, Any] | None:
 
 
 def uplift_record(res: Any, k: int) -> UpliftRecord | None:
-    """The uplift of tower k (0-based) of a run (:func:`linecheck.analysis.uplift.step1_uplift`):
-    the smallest margin [N] over the mean states, the weight span [m] and instant [s] there, and
-    the still-air values; None at a strain tower."""
+    """The uplift of tower k (0-based) of a run (:func:`uplift_of` of its step 1)."""
+    return uplift_of(res.static, k)
+
+
+def uplift_of(static: Any, k: int) -> UpliftRecord | None:
+    """The uplift at tower k (0-based) of a step-1 result
+    (:func:`linecheck.analysis.uplift.step1_uplift`): the smallest margin [N] over the mean
+    states, the weight span [m] and instant [s] there, and the still-air values; None at a
+    strain tower."""
     from ..analysis.uplift import step1_uplift
 
-    u = step1_uplift(res.static)
+    u = step1_uplift(static)
     if not u.suspension[k]:
         return None
     i = int(u.worst_state[k])
@@ -132,6 +139,10 @@ class RunDocument:
     ``"case_hash"``, ``"changes"``), ``model``/``models``/``models_envelope``/``models_failed``
     (downburst model spread), ``until``, ``provenance`` (versions, BLAS and compiled kernel of the
     run, :mod:`linecheck.io.provenance`; absent from results saved before it was recorded).
+    A run of a case with ``[[wires]]`` (:mod:`linecheck.io.wires_document`): ``wires`` (each
+    wire's :class:`~linecheck.io.wires_blocks.WireRecord`), ``reactions`` and each tower's
+    ``reactions`` the totals' forces, and each tower's ``type``, ``attachments``, ``totals`` and
+    ``load_trees`` (:class:`~linecheck.io.result_blocks.TowerRecord`); :attr:`has_wires`.
     ``blocks``: keys this version does not know, verbatim.
     """
 
@@ -161,6 +172,7 @@ class RunDocument:
     burn_in: BurnInRecord | None = None
     damping: str | None = None
     structural_damping: float | None = None
+    wires: tuple[WireRecord, ...] | None = None
     spectral: Spectral | None = None
     codes: dict[str, CodeCheckRecord] | None = None
     time_histories: TimeHistories | None = None
@@ -174,6 +186,11 @@ class RunDocument:
 
     def reaction(self, r: str) -> ReactionResult:
         return self.reactions[r]
+
+    @property
+    def has_wires(self) -> bool:
+        """A run of a case with ``[[wires]]``: every tower has attachments, totals and load trees."""
+        return self.wires is not None
 
     def to_json(self) -> dict[str, Any]:
         """The public JSON layout (plain dict of JSON values, keys in the documented order)."""
@@ -214,10 +231,7 @@ class RunDocument:
         try:
             head = {k: d[k] for k, _ in HEADER_FIELDS}
             reactions = reactions_from_json(d["reactions"])
-            towers = tuple(TowerRecord(int(t["index"]), t["support"], reactions_from_json(t["reactions"]),
-                                       {k: t[k] for k in SECTION_TOWER_KEYS if k in t} or None,
-                                       UpliftRecord.from_json(t["uplift"]) if "uplift" in t else None)
-                           for t in d["towers"])
+            towers = tuple(tower_from_json(t) for t in d["towers"])
             until = Until.from_json(d["until"]) if d.get("until") is not None else None
 
             def opt(key: str, read: Any) -> Any:
@@ -227,6 +241,7 @@ class RunDocument:
                 still_air=opt("still_air", StillAir.from_json), static=opt("static", StaticSeries.from_json),
                 parameters=d.get("parameters"), burn_in=opt("burn_in", BurnInRecord.from_json),
                 damping=d.get("damping"), structural_damping=d.get("structural_damping"),
+                wires=opt("wires", lambda w: tuple(WireRecord.from_json(x) for x in w)),
                 spectral=opt("spectral", Spectral.from_json),
                 codes=opt("codes", lambda c: {k: CodeCheckRecord.from_json(v) for k, v in c.items()}),
                 time_histories=opt("time_histories", TimeHistories.from_json),
@@ -243,6 +258,19 @@ class RunDocument:
         typed = {k for k, _ in HEADER_FIELDS} | {"reactions", "towers", "until"} | set(BLOCK_FIELDS) | set(_BATCH_KEYS)
         blocks = {k: v for k, v in d.items() if k not in typed}
         return cls(**head, reactions=reactions, towers=towers, until=until, **opts, blocks=blocks)
+
+
+def tower_from_json(t: dict[str, Any]) -> TowerRecord:
+    """A :class:`TowerRecord` from ``towers[i]`` of a saved document (with a run of a case with
+    ``[[wires]]``: its type, attachments, totals and load trees)."""
+    attachments = t.get("attachments")
+    return TowerRecord(
+        int(t["index"]), t["support"], reactions_from_json(t["reactions"]),
+        {k: t[k] for k in SECTION_TOWER_KEYS if k in t} or None,
+        UpliftRecord.from_json(t["uplift"]) if "uplift" in t else None, t.get("type"),
+        None if attachments is None else tuple(AttachmentRun.from_json(a) for a in attachments),
+        totals_from_json(t["totals"]) if "totals" in t else None,
+        load_trees_from_json(t["load_trees"]) if "load_trees" in t else None)
 
 
 #: What a saved result file is expected to be (messages).
@@ -271,7 +299,9 @@ def load_document(d: Any, *, source: str | None = None) -> RunDocument | FailedR
 
 
 # --------------------------------------------------------------------------- from a run
-def _stat_value(ss: Any, j: int, c: int) -> StatValue:
+def stat_value(ss: Any, j: int, c: int) -> StatValue:
+    """Column ``c`` of tower ``j`` (0-based) of a :class:`~linecheck.core.results.StatisticSummary`
+    as a :class:`StatValue` (with its Gumbel fit and interval when it has them)."""
     sm = ss.summary
     g = ss.gumbel
     gumbel = None if g is None else Gumbel(_f(g.location[j, c]), _f(g.scale[j, c]), _f(g.ppcc[j, c]),
@@ -283,7 +313,7 @@ def _stat_value(ss: Any, j: int, c: int) -> StatValue:
 
 def reactions_of(summary: Any, tower: int) -> dict[str, ReactionResult]:
     """Typed reaction blocks of 0-based ``tower`` from a :class:`~linecheck.core.results.ResultSummary`."""
-    return {r: ReactionResult({s.name: _stat_value(summary.statistics[s.name], tower, c) for s in STAT_TABLE},
+    return {r: ReactionResult({s.name: stat_value(summary.statistics[s.name], tower, c) for s in STAT_TABLE},
                               summary.dynamic_analysis[tower, c])
             for c, r in enumerate(REACTIONS)}
 

@@ -379,21 +379,42 @@ class TowerRecord:
     reactions are in that frame) and ``global``: the still-air and step-1 mean reactions in the
     global frame (x along the first span, y to its left, z down).  ``uplift``: a suspension
     tower's :class:`UpliftRecord` (None, no ``"uplift"`` key: a strain tower, or a result saved
-    before it was recorded)."""
+    before it was recorded).
+
+    A run of a case with ``[[wires]]`` (:mod:`linecheck.io.wires_blocks`, docs/wires.md): its
+    ``section`` holds the tower's place only (``name``, ``station``, ``ground``, ``angle``,
+    ``heading``), ``type`` its tower type, ``reactions`` the totals' forces (Fx, Fy, Fz as Rx,
+    Ry, Rz: the tower's whole load for a reader of single-wire results), ``attachments`` one
+    :class:`~linecheck.io.wires_blocks.AttachmentRun` per wire, ``totals`` a
+    :class:`~linecheck.io.wires_blocks.TotalResult` per total (Fx ... Mz) and ``load_trees`` a
+    :class:`~linecheck.io.wires_blocks.LoadTree` per load case; None (absent from the JSON)
+    for a single-wire run."""
 
     index: int
     support: str
     reactions: dict[str, ReactionResult]
     section: dict[str, Any] | None = None
     uplift: UpliftRecord | None = None
+    type: str | None = None
+    attachments: tuple[Any, ...] | None = None
+    totals: dict[str, Any] | None = None
+    load_trees: dict[str, Any] | None = None
 
     def to_json(self) -> dict[str, Any]:
         d: dict[str, Any] = {"index": self.index, "support": self.support}
         if self.section is not None:
             d.update(self.section)
+        if self.type is not None:
+            d["type"] = self.type
         if self.uplift is not None:
             d["uplift"] = self.uplift.to_json()
         d["reactions"] = reactions_to_json(self.reactions)
+        if self.attachments is not None:
+            d["attachments"] = [a.to_json() for a in self.attachments]
+        if self.totals is not None:
+            d["totals"] = {k: v.to_json() for k, v in self.totals.items()}
+        if self.load_trees is not None:
+            d["load_trees"] = {k: v.to_json() for k, v in self.load_trees.items()}
         return d
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..core.tower_totals import LOAD_CASES, TOTALS
 from .schema import MAX_DEPTH, MAX_INTEGER, MAX_MAGNITUDE
 from .stat_table import FLAG_STATES, GUMBEL_KEYS, REACTIONS, STAT_TABLE, SUMMARY_KEYS, StatDef
 
@@ -150,7 +151,11 @@ def _towers_schema() -> dict[str, Any]:
                                   "y to its left, z down); the tower's reactions are in its own frame, "
                                   "x along heading"},
                        "uplift": _uplift_schema(),
-                       "reactions": {"$ref": "#/$defs/reactions"}},
+                       "reactions": {"$ref": "#/$defs/reactions"},
+                       "type": {"type": "string", "description": "a case with [[wires]]: the tower's type"},
+                       "attachments": {"type": "array", "items": {"$ref": "#/$defs/run_attachment"}},
+                       "totals": {"$ref": "#/$defs/run_totals"},
+                       "load_trees": {"$ref": "#/$defs/load_trees"}},
         "required": ["index", "support", "reactions"], "additionalProperties": False}}
 
 
@@ -217,6 +222,68 @@ def _static_wires_schemas() -> tuple[dict[str, Any], dict[str, Any]]:
     return attachment, tot
 
 
+def _run_wires_schemas() -> dict[str, Any]:
+    """The ``$defs`` of a run of a case with ``[[wires]]`` (docs/wires.md,
+    :mod:`linecheck.io.wires_blocks`): ``run_attachment``, ``total``, ``run_totals``,
+    ``peak_bound``, ``load_tree``, ``load_trees`` and ``wire``."""
+    reaction, _ = _reaction_schemas()
+    bound = {"type": "object", "properties": {**{k: NUM_OR_NULL for k in SUMMARY_KEYS},
+                                              "gumbel": {"$ref": "#/$defs/gumbel"}},
+             "required": [*SUMMARY_KEYS, "gumbel"], "additionalProperties": False}
+    total = {**reaction, "description": "one total of the tower, from the summed histories of its attachments: "
+             "every statistic of a reaction [N; moments N m] and the flag, peak_sum: the sum over the attachments "
+             "of their own peak_dynamic and peak_largest the largest of them (per sample, summarised with a "
+             "Gumbel fit), peak_to_sum and peak_to_largest: the mean peak_dynamic of the total over their means",
+             "properties": {**reaction["properties"], "peak_sum": {**bound, "description": "sum of the attachments' "
+                            "peak_dynamic [N or N m]"},
+                            "peak_largest": {**bound, "description": "largest attachment's peak_dynamic"},
+                            "peak_to_sum": NUM_OR_NULL, "peak_to_largest": NUM_OR_NULL},
+             "required": [*reaction["required"], "peak_sum", "peak_largest", "peak_to_sum", "peak_to_largest"]}
+    attachment = {
+        "type": "object",
+        "description": "a run of a case with [[wires]]: towers[i].attachments[j], wire j's attachment on tower i: "
+                       "its point y (to the left of the line's centre) and z (above the tower's ground) [m], support, "
+                       "the wire's still-air clamp height [m], the statistics of its reactions Rx, Ry, Rz [N] in the "
+                       "tower frame (z down) and its uplift at a suspension attachment",
+        "properties": {"wire": {"type": "string"}, "kind": {"enum": ["phase", "ground"]}, "y": {"type": "number"},
+                       "z": {"type": "number"}, "support": {"enum": ["strain", "suspension"]}, "height": NUM_OR_NULL,
+                       "uplift": _uplift_schema(), "reactions": {"$ref": "#/$defs/reactions"}},
+        "required": ["wire", "kind", "y", "z", "support", "reactions"], "additionalProperties": False}
+    totals = {"type": "object", "description": "a run of a case with [[wires]]: towers[i].totals, forces Fx, Fy, Fz "
+              "[N] (tower frame, z down) and moments Mx, My, Mz [N m] about the tower's base (M = sum r x F, z up: "
+              "Mx = -sum (z Ry + y Rz), My = sum z Rx, Mz = -sum y Rx)",
+              "properties": {k: {"$ref": "#/$defs/total"} for k in TOTALS}, "required": list(TOTALS),
+              "additionalProperties": False}
+    comps = ("Rx", "Ry", "Rz")
+    load = {"type": "object", "description": "one wire's reaction [N] (tower frame, z down, still air included) at "
+            "the instant the load case's total is reached: mean over the samples and its standard deviation (_std)",
+            "properties": {"wire": {"type": "string"}, **{c: NUM_OR_NULL for c in comps},
+                           **{f"{c}_std": NUM_OR_NULL for c in comps}},
+            "required": ["wire", *comps, *(f"{c}_std" for c in comps)], "additionalProperties": False}
+    tree = {"type": "object", "description": "the coincident attachment loads of one load case: total (the "
+            "governing total), value: that total at its instant, still air included [N or N m], mean over the "
+            "samples, value_std its standard deviation, attachments: every wire's load (they add up to value)",
+            "properties": {"total": {"enum": list(TOTALS)}, "value": NUM_OR_NULL, "value_std": NUM_OR_NULL,
+                           "attachments": {"type": "array", "items": load}},
+            "required": ["total", "value", "value_std", "attachments"], "additionalProperties": False}
+    trees = {"type": "object", "description": "a run of a case with [[wires]]: towers[i].load_trees, one per load "
+             "case: " + ", ".join(f"{k} ({'least' if sense == 'min' else 'largest |'}{t}{'' if sense == 'min' else '|'})"
+                                  for k, (t, sense) in LOAD_CASES.items()),
+             "properties": {k: {"$ref": "#/$defs/load_tree"} for k in LOAD_CASES}, "required": list(LOAD_CASES),
+             "additionalProperties": False}
+    wire = {"type": "object", "description": "a run of a case with [[wires]]: wires[k], wire k's name, kind, "
+            "sub-conductors, its offset in the one turbulence field (y, z [m]: its attachment's y and still-air "
+            "clamp height at the tower of interest) and its record's burn-in (null: a downburst)",
+            "properties": {"name": {"type": "string"}, "kind": {"enum": ["phase", "ground"]},
+                           "bundle": {"type": "integer", "minimum": 1},
+                           "field_offset": {"type": "object", "properties": {"y": NUM_OR_NULL, "z": NUM_OR_NULL},
+                                            "required": ["y", "z"], "additionalProperties": False},
+                           "burn_in": {"type": ["object", "null"]}},
+            "required": ["name", "kind", "bundle", "field_offset", "burn_in"], "additionalProperties": False}
+    return {"run_attachment": attachment, "total": total, "run_totals": totals, "load_tree": tree,
+            "load_trees": trees, "wire": wire}
+
+
 def _properties() -> dict[str, Any]:
     """The document's top-level properties: header, ``until``, reactions, towers, blocks."""
     return {
@@ -233,6 +300,7 @@ def _properties() -> dict[str, Any]:
         "burn_in": {"type": "object"},
         "damping": {"type": "string"},
         "structural_damping": {"type": "number"},
+        "wires": {"type": "array", "items": {"$ref": "#/$defs/wire"}},
         "spectral": {"type": "object"},
         "time_histories": _histories_schema(),
         "provenance": {"$ref": "#/$defs/provenance"},
@@ -258,6 +326,7 @@ def _definitions() -> dict[str, Any]:
         "provenance": provenance,
         "static_attachment": static_attachment,
         "static_totals": static_totals,
+        **_run_wires_schemas(),
         **{f"stat_{s.name}": _stat_schema(s) for s in STAT_TABLE},
     }
 
@@ -278,7 +347,9 @@ def json_schema() -> dict[str, Any]:
                         f"at most {MAX_MAGNITUDE:g}, integers of magnitude at most {MAX_INTEGER}, arrays and "
                         f"objects nested at most {MAX_DEPTH} levels. "
                         "$defs static_attachment and static_totals describe the per-tower blocks of `linecheck "
-                        "static --json` of a case with [[wires]] (docs/wires.md). "
+                        "static --json` of a case with [[wires]] (docs/wires.md); a run of such a case adds wires, "
+                        "and to each tower its type, attachments, totals and load_trees ($defs run_attachment, "
+                        "run_totals, load_trees, wire). "
                         "Generated by tools/make_result_schema.py from linecheck/io/document.py."),
         "type": "object",
         "properties": _properties(),

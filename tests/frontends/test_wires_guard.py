@@ -1,7 +1,8 @@
-"""A case with ``[[wires]]`` runs `check` and `static` only: every job that analyses one wire
-(run, spectral, modes, wind and its --field, codes, scan, run --excel, a batch's run, the TUI's
-run) refuses it in one line naming the file and what such a case runs (exit 2), before any
-work; a batch records it as a failed case and runs the others."""
+"""A case with ``[[wires]]`` runs `check`, `static` and `linecheck run` (tests/frontends/
+test_wires_run_cli.py): every job that analyses one wire (spectral, modes, wind and its --field,
+codes, scan, a batch's run, the TUI's run, ``run_case``) refuses it in one line naming the file
+and what such a case runs (exit 2), before any work; a batch records it as a failed case and
+runs the others."""
 
 from __future__ import annotations
 
@@ -18,8 +19,11 @@ from ..two_wires import DOWNBURST, write_two_wires
 
 
 def refusal(path, job: str) -> str:
-    return (f"error: {path}: wires: a case with several wires runs `check` and `static` (every attachment and the "
-            f"tower totals); `{job}` of several wires is not available yet: run each wire as a single-wire case")
+    what = ("a batch's or the TUI's run of several wires is not available yet: run the case with `linecheck run`"
+            if job == "run" else
+            f"`{job}` of several wires is not available yet: run each wire as a single-wire case")
+    return (f"error: {path}: wires: a case with several wires runs `check`, `static` and `linecheck run` (every "
+            f"attachment, the tower totals and load trees); {what}")
 
 
 def _invoke(*args):
@@ -27,9 +31,6 @@ def _invoke(*args):
 
 
 @pytest.mark.parametrize(("args", "job"), [
-    (["run"], "run"),
-    (["run", "--until", "0.05"], "run"),
-    (["run", "--excel", "{tmp}/out.xlsx"], "run"),
     (["spectral"], "spectral"),
     (["modes"], "modes"),
     (["wind"], "wind"),

@@ -102,20 +102,7 @@ def export(
     check_outputs([("--excel", excel)], [*(("result file", r) for r in results), ("template", template)])
     check_excel_target(excel, force=force, template=template)
     docs = load_result_docs(results)
-    refuse_wires(docs)
     write_workbook(docs, excel, template=template, force=force, cont_r_threshold=cont_r_threshold,
                    title=fields or None)
     n = len(docs)
     console.print(f"wrote {excel} ({n} case{'s' if n != 1 else ''})")
-
-
-def refuse_wires(docs: list) -> None:
-    """A run of a case with ``[[wires]]`` has no workbook yet (as ``run --excel`` of such a case):
-    one :class:`~linecheck.core.errors.CaseError` line (exit 2) naming the case."""
-    from ..core.errors import CaseError
-
-    wired = [d.case for d in docs if getattr(d, "has_wires", False)]
-    if wired:
-        raise CaseError(f"result of case {wired[0]!r} is a run of several wires: its workbook (attachments, totals, "
-                        "load trees) is not available yet; read its JSON, or write its load trees with `linecheck run "
-                        "--load-trees`", key="--excel")

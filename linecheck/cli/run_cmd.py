@@ -207,9 +207,9 @@ def run(
     case = override(read_case(case_file), realizations, seed)
     require_wires(case, load_trees)
     if case.has_wires:
-        refuse_options(case, {"--excel": excel, "--template": template, "--models": models, "--until": until,
-                              "--full-histories": full_histories})
-        run_wires_command(case, json_out=json_out, load_trees=load_trees, threads=threads)
+        refuse_options(case, {"--models": models, "--until": until, "--full-histories": full_histories})
+        run_wires_command(case, json_out=json_out, load_trees=load_trees, threads=threads, excel=excel,
+                          template=template, force=force, title=fields)
         return
     target = parse_until(until)
     _check_run_outputs(case, json_out, excel, template, force)

@@ -1,6 +1,7 @@
 """`linecheck run` of a case with ``[[wires]]``: every wire in one correlated wind
 (:func:`linecheck.service.run_wires`), the console report (:mod:`linecheck.cli.wires_view`), the
-JSON result and the load-tree CSV (:mod:`linecheck.io.wires_document`); docs/wires.md."""
+JSON result, the load-tree CSV (:mod:`linecheck.io.wires_document`) and the Excel design sheet
+with its "Totals" and "Load trees" sheets (:mod:`linecheck.excel`); docs/wires.md."""
 
 from __future__ import annotations
 
@@ -23,8 +24,6 @@ LoadTreesOpt = Annotated[Path | None, typer.Option(
 
 #: The options of `run` a case with ``[[wires]]`` does not take yet, each with why.
 NOT_FOR_WIRES = {
-    "--excel": "the workbook of a run of several wires is not available yet: write --json (and --load-trees)",
-    "--template": "the workbook of a run of several wires is not available yet: write --json (and --load-trees)",
     "--models": "the downburst model spread of several wires is not available yet: run the case under each model",
     "--until": "the adaptive realization count of several wires is not available yet: give --realizations",
     "--full-histories": "a run of several wires records no time histories",
@@ -36,7 +35,8 @@ def refuse_options(case: Case, given: dict[str, object]) -> None:
     :data:`NOT_FOR_WIRES` given (not None and not False) with a case with ``[[wires]]``."""
     for option, value in given.items():
         if value is not None and value is not False:
-            raise CaseError(f"a run of a case with several wires writes the console report, --json and --load-trees; "
+            raise CaseError(f"a run of a case with several wires writes the console report, --json, --load-trees and "
+                            f"--excel; "
                             f"{NOT_FOR_WIRES[option]}", file=str(case.source) if case.source else None, key=option)
 
 
@@ -48,21 +48,28 @@ def require_wires(case: Case, load_trees: Path | None) -> None:
                         file=str(case.source) if case.source else None, key="--load-trees")
 
 
-def run_wires_command(case: Case, *, json_out: Path | None, load_trees: Path | None, threads: int) -> None:
-    """`run` of a case with ``[[wires]]``: outputs checked first, the case's warnings, the run
-    with progress bars (Ctrl-C stops it), the report, then the JSON and the CSV, each atomically
-    with a "wrote" line."""
+def run_wires_command(case: Case, *, json_out: Path | None, load_trees: Path | None, threads: int,
+                      excel: Path | None = None, template: Path | None = None, force: bool = False,
+                      title: dict[str, str] | None = None) -> None:
+    """`run` of a case with ``[[wires]]``: outputs (and the Excel template) checked first, the
+    case's warnings, the run with progress bars (Ctrl-C stops it), the report, then the JSON, the
+    CSV and the workbook (``title``: its title block), each atomically with a "wrote" line."""
     from .. import service
     from ..io.jsonout import write_json
     from ..io.provenance import kernel_warning
     from ..io.wires_document import wires_run_document, write_load_trees
     from .wires_view import print_wires_run
 
-    check_outputs([("--json", json_out), ("--load-trees", load_trees)], case_inputs(case))
+    check_outputs([("--json", json_out), ("--load-trees", load_trees), ("--excel", excel)],
+                  [*case_inputs(case), ("template", template)])
     if json_out is not None:
         check_target(json_out, what="JSON")
     if load_trees is not None:
         check_target(load_trees, what="CSV")
+    if excel is not None:
+        from ..excel.writer import check_excel_target
+
+        check_excel_target(excel, force=force, template=template)
     service.warn_case(case, limits_warn)
     kernel_off = kernel_warning()
     if kernel_off:
@@ -77,3 +84,8 @@ def run_wires_command(case: Case, *, json_out: Path | None, load_trees: Path | N
     if load_trees is not None:
         write_load_trees(load_trees, doc)
         console.print(f"wrote {load_trees}")
+    if excel is not None:
+        from ..excel.writer import write_workbook
+
+        write_workbook([doc], excel, template=template, force=force, title=title or None)
+        console.print(f"wrote {excel}")

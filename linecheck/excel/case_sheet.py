@@ -43,14 +43,17 @@ from .cells import (
     wind_label,
 )
 from .charts import CHART_COL, CHART_ROWS, CHART_W, case_charts, section_charts
+from .wires_sheets import totals_note, wires_section
 
 
 def write_case(ws: Worksheet, doc: RunDocument, threshold: float, chart_points: int, summary: Worksheet,
-               project: str, flagged: Sequence[str] = SUMMARY_REACTIONS) -> None:
-    """Fill ``ws`` with the sheet of one result document (tables in A-H, charts from J)."""
+               project: str, flagged: Sequence[str] = SUMMARY_REACTIONS,
+               wire_sheets: tuple[str, str] | None = None) -> None:
+    """Fill ``ws`` with the sheet of one result document (tables in A-H, charts from J);
+    ``wire_sheets``: the names of the "Totals" and "Load trees" sheets (a run of several wires)."""
     cur = _sheet_head(ws, doc, summary)
-    section = line_from_parameters(doc.parameters, doc.towers)  # None: the paper's equal-span form
-    contrib_rows = _case_tables(cur, doc, section, threshold, flagged)
+    section = None if doc.has_wires else line_from_parameters(doc.parameters, doc.towers)  # None: equal spans
+    contrib_rows = _case_tables(cur, doc, section, threshold, flagged, wire_sheets or ("Totals", "Load trees"))
     last_table_row = cur.row
     bottom = _place_charts(ws, doc, chart_points, contrib_rows, section)
     ws.freeze_panes = "A4"
@@ -70,7 +73,8 @@ def _sheet_head(ws: Worksheet, doc: RunDocument, summary: Worksheet) -> Cursor:
     ws.sheet_view.showGridLines = False
     cur = Cursor(ws, 1)
     n = doc.realizations
-    cur.put(1, 1, f"{doc.case}: reactions at tower {doc.tower_of_interest}", "lc_title")
+    what = f"tower totals of {len(doc.wires)} wires" if doc.has_wires else "reactions"
+    cur.put(1, 1, f"{doc.case}: {what} at tower {doc.tower_of_interest}", "lc_title")
     cur.put(2, 1, doc.description or wind_label(doc), "lc_subtitle")
     back = cur.put(3, 1, "← Summary", "lc_text")
     link(back, summary.title)
@@ -85,11 +89,15 @@ def _sheet_head(ws: Worksheet, doc: RunDocument, summary: Worksheet) -> Cursor:
 
 
 def _case_tables(cur: Cursor, doc: RunDocument, section: Line | None, threshold: float,
-                 flagged: Sequence[str]) -> tuple[int, int]:
+                 flagged: Sequence[str], wire_sheets: tuple[str, str]) -> tuple[int, int]:
     """The tables of the sheet in order, ending with the notes; returns the contributions table's rows."""
+    if doc.has_wires:
+        cur.note(totals_note(doc, wire_sheets))
     if doc.parameters is not None:
         _inputs_table(cur, doc, doc.parameters)
-    if section is not None:
+    if doc.has_wires:
+        wires_section(cur, doc, wire_sheets)
+    elif section is not None:
         _section_table(cur, doc, section)
     elif _is_section_doc(doc):
         cur.row += 1
@@ -104,6 +112,9 @@ def _case_tables(cur: Cursor, doc: RunDocument, section: Line | None, threshold:
     _uplift_table(cur, doc, section)
     if doc.spectral is not None:
         _spectral(cur, doc, doc.spectral)
+    elif doc.has_wires:
+        cur.row += 1
+        cur.note("Spectral check: none for a run of several wires (the check is of one wire's linear model).")
     elif doc.wind == "synoptic":
         cur.row += 1
         cur.note("Spectral check: not in this result (run without --no-check to add it).")
@@ -153,6 +164,8 @@ def _inputs_table(cur: Cursor, doc: RunDocument, params: dict) -> None:
                 value = table.get(spec.name)
             if value is None and is_section and section == "line" and spec.name in _EQUAL_SPAN_KEYS:
                 value = "(section: see Section)"
+            if value is None and doc.has_wires and section == "line" and spec.name in _WIRE_KEYS:
+                value = "(per wire: see Section)"
             if value is None:
                 preset = (table or {}).get("preset")
                 value = "(from preset)" if preset and spec.name in ("jet_diameter", "distance", "angle") else "(default)"
@@ -176,6 +189,8 @@ def _inputs_table(cur: Cursor, doc: RunDocument, params: dict) -> None:
 
 
 _EQUAL_SPAN_KEYS = ("spans", "span_length", "sag", "height", "supports")
+#: The conductor keys of [line] that each wire of a case with [[wires]] gives instead.
+_WIRE_KEYS = ("weight", "diameter", "drag_coefficient", "area", "elastic_modulus", "tension")
 
 
 def _is_section_doc(doc: RunDocument) -> bool:
@@ -396,6 +411,8 @@ def _towers_table(cur: Cursor, doc: RunDocument, section: Line | None = None) ->
     if not doc.towers:
         return
     names = [r.name for r in tower_rows(section)] if section is not None else []
+    if doc.has_wires:
+        names = [str((t.section or {}).get("name", "")) for t in doc.towers]
     cur.section("Every tower: dynamic peak and maximum mean reactions (kN)")
     cur.header(["Tower", "", "peak Rx", "peak Ry", "peak Rz", "max|M| Rx", "max|M| Ry", "max|M| Rz"])
     for t in doc.towers:

@@ -218,8 +218,9 @@ def _print_setup(ws: Worksheet, top: int, left: int, last: int, right: int, bott
 
 
 def write_summary(ws: Worksheet, docs: list[RunDocument | FailedRun], names: list[str | None], threshold: float,
-                  top: int, left: int, summary_reactions: Sequence[str]) -> None:
-    """The Table 5 table from (top, left): one row per case and reaction, flags, notes, the design
+                  top: int, left: int, summary_reactions: Sequence[str], notes: Sequence[str] = ()) -> None:
+    """The Table 5 table from (top, left): one row per case and reaction, flags, notes (``notes``
+    after the table's own: a run of several wires says what its reactions are), the design
     block (design values, intervals, flag states, how to read them), print setup."""
     from .design import write_design_block
 
@@ -241,6 +242,8 @@ def write_summary(ws: Worksheet, docs: list[RunDocument | FailedRun], names: lis
         _flag_cont_r(ws, cols, top, last, left, threshold)
     cur.row = last + 2
     _summary_notes(cur, threshold, summary_reactions)
+    for line in notes:
+        cur.note(line)
     cur.row = write_design_block(ws, docs, cur.row + 1, left)
     _print_setup(ws, top, left, last, left + len(cols) - 1, cur.row)
 

@@ -20,7 +20,8 @@ that precision (Excel shows 15).
 Sheets: "Summary" (paper Table 5 layout, one row per case and reaction Rx, Ry;
 ``reactions=`` adds Rz), "Peaks" (Fig. 13), one sheet per case (inputs, still-air state, step-1 mean state,
 statistics, contributions, all towers, spectral check when present, and charts:
-Figs B1-B12, 7 and 12).  Time histories are thinned for the charts keeping every
+Figs B1-B12, 7 and 12); with runs of several wires also "Totals" and "Load trees"
+(:mod:`linecheck.excel.wires_sheets`).  Time histories are thinned for the charts keeping every
 block's extremes, unless the result was saved with ``--full-histories``.
 """
 
@@ -51,6 +52,7 @@ from .cells import (
 )
 from .charts import chart_indices
 from .summary import write_peaks, write_summary
+from .wires_sheets import totals_note, wires_docs, write_load_trees, write_totals
 
 
 # =========================================================================== public API
@@ -207,18 +209,27 @@ def build_workbook(wb: Workbook, docs: list[RunDocument | FailedRun], title: dic
     names = [None if isinstance(d, FailedRun) else sheet_name(d.case, taken) for d in docs]
     ok = [(d, n) for d, n in zip(docs, names) if n is not None]
     peaks_name = "Peaks" if "peaks" not in {n.lower() for n in wb.sheetnames} else sheet_name("Peaks (linecheck)", taken)
-    write_summary(summary, docs, names, threshold, top, left, reactions)
+    wired = wires_docs(ok)  # runs of several wires: their Totals and Load trees sheets
+    wire_sheets = (sheet_name("Totals", taken), sheet_name("Load trees", taken)) if wired else None
+    write_summary(summary, docs, names, threshold, top, left, reactions,
+                  notes=[totals_note(d, wire_sheets) for d, _ in wired] if wire_sheets else ())
     if ok:
         write_peaks(wb.create_sheet(peaks_name), ok, summary, reactions)
     header_text = str(title.get("project") or "")
     for d, name in ok:
         ws = wb.create_sheet(name)
-        write_case(ws, d, threshold, chart_points, summary, header_text, reactions)
+        write_case(ws, d, threshold, chart_points, summary, header_text, reactions, wire_sheets)
+    after = peaks_name
     if any(d.codes for d, _ in ok):  # design codes
         from .codes_sheet import write_codes
 
         at = wb.sheetnames.index(peaks_name) + 1 if peaks_name in wb.sheetnames else None
-        write_codes(wb.create_sheet(sheet_name("Codes", taken), at), [d for d, _ in ok], summary)
+        after = sheet_name("Codes", taken)
+        write_codes(wb.create_sheet(after, at), [d for d, _ in ok], summary)
+    if wire_sheets is not None:
+        at = wb.sheetnames.index(after) + 1
+        write_totals(wb.create_sheet(wire_sheets[0], at), wired, summary, wire_sheets[1])
+        write_load_trees(wb.create_sheet(wire_sheets[1], at + 1), wired, summary, header_text)
     wb.active = wb.sheetnames.index(summary.title)
 
 

@@ -5,7 +5,7 @@ their peaks) and load trees, follows docs/results.schema.json and reads back byt
 totals' peaks lie between the largest attachment's and the sum of the attachments'; each load
 tree's attachments add up to its total; `--load-trees` writes the same trees as CSV (kN); the
 options a run of several wires does not take, and `--load-trees` without wires, are refused in
-one line."""
+one line (its workbook: tests/frontends/test_excel_wires.py)."""
 
 from __future__ import annotations
 
@@ -129,17 +129,6 @@ def test_the_console_report(two_run):
     assert "wrote" in out and "trees.csv" in out
 
 
-def test_export_refuses_the_result_as_run_refuses_excel(two_run, tmp_path):
-    """The workbook of a run of several wires is not available yet: `export` of its JSON refuses it
-    in one line, as `run --excel` does, and writes nothing."""
-    folder = two_run[3]
-    out = tmp_path / "x.xlsx"
-    assert one_error_line(_invoke("export", folder / "run.json", "--excel", out)) == (
-        "error: --excel: result of case 'two' is a run of several wires: its workbook (attachments, totals, load "
-        "trees) is not available yet; read its JSON, or write its load trees with `linecheck run --load-trees`")
-    assert not out.exists()
-
-
 def test_a_downburst_runs_without_burn_in(tmp_path):
     path = write_two_wires(tmp_path, wind=DOWNBURST)
     out = tmp_path / "db.json"
@@ -162,7 +151,6 @@ def test_load_trees_without_wires_is_refused(tmp_path):
 
 
 @pytest.mark.parametrize(("args", "option"), [
-    (["--excel", "{tmp}/out.xlsx"], "--excel"),
     (["--until", "0.05"], "--until"),
     (["--models", "all"], "--models"),
     (["--full-histories"], "--full-histories"),
@@ -171,7 +159,7 @@ def test_options_a_run_of_several_wires_does_not_take(tmp_path, args, option):
     path = write_two_wires(tmp_path)
     line = one_error_line(_invoke("run", path, *(a.format(tmp=tmp_path) for a in args)))
     assert line.startswith(f"error: {path}: {option}: a run of a case with several wires writes the console report, "
-                           "--json and --load-trees; ")
+                           "--json, --load-trees and --excel; ")
     assert list(tmp_path.iterdir()) == [path]
 
 

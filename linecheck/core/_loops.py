@@ -30,10 +30,10 @@ from ._loops_second_order import (
     so_products,
     so_solve,
 )
-from ._loops_wind import coherent_spectrum, drag_loads, field_radius, field_velocity, phasors, quad_kms
+from ._loops_wind import coherent_spectrum, drag_loads, field_radius, field_velocity, mix_wires, phasors, quad_kms
 
 __all__ = ["background", "band_solve", "band_solve_1", "coherent_spectrum", "drag_loads",
-           "field_radius", "field_velocity", "from_lanes", "history_reductions", "phasors",
+           "field_radius", "field_velocity", "from_lanes", "history_reductions", "mix_wires", "phasors",
            "quad_kms", "reactions_into", "rest_product", "rotate", "rowdot", "scipy_dgemm",
            "so_frame", "so_history", "so_nodes", "so_nodes_t", "so_place", "so_products",
            "so_solve", "solve_columns", "span_terms", "steps", "steps_1", "to_lanes"]

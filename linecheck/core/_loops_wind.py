@@ -8,7 +8,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["coherent_spectrum", "drag_loads", "field_radius", "field_velocity", "phasors", "quad_kms"]
+__all__ = ["coherent_spectrum", "drag_loads", "field_radius", "field_velocity", "mix_wires", "phasors", "quad_kms"]
 
 @numba.njit(cache=True, nogil=True)
 def phasors(phases, xr, xi):  # pragma: no cover - compiled
@@ -53,6 +53,34 @@ def coherent_spectrum(xr_, xi_, rho_rows, s_rows, row_of_gap, amp, scale, spec):
             zr = a * yr - 0.0 * yi
             zi = a * yi + 0.0 * yr
             spec[j, k + 1] = complex(scale * zr - 0.0 * zi, scale * zi + 0.0 * zr)
+
+
+@numba.njit(cache=True, nogil=True)
+def mix_wires(spec, low, k0):  # pragma: no cover - compiled
+    """The many-wire synthesis' mixing across wires (wires.mix_wires_numpy), in place and in one
+    pass over the spectra: spec (n_p, n_nodes, n_bins) complex, the points' single-wire spectra;
+    low (n_p, n_p, n_freq) the lower factor L_w per frequency; for bins k0 .. k0 + n_freq - 1 and
+    every point p >= 1, spec[p] = sum_(q <= p) L_w[p, q] spec[q] of the raw spectra, the real and
+    imaginary parts each summed from 0 over q in order, every product rounded by itself (no fused
+    multiply-add), as the numpy form's acc += L_w[p, q] spec[q]."""
+    n_p, n_nodes = spec.shape[0], spec.shape[1]
+    n_freq = low.shape[2]
+    vr = np.empty(n_p)
+    vi = np.empty(n_p)
+    for j in range(n_nodes):
+        for k in range(n_freq):
+            for q in range(n_p):
+                z = spec[q, j, k0 + k]
+                vr[q] = z.real
+                vi[q] = z.imag
+            for p in range(1, n_p):
+                ar = 0.0
+                ai = 0.0
+                for q in range(p + 1):
+                    c = low[p, q, k]
+                    ar += c * vr[q]
+                    ai += c * vi[q]
+                spec[p, j, k0 + k] = complex(ar, ai)
 
 
 @numba.njit(cache=True, nogil=True)

@@ -9,6 +9,7 @@ kernel is made of *pieces* (:data:`PIECES`), each a compiled form of one numpy c
 - ``rotate``: the change of node bases between mean states (:func:`rotate`);
 - ``rowdot``: step 3's static transfer X Bᵀ (:func:`rowdot`);
 - ``spectrum``: the wind synthesis' phasors and coherence recursion (:func:`coherent_spectrum`);
+- ``mixing``: the many-wire synthesis' mixing across wires (:func:`mix_wires`);
 - ``loads``: the fluctuating drag loads (:func:`drag_loads`);
 - ``span``: step 1's span-tension Newton integrands (:func:`span_terms`);
 - ``reductions``: the statistics' r.m.s. values and peaks over time (:func:`history_reductions`);
@@ -63,6 +64,7 @@ PIECES: dict[str, str] = {
     "rotate": "change of node bases between mean states",
     "rowdot": "step 3's static transfer",
     "spectrum": "wind synthesis: phasors and coherence recursion",
+    "mixing": "wind synthesis of many wires: mixing across wires",
     "loads": "fluctuating drag loads",
     "span": "step 1's span-tension integrands",
     "reductions": "statistics: r.m.s. values and peaks over time",
@@ -287,7 +289,7 @@ def phasors(phases: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
 
 
 def coherent_spectrum(phases, rho_rows: np.ndarray, row_of_gap: np.ndarray, amp: np.ndarray,
-                      m: int) -> np.ndarray | None:
+                      m: int, *, s_rows: np.ndarray | None = None, out: np.ndarray | None = None) -> np.ndarray | None:
     """The synthesis spectrum of ordered nodes (turbulence.synthesize), compiled, or None when
     the piece ``spectrum`` is off.
 
@@ -295,16 +297,34 @@ def coherent_spectrum(phases, rho_rows: np.ndarray, row_of_gap: np.ndarray, amp:
     rho_rows [-] neighbour coherence rows (n_rows, n_freq) and the row of every gap (n_nodes - 1,)
     (equal gaps: one row); amp [-] cosine amplitudes (n_freq,); m the FFT length.  Returns
     (n_nodes, m // 2 + 1) complex: column k + 1 = (m/2) amp_k y_k with y the KMS / Markov
-    recursion of the unit phasors (Deodatis 1996)."""
+    recursion of the unit phasors (Deodatis 1996).
+
+    ``s_rows``: sqrt(max(1 - rho_rows², 0)) when the caller has it (a many-wire synthesis computes
+    it once for every wire; the same values as computed here); ``out``: a C-ordered complex array
+    of that shape, zero outside columns 1 .. n_freq, filled and returned instead of a new one."""
     if not use("spectrum"):
         return None
     xr, xi = phases if isinstance(phases, tuple) else phasors(phases)
     rho_rows = np.ascontiguousarray(rho_rows, dtype=float)
-    spec = np.zeros((xr.shape[0], m // 2 + 1), dtype=complex)
-    _fns.coherent_spectrum(xr, xi, rho_rows, np.sqrt(np.maximum(1.0 - rho_rows * rho_rows, 0.0)),
+    if s_rows is None:
+        s_rows = np.sqrt(np.maximum(1.0 - rho_rows * rho_rows, 0.0))
+    spec = np.zeros((xr.shape[0], m // 2 + 1), dtype=complex) if out is None else out
+    _fns.coherent_spectrum(xr, xi, rho_rows, np.ascontiguousarray(s_rows, dtype=float),
                            np.ascontiguousarray(row_of_gap, dtype=np.int64),
                            np.ascontiguousarray(amp, dtype=float), 0.5 * m, spec)
     return spec
+
+
+def mix_wires(spec: np.ndarray, low: np.ndarray, k0: int) -> None:
+    """The many-wire synthesis' mixing across wires (:func:`~linecheck.core.wind.wires.mix_wires_numpy`),
+    in place: spec (n_p, n_nodes, n_bins) complex (C-ordered), the points' single-wire spectra;
+    low [-] (n_p, n_p, n_freq) the lower factor L_w(f); bins k0 .. k0 + n_freq - 1 of every point
+    p >= 1 become sum_(q <= p) L_w[p, q] times point q's.  Compiled in one pass when the piece
+    ``mixing`` is on, else the numpy form (registered with the piece's check)."""
+    if not use("mixing"):
+        _numpy_forms["mixing"](spec, low, k0)
+        return
+    _fns.mix_wires(spec, np.ascontiguousarray(low, dtype=float), int(k0))
 
 
 def drag_loads(pv: np.ndarray, pq: np.ndarray | None, s2: np.ndarray | None, v: np.ndarray, sel,

@@ -91,6 +91,77 @@ def test_a_per_wire_modulation_scales_each_wire_and_cancel_stops():
         ww.fluctuating_velocity_wires(case, system, OFFSETS, t, [0], cancel=_Set())
 
 
+def test_realizations_are_the_same_bits_whatever_the_chunk_and_the_lead_wraps(kernel_mode):
+    """The realizations of one call share the spectra's buffer and the factors: each realization's
+    field is still its own (any chunking, any order); a lead longer than the transform wraps the
+    periodic continuation more than once (np.take's "wrap", as turbulence.synthesize)."""
+    case = load_case(SECTION)
+    system = LineSystem(case.line)
+    off = np.vstack([OFFSETS, OFFSETS[2:3]])  # a fifth wire at the third one's point
+    t = np.arange(-30, 400) * 0.05
+    both = ww.fluctuating_velocity_wires(case, system, off, t, [3, 1], lead=30)
+    for i, r in enumerate((3, 1)):
+        assert np.array_equal(both[:, i], ww.fluctuating_velocity_wires(case, system, off, t, [r], lead=30)[:, 0])
+    assert np.array_equal(both[4], both[2])
+    long = ww.unit_field_wires(case, system, OFFSETS, 300, 0.05, 2, lead=700)  # 700 > n_fft = 300
+    ref = ww.unit_field_wires(case, system, OFFSETS, 300, 0.05, 2)
+    assert np.array_equal(long, ref[:, np.arange(-700, 300) % 300])
+    assert np.array_equal(long[0], tb.unit_field(case, system, 300, 0.05, 2, lead=700))
+
+
+def test_unit_modulation_leaves_the_unit_field():
+    """a = 1 (what run_wires passes before each wire's own modulation) is the unit field itself,
+    and a scalar modulation the unit field times it, bit for bit."""
+    case = load_case(PAPER)
+    system = LineSystem(case.line)
+    t = np.arange(300) * 0.05
+    u = ww.unit_field_wires(case, system, OFFSETS, t.size, 0.05, 5)
+    assert np.array_equal(ww.fluctuating_velocity_wires(case, system, OFFSETS, t, [5], a=np.ones((1, 1)))[:, 0], u)
+    assert np.array_equal(ww.fluctuating_velocity_wires(case, system, OFFSETS, t, [5], a=np.full((1, 1), 3.5))[:, 0],
+                          u * 3.5)
+
+
+# --------------------------------------------------------------------------- the mixing across wires
+def _raw_spectra(n_p: int, n_nodes: int, n_freq: int, seed: int = 7) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    spec = np.zeros((n_p, n_nodes, n_freq + 2), dtype=complex)
+    spec[:, :, 1:n_freq + 1] = rng.standard_normal((n_p, n_nodes, n_freq)) + 1j * rng.standard_normal(
+        (n_p, n_nodes, n_freq))
+    return spec
+
+
+def test_mixing_is_the_kronecker_factor_applied_per_frequency():
+    """mix_wires_numpy: point p's bins = sum_(q<=p) L_w[p, q](f) times point q's raw bins (the
+    (L_w (x) I) product written as a dense matrix per frequency here), the other bins untouched."""
+    f = np.arange(1, 41) * 0.03
+    low = ww.wire_factor(f, OFFSETS, 25.0)
+    raw = _raw_spectra(4, 5, f.size)
+    got = raw.copy()
+    ww.mix_wires_numpy(got, low, 1)
+    ref = np.einsum("pqk,qjk->pjk", low, raw[:, :, 1:f.size + 1])
+    assert np.allclose(got[:, :, 1:f.size + 1], ref, rtol=0, atol=1e-14)
+    assert np.array_equal(got[0], raw[0]) and not got[:, :, [0, f.size + 1]].any()
+
+
+def test_compiled_mixing_agrees_with_numpy_and_is_on_where_numba_is(monkeypatch):
+    """The piece ``mixing`` (kernel.mix_wires): on where Numba is installed (its load check
+    passed), within kernel.RTOL of mix_wires_numpy, semidefinite factors (zero columns) included."""
+    from linecheck.core import kernel
+
+    monkeypatch.setenv("LINECHECK_KERNEL", "auto")
+    if not kernel.installed():
+        pytest.skip("Numba (linecheck[fast]) not installed")
+    assert kernel.use("mixing"), [p.reason for p in kernel.status() if p.name == "mixing"]
+    f = np.arange(1, 61) * 0.02
+    for off in (OFFSETS, np.array([[0.0, 0.0], [0.0, 0.0], [1e-9, 3.0], [0.0, 3.0]])):
+        low = ww.wire_factor(f, off, 30.0)
+        raw = _raw_spectra(off.shape[0], 6, f.size, seed=11)
+        ref, got = raw.copy(), raw.copy()
+        ww.mix_wires_numpy(ref, low, 1)
+        kernel.mix_wires(got, low, 1)
+        assert kernel.relative_difference(ref.view(float), got.view(float)) <= kernel.RTOL
+
+
 # --------------------------------------------------------------------------- randomness
 def test_extra_wires_draw_from_spawned_children_of_the_realization():
     ss = np.random.SeedSequence(5, spawn_key=(3,)).spawn(3)[2]

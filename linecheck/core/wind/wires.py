@@ -33,6 +33,14 @@ Wires at the same point (equal offsets) get the same field exactly (the first on
 fully coherent wires (Gamma_w semidefinite) are factored by a Cholesky that gives zero columns
 for zero pivots (:func:`semidefinite_cholesky`).
 
+Work per realization (docs/performance.md "Every wire in one wind"): the spectral grid, L_w, the
+along-line coefficients and a buffer of the points' spectra are made once per call and shared by
+its realizations (the same values as made afresh); each distinct point's spectrum is written into
+the buffer, the buffer is mixed in place (the piece ``mixing`` of the compiled kernel, or
+:func:`mix_wires_numpy`: the same products summed in the same order), and each inverse FFT is
+copied straight into the result.  The inverse FFTs (one per point, as the single-wire synthesis
+has one) are most of the cost.
+
 Layout: wire-major, a unit field of shape (n_w, n_steps, n_nodes) (``field[w]`` is the array the
 single-wire code gives for that wire); velocities (n_w, n_real, n_steps, n_nodes).
 Nothing here prints.
@@ -60,6 +68,7 @@ __all__ = [
     "PIVOT_TOL",
     "CrossCoherence",
     "fluctuating_velocity_wires",
+    "mix_wires_numpy",
     "semidefinite_cholesky",
     "synthesize_wires",
     "unit_field_wires",
@@ -229,38 +238,123 @@ def _resolve(x: np.ndarray, method: str) -> tuple[str, float | None]:
     return method, spacing
 
 
+def mix_wires_numpy(spec: np.ndarray, low: np.ndarray, k0: int) -> None:
+    """(L_w (x) I) y per frequency, in place: the numpy form of ``kernel.mix_wires`` (piece ``mixing``).
+
+    spec (n_p, n_nodes, n_bins) complex, C-ordered: each distinct point's single-wire spectrum;
+    low [-] (n_p, n_p, n_freq) the lower factor L_w(f) (:func:`wire_factor`).  Bins k0 .. k0 +
+    n_freq - 1 of point p >= 1 become sum_(q <= p) L_w[p, q](f) times point q's raw bins (a real
+    factor on the real and imaginary parts, summed from zero over q in order); point 0 and the
+    other bins are not touched.  Points in descending order, so that the raw spectra of the
+    points before p are still there when p is mixed."""
+    n_p, n_nodes = spec.shape[:2]
+    n_freq = low.shape[2]
+    k = slice(k0, k0 + n_freq)
+    pairs = spec.view(float).reshape(n_p, n_nodes, -1, 2)
+    acc, term = np.empty((n_nodes, n_freq, 2)), np.empty((n_nodes, n_freq, 2))
+    for p in range(n_p - 1, 0, -1):
+        acc[...] = 0.0
+        for q in range(p + 1):
+            # point p's value = sum_(q<=p) L_w[p, q](f) times point q's (the Kronecker factor's rows)
+            np.multiply(low[p, q][None, :, None], pairs[q, :, k], out=term)
+            acc += term
+        pairs[p, :, k] = acc
+
+
+@dataclass(frozen=True, eq=False)
+class _Along:
+    """The along-line recursion of every wire (the same for all wires and realizations): the
+    path (``turbulence.synthesize``'s rule), the neighbours' coherence rows (n_rows, n_freq), the
+    row of every gap (n_nodes - 1,) and the innovation weights sqrt(max(1 - rho^2, 0)) of the rows
+    (None on the dense "general" path)."""
+
+    method: str
+    rows: np.ndarray | None
+    gap: np.ndarray | None
+    s_rows: np.ndarray | None
+
+
+def _along(x: np.ndarray, grid: tb.SpectralGrid, decay: float, v_mean: float, method: str) -> _Along:
+    method, spacing = _resolve(x, method)
+    if method == "kms":
+        rows = tb.davenport_coherence(grid.freq, spacing, decay, v_mean)[None, :]  # Davenport (1961), neighbours
+        gap = np.zeros(max(x.size - 1, 0), dtype=np.int64)
+    elif method == "markov":
+        rows, gap = tb.gap_rows(x, grid.freq, decay, v_mean)
+    else:
+        return _Along(method, None, None, None)
+    rows = np.ascontiguousarray(rows, dtype=float)
+    # the kernel's innovation weights (kernel.coherent_spectrum computes the same values per call)
+    return _Along(method, rows, gap, np.sqrt(np.maximum(1.0 - rows * rows, 0.0)))
+
+
 def _wire_spectrum(x: np.ndarray, grid: tb.SpectralGrid, phases: tb.UnitPhases | np.ndarray, decay: float,
-                   v_mean: float, method: str, spacing: float | None) -> np.ndarray:
-    """One wire's inverse-FFT input (n_nodes, n_fft // 2 + 1) complex, exactly as
-    ``turbulence.synthesize`` builds it (the same calls in the same order): the along-line factor
-    L_x applied to the unit phasors, scaled by (m/2) A_k (Deodatis 1996)."""
+                   v_mean: float, along: _Along, out: np.ndarray) -> None:
+    """Fill out (n_nodes, n_fft // 2 + 1) complex (zero outside bins 1 .. n_freq) with one wire's
+    inverse-FFT input, exactly as ``turbulence.synthesize`` builds it (the same calls on the same
+    values): the along-line factor L_x applied to the unit phasors, scaled by (m/2) A_k
+    (Deodatis 1996)."""
     given = phases
     if isinstance(phases, tb.UnitPhases):
         phases, given = phases.phases, (phases.phasors if phases.phasors is not None else phases.phases)
     m = grid.n_fft
-    if method == "kms":
-        rho = tb.davenport_coherence(grid.freq, spacing, decay, v_mean)  # Davenport (1961), neighbours
-        spec = kernel.coherent_spectrum(given, rho[None, :], np.zeros(max(x.size - 1, 0), dtype=np.int64),
-                                        grid.amplitude, m)
-        if spec is None:
-            spec = tb.fft_input(tb.kms_apply(rho, np.exp(1j * phases)), grid.amplitude, m)
-    elif method == "markov":
-        spec = kernel.coherent_spectrum(given, *tb.gap_rows(x, grid.freq, decay, v_mean), grid.amplitude, m)
-        if spec is None:
-            spec = tb.fft_input(tb.markov_apply(x, grid.freq, np.exp(1j * phases), decay, v_mean), grid.amplitude, m)
+    if along.method == "general":
+        y = tb.general_apply(x, grid.freq, np.exp(1j * phases), decay, v_mean)
+    elif kernel.coherent_spectrum(given, along.rows, along.gap, grid.amplitude, m, s_rows=along.s_rows,
+                                  out=out) is not None:
+        return
+    elif along.method == "kms":
+        y = tb.kms_apply(along.rows[0], np.exp(1j * phases))
     else:
-        spec = tb.fft_input(tb.general_apply(x, grid.freq, np.exp(1j * phases), decay, v_mean), grid.amplitude, m)
-    return spec
+        y = tb.markov_apply(x, grid.freq, np.exp(1j * phases), decay, v_mean)
+    out[...] = tb.fft_input(y, grid.amplitude, m)
 
 
 def _to_time(spec: np.ndarray, grid: tb.SpectralGrid, lead: int, out: np.ndarray) -> None:
     """out (lead + n_steps, n_nodes) = the inverse FFT of one wire's spectrum, its first n_steps
-    samples after ``lead`` samples of periodic continuation (as ``turbulence.synthesize``)."""
-    full = sfft.irfft(spec, n=grid.n_fft, axis=1)
-    if lead == 0:
-        out[...] = full[:, : grid.n_steps].T
-    else:
-        out[...] = np.take(full, np.arange(-lead, grid.n_steps), axis=1, mode="wrap").T
+    samples after ``lead`` samples of periodic continuation (as ``turbulence.synthesize``: the
+    same transform, its samples copied into place without an intermediate array)."""
+    m, n = grid.n_fft, grid.n_steps
+    full = sfft.irfft(spec, n=m, axis=1)
+    if lead > m:  # the continuation wraps more than once
+        out[...] = np.take(full, np.arange(-lead, n), axis=1, mode="wrap").T
+        return
+    out[lead:] = full[:, :n].T
+    if lead:
+        out[:lead] = full[:, m - lead:].T  # samples m - lead .. m - 1: the period before t_0
+
+
+class _Synthesis:
+    """What every realization of one field shares: the distinct points, their factor L_w per
+    frequency, the along-line coefficients and the buffer of the points' spectra (n_p, n_nodes,
+    n_fft // 2 + 1), zero outside the simulated bins (each realization overwrites those)."""
+
+    def __init__(self, x: np.ndarray, off: np.ndarray, grid: tb.SpectralGrid, decay: float, v_mean: float,
+                 cross: CrossCoherence | None, method: str) -> None:
+        self.x, self.grid, self.decay, self.v_mean = x, grid, decay, v_mean
+        self.along = _along(x, grid, decay, v_mean, method)
+        self.first, self.point = _distinct_points(off)
+        self.low = wire_factor(grid.freq, off[self.first], v_mean, cross)  # (n_p, n_p, n_freq)
+        self.spec = np.zeros((self.first.size, x.size, grid.n_fft // 2 + 1), dtype=complex)
+
+    def __call__(self, phases: Sequence[tb.UnitPhases | np.ndarray | None], lead: int, out: np.ndarray) -> None:
+        """out (n_w, lead + n_steps, n_nodes) = the field of these phases (one entry per wire;
+        only the first wire at each point is read)."""
+        x, grid = self.x, self.grid
+        for p, w in enumerate(self.first):
+            ph = phases[w]
+            shape = (ph.phases if isinstance(ph, tb.UnitPhases) else np.asarray(ph)).shape
+            if shape != (x.size, grid.n_freq):
+                raise ValueError(f"wire {w}: phases shape {shape} != {(x.size, grid.n_freq)}")
+            _wire_spectrum(x, grid, ph, self.decay, self.v_mean, self.along, self.spec[p])
+        if self.first.size > 1:
+            # (L_w (x) I) y: the simulated bins 1 .. n_freq mixed across points (the others are zero)
+            kernel.mix_wires(self.spec, self.low, 1)
+        for p, w in enumerate(self.first):
+            _to_time(self.spec[p], grid, lead, out[w])
+        for w in range(out.shape[0]):
+            if self.first[self.point[w]] != w:
+                out[w] = out[self.first[self.point[w]]]  # the same point: the same field
 
 
 def synthesize_wires(x: np.ndarray, offsets: np.ndarray, grid: tb.SpectralGrid,
@@ -281,40 +375,35 @@ def synthesize_wires(x: np.ndarray, offsets: np.ndarray, grid: tb.SpectralGrid,
     off = _offsets(offsets)
     if len(phases) != off.shape[0]:
         raise ValueError(f"{len(phases)} phase arrays for {off.shape[0]} wires")
-    method, spacing = _resolve(x, method)
-    first, point = _distinct_points(off)
-    low = wire_factor(grid.freq, off[first], v_mean, cross)  # (n_p, n_p, n_freq)
-    specs = []
-    for w in first:
-        ph = phases[w]
-        shape = (ph.phases if isinstance(ph, tb.UnitPhases) else np.asarray(ph)).shape
-        if shape != (x.size, grid.n_freq):
-            raise ValueError(f"wire {w}: phases shape {shape} != {(x.size, grid.n_freq)}")
-        specs.append(_wire_spectrum(x, grid, ph, decay, v_mean, method, spacing))
     out = np.empty((off.shape[0], lead + grid.n_steps, x.size))
-    k = slice(1, grid.n_freq + 1)  # the simulated bins; the others are zero in every spectrum
-    # descending, so that the raw spectra of the points before p are still there when p is mixed
-    for p in range(len(first) - 1, -1, -1):
-        spec = specs[p]
-        if p > 0:
-            mixed = np.zeros_like(spec)
-            acc = mixed.view(float).reshape(x.size, -1, 2)[:, k]
-            for q in range(p + 1):
-                # (L_w (x) I) y: point p's value = sum_(q<=p) L_w[p, q](f) times point q's (real factor)
-                acc += low[p, q][None, :, None] * specs[q].view(float).reshape(x.size, -1, 2)[:, k]
-            spec = mixed
-        _to_time(spec, grid, lead, out[first[p]])
-        if p > 0:
-            specs[p] = None  # no point before p needs it: free it
-    for w in range(off.shape[0]):
-        if first[point[w]] != w:
-            out[w] = out[first[point[w]]]  # the same point: the same field
+    _Synthesis(x, off, grid, decay, v_mean, cross, method)(phases, lead, out)
     return out
 
 
 # ------------------------------------------------------------------------- case-level API
 def _stations(system: LineSystem) -> np.ndarray:
     return system.node_station if system.is_section else system.node_x0
+
+
+def _setup(case: Case, system: LineSystem, off: np.ndarray, n_steps: int, dt: float,
+           cross: CrossCoherence | None) -> _Synthesis:
+    """The field's shared part for the case's wind on ``system``'s stations (as ``turbulence.unit_field``)."""
+    x = _stations(system)
+    v = float(case.wind.v_ref)
+    if not v > 0:
+        raise CaseError("value 0.0 is not allowed for turbulence synthesis: expected v_ref > 0",
+                        file=str(case.source) if case.source else None, key="wind.v_ref")
+    grid = tb.spectral_grid(int(n_steps), float(dt), tb.length_scale(case), v, case.wind.fft_length == "fast")
+    return _Synthesis(x, off, grid, case.wind.coherence_decay, v, cross, "auto")
+
+
+def _realization_phases(case: Case, synth: _Synthesis, n_w: int, realization: int) -> list:
+    """Realization r's phases of the first wire at each point (None for the others)."""
+    phases: list = [None] * n_w
+    first = [int(f) for f in synth.first]
+    for w, ph in zip(first, wire_phases(case.analysis.seed, realization, first, synth.x.size, synth.grid.n_freq)):
+        phases[w] = ph
+    return phases
 
 
 def unit_field_wires(case: Case, system: LineSystem, offsets: np.ndarray, n_steps: int, dt: float,
@@ -327,19 +416,11 @@ def unit_field_wires(case: Case, system: LineSystem, offsets: np.ndarray, n_step
     ``turbulence.unit_field`` bit for bit; the spectrum, L_u, C_x = ``wind.coherence_decay`` and
     V = V_ref are the case's.
     """
-    x = _stations(system)
-    v = float(case.wind.v_ref)
-    if not v > 0:
-        raise CaseError("value 0.0 is not allowed for turbulence synthesis: expected v_ref > 0",
-                        file=str(case.source) if case.source else None, key="wind.v_ref")
     off = _offsets(offsets)
-    grid = tb.spectral_grid(int(n_steps), float(dt), tb.length_scale(case), v, case.wind.fft_length == "fast")
-    first, _ = _distinct_points(off)
-    phases: list = [None] * off.shape[0]
-    for w, ph in zip(first, wire_phases(case.analysis.seed, realization, [int(f) for f in first], x.size,
-                                        grid.n_freq)):
-        phases[w] = ph
-    return synthesize_wires(x, off, grid, phases, case.wind.coherence_decay, v, cross, lead=lead)
+    synth = _setup(case, system, off, n_steps, dt, cross)
+    out = np.empty((off.shape[0], lead + synth.grid.n_steps, synth.x.size))
+    synth(_realization_phases(case, synth, off.shape[0], realization), lead, out)
+    return out
 
 
 def _record(time: np.ndarray) -> tuple[int, float]:
@@ -365,7 +446,9 @@ def fluctuating_velocity_wires(case: Case, system: LineSystem, offsets: np.ndarr
     ``offsets`` [m] (n_w, 2).  ``a`` [m/s]: the modulation, (n_w, n_steps, n_nodes) for each wire's
     own running mean (downbursts: I V_m at that wire's nodes) or anything that broadcasts to it;
     default ``turbulence.modulation(case, system, time)`` for every wire.  Wire 0 with that
-    modulation equals ``turbulence.fluctuating_velocity`` bit for bit.
+    modulation equals ``turbulence.fluctuating_velocity`` bit for bit.  Each realization's field
+    is synthesized in place in the result; the spectral grid, the factors and the spectra's buffer
+    are shared by the realizations (the same values as computed afresh).
     """
     n_steps, dt = _record(time)
     if not 0 <= lead < n_steps - 3:
@@ -379,13 +462,39 @@ def fluctuating_velocity_wires(case: Case, system: LineSystem, offsets: np.ndarr
     per_wire = a.ndim == 3 and a.shape[0] > 1  # else one modulation broadcast to every wire
     if a.ndim == 3 and not per_wire:
         a = a[0]
+    unit = not per_wire and a.size == 1 and float(a.reshape(-1)[0]) == 1.0  # u * 1.0 is u: skip the pass
+    synth = _setup(case, system, off, n_steps - lead, dt, cross)
     reals = list(realizations)
     out = np.empty((off.shape[0], len(reals), n_steps, system.n_nodes))
     for i, r in enumerate(reals):
         if cancel is not None and cancel.is_set():
             raise Cancelled("run cancelled")
-        u = unit_field_wires(case, system, off, n_steps - lead, dt, int(r), int(lead), cross)
+        synth(_realization_phases(case, synth, off.shape[0], int(r)), int(lead), out[:, i])
+        if unit:
+            continue
         for w in range(off.shape[0]):
-            out[w, i] = u[w]
             out[w, i] *= a[w] if per_wire else a
     return out
+
+
+# ---- the compiled kernel's piece ``mixing`` (linecheck.core.kernel): its load check
+
+def _mixing_check(fns) -> float:
+    """The compiled mixing (``fns.mix_wires``) against :func:`mix_wires_numpy` on random spectra
+    of five points, two of them nearly coincident (zero pivots: zero columns of L_w); the largest
+    relative difference."""
+    rng = np.random.default_rng(26)
+    n_nodes, n_freq = 7, 97
+    freq = np.arange(1, n_freq + 1) * 0.02
+    off = np.array([[0.0, 0.0], [-6.5, 2.0], [6.5, 2.0], [0.0, 9.0], [0.0, 9.0 + 1e-9]])
+    low = wire_factor(freq, off, 30.0)
+    spec = np.zeros((off.shape[0], n_nodes, n_freq + 2), dtype=complex)
+    spec[:, :, 1:n_freq + 1] = rng.standard_normal((off.shape[0], n_nodes, n_freq)) + 1j * rng.standard_normal(
+        (off.shape[0], n_nodes, n_freq))
+    ref, got = spec.copy(), spec.copy()
+    mix_wires_numpy(ref, low, 1)
+    fns.mix_wires(got, low, 1)
+    return kernel.worst_difference([(ref.view(float), got.view(float))])
+
+
+kernel.register_check("mixing", _mixing_check, numpy=mix_wires_numpy)

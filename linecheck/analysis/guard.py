@@ -21,8 +21,8 @@ Warn = Callable[[str], None]
 #: The jobs a case with ``[[wires]]`` runs through :func:`check_budget`: every other job analyses
 #: one wire (the case's ``line`` is only its first wire's) and :func:`require_one_wire` refuses
 #: it.  Its dynamic run is :func:`~linecheck.analysis.wires_run.run_wires` (``linecheck run``),
-#: which guards each wire's single-wire case instead; the one-wire run (``run_case``: a batch's
-#: run, the TUI's) stays refused.
+#: which guards each wire's single-wire case instead (``linecheck run`` and the TUI's run call
+#: it); the one-wire run (``run_case``: a batch's run) stays refused.
 WIRES_JOBS = frozenset({"static"})
 
 
@@ -31,10 +31,11 @@ def require_one_wire(case: Case, job: str) -> None:
     :class:`~linecheck.core.errors.CaseError` line (exit 2) naming the file, what such a case
     runs and what to do.  :func:`check_budget` calls it, so every job meets it before any work;
     the few entry points without a resource guard (code loads, scan, batch) call it themselves.
-    ``job`` "run" is the one-wire run (``run_case``), which a batch and the TUI call."""
+    ``job`` "run" is the one-wire run (``run_case``), which a batch calls."""
     if not case.has_wires or job in WIRES_JOBS:
         return
-    what = ("a batch's or the TUI's run of several wires is not available yet: run the case with `linecheck run`"
+    what = ("a batch's run of several wires is not available yet: run the case with `linecheck run` (or in the "
+            "TUI)"
             if job == "run" else
             f"`{job}` of several wires is not available yet: run each wire as a single-wire case")
     raise CaseError(f"a case with several wires runs `check`, `static` and `linecheck run` (every attachment, the "

@@ -164,6 +164,17 @@ class LinecheckApp(App[None]):
         self.query_one("#main-tabs", TabbedContent).active = tab
         self.query_one(MAIN_TABS[tab]).focus()
 
+    def show_result_tab(self, tab: str) -> None:
+        """Tab 3 on its view ``tab`` ("res-trees": the load trees of a run of several wires; a view
+        the result does not have: a notification)."""
+        results = self.query_one(ResultsView)
+        if not results.has_tab(tab):
+            self.notify("The load trees are those of a run of a case with [[wires]]: open one and press r.",
+                        severity="warning")
+            return
+        self.query_one("#main-tabs", TabbedContent).active = "results"
+        results.active_tab = tab
+
     def action_result_tab(self, step: int) -> None:
         tabs = self.query_one("#main-tabs", TabbedContent)
         if tabs.active != "results":
@@ -281,6 +292,9 @@ class LinecheckApp(App[None]):
         if self.case is not None and self.case.wind.type != "downburst":
             self.notify("The model spread is for downburst cases.", severity="warning")
             return
+        if self.case is not None and self.case.has_wires:
+            self.notify("The model spread of several wires is not available yet: r runs the case.", severity="warning")
+            return
         self.action_run(models="all")
 
     def action_run(self, models: str | None = None) -> None:
@@ -356,8 +370,9 @@ class LinecheckApp(App[None]):
         self._run_ended()
         out = event.output
         self.output, self.output_original = out, self._run_original
+        views = "Summary, Contributions, Load trees: [ ] steps" if out.has_wires else "[ ] steps through its views"
         self.query_one(RunPanel).finish(f"done: {out.case.name} in {out.seconds:.1f} s - "
-                                        "tab 3 Results ([ ] steps through its views), p pins for compare, x/j export")
+                                        f"tab 3 Results ({views}), p pins for compare, x/j export")
         try:
             self.query_one(ResultsView).show(out, self.pinned, stale=self._stale_note(out))
             self.query_one(CompareView).show(self.pinned, out)

@@ -51,6 +51,8 @@ class LinecheckCommands(Provider):
             Command("view: parameters", partial(app.action_show_tab, "params"), "tab 2", listed=False),
             Command("view: results", partial(app.action_show_tab, "results"), "tab 3", listed=False),
             Command("view: compare", partial(app.action_show_tab, "compare"), "tab 4", listed=False),
+            Command("view: load trees", partial(app.show_result_tab, "res-trees"),
+                    "tab 3: a run of several wires, every tower's load trees", listed=False),
             Command("view: help", app.action_help, "keys and a typical session"),
         ]
         return cmds

@@ -1,8 +1,8 @@
 """A case with ``[[wires]]`` runs `check`, `static` and `linecheck run` (tests/frontends/
 test_wires_run_cli.py): every job that analyses one wire (spectral, modes, wind and its --field,
-codes, scan, a batch's run, the TUI's run, ``run_case``) refuses it in one line naming the file
-and what such a case runs (exit 2), before any work; a batch records it as a failed case and
-runs the others."""
+codes, scan, a batch's run, ``run_case``) refuses it in one line naming the file and what such a
+case runs (exit 2), before any work; a batch records it as a failed case and runs the others (the
+TUI's run calls ``run_wires``: tests/frontends/test_tui_wires.py)."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ from ..two_wires import DOWNBURST, write_two_wires
 
 
 def refusal(path, job: str) -> str:
-    what = ("a batch's or the TUI's run of several wires is not available yet: run the case with `linecheck run`"
+    what = ("a batch's run of several wires is not available yet: run the case with `linecheck run` (or in the TUI)"
             if job == "run" else
             f"`{job}` of several wires is not available yet: run each wire as a single-wire case")
     return (f"error: {path}: wires: a case with several wires runs `check`, `static` and `linecheck run` (every "
@@ -73,14 +73,13 @@ def test_a_batch_fails_the_case_with_wires_and_runs_the_others(tmp_path):
 
 def test_the_service_refuses_before_any_work(tmp_path):
     """The one guard every job meets (``check_budget``) and the entry points without a resource
-    guard (code loads, the scan's estimate) refuse the case; the TUI's run calls ``run_case``."""
+    guard (code loads, the scan's estimate) refuse the case."""
     from linecheck import service
     from linecheck.batch.scan import scan_estimate
-    from linecheck.tui import runner
 
     path = write_two_wires(tmp_path)
     case = load_case(path)
-    for call, job in [(lambda: service.run_case(case), "run"), (lambda: runner.execute(case), "run"),
+    for call, job in [(lambda: service.run_case(case), "run"),
                       (lambda: service.modes_analysis(case), "modes"),
                       (lambda: service.spectral_analysis(case), "spectral"),
                       (lambda: service.wind_at_p(case), "wind"), (lambda: service.code_loads(case), "codes"),

@@ -23,8 +23,13 @@ Design check of conductor reactions under downburst and synoptic winds
   cell, `enter` edits it (checked like the case file; saved as inline `[[line.towers]]`)
 - `s`: save the edited case as a new TOML file in the working folder (an existing file is never
   replaced silently; a shipped case folder such as `cases/paper/` needs a second `enter`)
-- `r`: run the case (steps 1-3, natural frequencies, wind at p); `c` cancels the run
+- `r`: run the case (steps 1-3, natural frequencies, wind at p); `c` cancels the run. A case with
+  `[[wires]]` runs every wire in one correlated wind, as `linecheck run` does: its Results are the
+  Summary (the tower totals' forces at the tower of interest), Contributions and Load trees
 - `[` `]`: previous / next result tab
+- Load trees (a run of several wires): `↑` `↓` pick the tower, `←` `→` the load case; every wire's
+  vertical, transverse and longitudinal load (kN) at the instant the case's total is reached, and
+  the tower's totals
 - `p`: pin the result for Compare
 - `x` / `j`: export the result to Excel (.xlsx) / JSON
 - `ctrl+p`: command palette: "case: ...", "run: ...", "export: ..."

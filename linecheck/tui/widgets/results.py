@@ -1,5 +1,6 @@
 """Result tabs of the last run: summary, time histories, mean states, wind at p,
-contributions, spectral check, natural frequencies."""
+contributions, spectral check, natural frequencies; a run of a case with ``[[wires]]``: summary,
+contributions and load trees (its one-wire tabs hidden)."""
 
 from __future__ import annotations
 
@@ -24,24 +25,20 @@ from ..formatting import (
 )
 from ..plotting import PlotView
 from ..runner import RunOutput
+from ..wires_text import wires_summary_note, wires_title
+from .choice import StepChoice
+from .trees import LoadTreeView
 
 NO_RUN = "No results yet: open a case and press r to run it."
-TABS = ("res-summary", "res-histories", "res-mean", "res-wind", "res-contrib", "res-spectral", "res-freq")
+TABS = ("res-summary", "res-histories", "res-mean", "res-wind", "res-contrib", "res-spectral", "res-freq",
+        "res-trees")
+#: The tabs of one wire's run (hidden for a run of several wires); "res-trees" only for several wires.
+ONE_WIRE_TABS = ("res-histories", "res-mean", "res-wind", "res-spectral", "res-freq")
+WIRES_TABS = ("res-trees",)
 
 
-class ReactionChoice(RadioSet):
+class ReactionChoice(StepChoice):
     """Rx / Ry / Rz: the arrow keys pick a reaction at once (no enter needed)."""
-
-    def _step(self, step: int) -> None:
-        buttons = list(self.query(RadioButton))
-        i = max(self.pressed_index, 0)
-        buttons[(i + step) % len(buttons)].value = True
-
-    def action_next_button(self) -> None:
-        self._step(1)
-
-    def action_previous_button(self) -> None:
-        self._step(-1)
 
 
 class ResultsView(Vertical):
@@ -81,6 +78,8 @@ class ResultsView(Vertical):
             with TabPane("Frequencies", id="res-freq"):
                 yield Static(NO_RUN, id="freq-notes")
                 yield DataTable(id="freq-table", cursor_type="row", zebra_stripes=True)
+            with TabPane("Load trees", id="res-trees"):
+                yield LoadTreeView(id="tree-view")
 
     def on_mount(self) -> None:
         t = self.query_one("#summary-table", DataTable)
@@ -89,6 +88,7 @@ class ResultsView(Vertical):
         self.query_one("#sanity-table", DataTable).add_columns(
             "reaction", "sanity check", "time domain ± std", "frequency domain", "allowed difference", "verdict")
         self.query_one("#freq-table", DataTable).add_columns("mode", "still air (Hz)", "dir", "mean state (Hz)", "dir")
+        self._tabs_for(wires=False)
 
     # ------------------------------------------------------------------ tabs
     @property
@@ -100,26 +100,45 @@ class ResultsView(Vertical):
         self.query_one("#results-tabs", TabbedContent).active = tab
 
     def cycle_tab(self, step: int) -> None:
-        i = TABS.index(self.active_tab) if self.active_tab in TABS else 0
-        self.active_tab = TABS[(i + step) % len(TABS)]
+        """The next (``step`` 1) or previous (-1) of the tabs shown."""
+        shown = [t for t in TABS if self.has_tab(t)]
+        i = shown.index(self.active_tab) if self.active_tab in shown else 0
+        self.active_tab = shown[(i + step) % len(shown)]
+
+    def has_tab(self, tab: str) -> bool:
+        """Whether the view ``tab`` is shown (the tabs depend on the result: one or several wires)."""
+        return bool(self.query_one("#results-tabs", TabbedContent).get_tab(tab).display)
+
+    def _tabs_for(self, *, wires: bool) -> None:
+        """Show the tabs of a run of several wires (``wires``) or of one wire, hide the others."""
+        tabs = self.query_one("#results-tabs", TabbedContent)
+        for tab in ONE_WIRE_TABS:
+            (tabs.hide_tab if wires else tabs.show_tab)(tab)
+        for tab in WIRES_TABS:
+            (tabs.show_tab if wires else tabs.hide_tab)(tab)
 
     # ------------------------------------------------------------------ content
     def show(self, output: RunOutput, pinned: RunOutput | None = None, *, stale: str | None = None) -> None:
         """Fill every tab from ``output``; ``stale``: why it is not the current case (shown)."""
         self.output, self.pinned = output, pinned
         doc = output.doc
-        title = Text(summary_title(doc), style="bold")
+        wires = doc.has_wires
+        title = Text(wires_title(doc) if wires else summary_title(doc), style="bold")
         title.append(f"   run in {output.seconds:.1f} s", style="dim")
         if stale:
             title.append(f"   ({stale})", style="yellow")
         self.query_one("#results-title", Static).update(title)
+        self._tabs_for(wires=wires)
         self._summary(doc)
+        self.show_contributions()
+        self.query_one(LoadTreeView).show(doc)
+        if wires:  # no time histories, mean-state series, wind at p, spectral check or modes of several wires
+            return
         self._history()
         self.query_one("#plot-tension", PlotView).show(figures.mean_tension(output.result))
         self.query_one("#plot-displacement", PlotView).show(figures.mean_displacement(output.result))
         wind = self.query_one("#plot-wind", PlotView)
         wind.show(figures.wind_at_p(output.wind) if output.wind is not None else None, "wind at p not computed")
-        self.show_contributions()
         self._spectral(doc)
         self._frequencies(output)
 
@@ -139,6 +158,8 @@ class ResultsView(Vertical):
                     Text(c, style="bold black on yellow") if r in flagged else c for r, c in zip(REACTIONS, cells[2:])]
             t.add_row(*cells, key=row[0])
         notes = Text()
+        if doc.has_wires:
+            notes.append(wires_summary_note(doc) + "\n", style="bold")
         notes.append("Wind-induced reactions (still air removed) at the tower of interest, "
                      f"{doc_frame_caption(doc)}; "
                      "** : GF undefined, mean zero by symmetry or < 1 % of the largest mean. "
@@ -171,6 +192,8 @@ class ResultsView(Vertical):
     def _tab_activated(self, event: TabbedContent.TabActivated) -> None:
         if event.pane.id == "res-histories":
             self.query_one(ReactionChoice).focus()
+        elif event.pane.id == "res-trees":
+            self.query_one("#tree-towers").focus()
 
     @on(RadioSet.Changed, "#reaction-choice")
     def _reaction_changed(self, event: RadioSet.Changed) -> None:

@@ -221,9 +221,9 @@ needs the columns `station` and `type`).
   first wire's); a wire's single-wire case carries that height (docs/wires.md "One wind").
 - **Jobs.** A case with `[[wires]]` runs `check`, `static` (every attachment's reactions and
   each tower's totals) and `linecheck run` (every wire in one correlated wind: each attachment,
-  the tower totals and load trees; docs/wires.md). Every other job (`spectral`, `modes`, `wind`,
-  `codes`, `scan`, a batch's run, the TUI's run) analyses one wire and refuses it in one line
-  before any work (exit 2; a batch fails that case and runs the others):
+  the tower totals and load trees; docs/wires.md; the TUI's run does the same). Every other job
+  (`spectral`, `modes`, `wind`, `codes`, `scan`, a batch's run) analyses one wire and refuses it
+  in one line before any work (exit 2; a batch fails that case and runs the others):
 
   ```
   error: c.toml: wires: a case with several wires runs `check`, `static` and `linecheck run` (every

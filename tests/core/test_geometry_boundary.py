@@ -27,6 +27,7 @@ GEOMETRY_CODE = {"core/case_model.py", "core/case_load.py", "core/system.py"}
 DISPLAY_ONLY = {
     "io/section.py": "one-line line summary of the front ends: '6 spans x 300 m' (equal-span form)",
     "io/document.py": "run document copies the case's span_length key into the JSON identity block",
+    "io/wires_document.py": "a run of several wires: the same JSON identity block as io/document.py",
     "excel/summary.py": "summary sheet prints the document's span_length column",
 }
 

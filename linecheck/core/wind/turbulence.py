@@ -333,7 +333,9 @@ def general_apply(x: np.ndarray, freq: np.ndarray, xi: np.ndarray, decay: float,
     return y
 
 
-def _uniform_spacing(x: np.ndarray) -> float | None:
+def uniform_spacing(x: np.ndarray) -> float | None:
+    """[m] the spacing of equally spaced increasing x, else None: the rule that picks the KMS path
+    (:mod:`linecheck.core.wind.wires` uses it too, so its wire 0 takes the same path)."""
     d = np.diff(x)
     if d.size == 0:
         return 0.0
@@ -371,7 +373,7 @@ def synthesize(x: np.ndarray, grid: SpectralGrid, phases: np.ndarray | UnitPhase
     n_nodes = x.size
     if phases.shape != (n_nodes, grid.n_freq):
         raise ValueError(f"phases shape {phases.shape} != {(n_nodes, grid.n_freq)}")
-    spacing = _uniform_spacing(x)
+    spacing = uniform_spacing(x)
     if method == "auto":
         method = "kms" if spacing is not None else ("markov" if np.all(np.diff(x) >= 0) else "general")
     m = grid.n_fft
@@ -467,7 +469,9 @@ def modulation(case: Case, system: LineSystem, time: np.ndarray) -> np.ndarray:
     return i * mean_speed_at_nodes(case, system, time)
 
 
-def _record(time: np.ndarray) -> tuple[int, float]:
+def record_axis(time: np.ndarray) -> tuple[int, float]:
+    """(n_steps, dt [s]) of an equally spaced time axis [s], dt to 12 significant digits (a
+    :class:`CaseError` otherwise); the many-wire synthesis uses the same rule (the same grid)."""
     t = np.asarray(time, dtype=float)
     if t.ndim != 1 or t.size < 4:
         raise CaseError(f"time axis of {t.size} instants is not allowed: expected at least 4 equally spaced instants")
@@ -494,7 +498,7 @@ def fluctuating_velocity(case: Case, system: LineSystem, time: np.ndarray, reali
     ``cancel``: an event (``is_set()``) checked before each realization (Cancelled when set).
     Returns shape (n_real, n_steps, n_nodes).
     """
-    n_steps, dt = _record(time)
+    n_steps, dt = record_axis(time)
     if not 0 <= lead < n_steps - 3:
         raise ValueError(f"lead of {lead} samples does not fit a record of {n_steps}")
     if a is None:

@@ -216,19 +216,8 @@ def wire_phases(seed: int, realization: int, wires: Sequence[int], n_nodes: int,
 
 
 # ------------------------------------------------------------------------- synthesis
-def _equal_spacing(x: np.ndarray) -> float | None:
-    """The spacing of equally spaced increasing x, else None: the rule by which
-    ``turbulence.synthesize`` picks its KMS path (the same rule, so wire 0 takes the same path)."""
-    d = np.diff(x)
-    if d.size == 0:
-        return 0.0
-    if d[0] > 0 and np.allclose(d, d[0], rtol=1e-9, atol=0.0):
-        return float(d[0])
-    return None
-
-
 def _resolve(x: np.ndarray, method: str) -> tuple[str, float | None]:
-    spacing = _equal_spacing(x)
+    spacing = tb.uniform_spacing(x)  # turbulence.synthesize's rule: wire 0 takes its path
     if method == "auto":
         method = "kms" if spacing is not None else ("markov" if np.all(np.diff(x) >= 0) else "general")
     if method not in ("kms", "markov", "general"):
@@ -423,19 +412,6 @@ def unit_field_wires(case: Case, system: LineSystem, offsets: np.ndarray, n_step
     return out
 
 
-def _record(time: np.ndarray) -> tuple[int, float]:
-    """(n_steps, dt [s]) of an equally spaced time axis, dt to 12 significant digits: the rule of
-    ``turbulence.fluctuating_velocity`` (the same spectral grid, so wire 0 is its field bit for bit)."""
-    t = np.asarray(time, dtype=float)
-    if t.ndim != 1 or t.size < 4:
-        raise CaseError(f"time axis of {t.size} instants is not allowed: expected at least 4 equally spaced instants")
-    d = np.diff(t)
-    dt = float((t[-1] - t[0]) / (t.size - 1))
-    if not dt > 0 or not np.allclose(d, dt, rtol=1e-6, atol=1e-9 * max(1.0, abs(t[-1]))):
-        raise CaseError("time axis is not allowed: expected equally spaced, increasing instants")
-    return t.size, float(f"{dt:.12g}")
-
-
 def fluctuating_velocity_wires(case: Case, system: LineSystem, offsets: np.ndarray, time: np.ndarray,
                                realizations: Sequence[int], a: np.ndarray | None = None, lead: int = 0,
                                cancel=None, cross: CrossCoherence | None = None) -> np.ndarray:
@@ -450,7 +426,7 @@ def fluctuating_velocity_wires(case: Case, system: LineSystem, offsets: np.ndarr
     is synthesized in place in the result; the spectral grid, the factors and the spectra's buffer
     are shared by the realizations (the same values as computed afresh).
     """
-    n_steps, dt = _record(time)
+    n_steps, dt = tb.record_axis(time)
     if not 0 <= lead < n_steps - 3:
         raise ValueError(f"lead of {lead} samples does not fit a record of {n_steps}")
     off = _offsets(offsets)

@@ -147,3 +147,19 @@ def handle_errors(fn: F) -> F:
 
 def read_case(path: Path) -> Case:
     return load_case(path)
+
+
+def write_run_outputs(doc: Any, json_out: Path | None, excel: Path | None, template: Path | None,
+                      force: bool, fields: dict[str, str] | None) -> None:
+    """Write a run document's JSON result and Excel workbook asked for (``doc`` a
+    :class:`~linecheck.io.document.RunDocument`, one wire or several), each with a "wrote" line."""
+    if json_out is not None:
+        from ..io.jsonout import write_json
+
+        write_json(json_out, doc)
+        console.print(f"wrote {json_out}")
+    if excel is not None:
+        from ..excel.writer import write_workbook
+
+        write_workbook([doc], excel, template=template, force=force, title=fields or None)
+        console.print(f"wrote {excel}")

@@ -16,7 +16,7 @@ from ..io.atomic import check_target
 from ..io.display import STAT_ROWS, SUMMARY_STATS, number_text, stat_text, uplift_run_text
 from ..io.document import RunDocument, StatDef
 from ..io.outputs import case_inputs, check_outputs
-from .common import CaseArg, JsonOpt, app, console, handle_errors, read_case
+from .common import CaseArg, JsonOpt, app, console, handle_errors, read_case, write_run_outputs
 from .export_cmd import (
     EngineerOpt,
     ExcelOpt,
@@ -218,7 +218,7 @@ def run(
                            threads=threads)
     doc = _run_document(res, spread, names, full_histories)
     _print_run(doc, case, names, no_check)
-    _write_run_outputs(doc, json_out, excel, template, force, fields)
+    write_run_outputs(doc, json_out, excel, template, force, fields)
 
 
 def _check_run_outputs(case: Case, json_out: Path | None, excel: Path | None, template: Path | None,
@@ -291,21 +291,6 @@ def _print_run(doc: RunDocument, case: Case, names: tuple[str, ...], no_check: b
     print_sanity(doc, explained=burn_in_note(doc) is not None)
     if no_check and case.wind.type == "synoptic":
         console.print("[dim]frequency-domain check skipped (--no-check): no \"spectral\" block, no sanity check.[/]")
-
-
-def _write_run_outputs(doc: RunDocument, json_out: Path | None, excel: Path | None, template: Path | None,
-                       force: bool, fields: dict[str, str]) -> None:
-    """Write the JSON result and the Excel workbook asked for, each with a "wrote" line."""
-    if json_out is not None:
-        from ..io.jsonout import write_json
-
-        write_json(json_out, doc)
-        console.print(f"wrote {json_out}")
-    if excel is not None:
-        from ..excel.writer import write_workbook
-
-        write_workbook([doc], excel, template=template, force=force, title=fields or None)
-        console.print(f"wrote {excel}")
 
 
 

@@ -14,7 +14,7 @@ from ..core.case import Case
 from ..core.errors import CaseError
 from ..io.atomic import check_target
 from ..io.outputs import case_inputs, check_outputs
-from .common import console
+from .common import console, write_run_outputs
 from .limits import warn as limits_warn
 from .progress import progress_bar
 
@@ -55,7 +55,6 @@ def run_wires_command(case: Case, *, json_out: Path | None, load_trees: Path | N
     case's warnings, the run with progress bars (Ctrl-C stops it), the report, then the JSON, the
     CSV and the workbook (``title``: its title block), each atomically with a "wrote" line."""
     from .. import service
-    from ..io.jsonout import write_json
     from ..io.provenance import kernel_warning
     from ..io.wires_document import wires_run_document, write_load_trees
     from .wires_view import print_wires_run
@@ -78,14 +77,7 @@ def run_wires_command(case: Case, *, json_out: Path | None, load_trees: Path | N
         res = service.run_wires(case, progress=cb, threads=threads, warn=limits_warn)
     doc = wires_run_document(res)
     print_wires_run(doc)
-    if json_out is not None:
-        write_json(json_out, doc)
-        console.print(f"wrote {json_out}")
+    write_run_outputs(doc, json_out, excel, template, force, title)
     if load_trees is not None:
         write_load_trees(load_trees, doc)
         console.print(f"wrote {load_trees}")
-    if excel is not None:
-        from ..excel.writer import write_workbook
-
-        write_workbook([doc], excel, template=template, force=force, title=title or None)
-        console.print(f"wrote {excel}")

@@ -13,7 +13,7 @@ from ..core.case import Case
 from ..core.line_damping import damping_stack
 from ..core.loads import synoptic_load_per_v, to_global_nodes
 from ..core.model import LinearModel, build_model
-from .record import record_mean_wind, states_cross_wind
+from .record import record_mean_wind
 from .step1 import StaticResult
 from .uplift import require_tension
 
@@ -30,7 +30,7 @@ def damping_matrices(case: Case, st: StaticResult, models: list[LinearModel], st
     """
     states = list(range(len(models))) if states is None else list(states)
     vn = to_global_nodes(st.system, st.wind.normal)  # (n_k, n_nodes)
-    cross = states_cross_wind(case, st)
+    cross = st.cross_wind
     u = None if cross is None else (cross.perp_vectors, cross.directions)
     return damping_stack(case, st.system, st.mean, vn, models, states, omega1, u)
 
@@ -64,7 +64,7 @@ def synoptic_model(case: Case, st: StaticResult, *, vectors: bool = True, omega1
     damping = damping_matrices(case, st, [model], omega1=omega1)[0]
     vn = to_global_nodes(system, st.wind.normal)[0]
     vl = perp = None
-    cross = states_cross_wind(case, st)
+    cross = st.cross_wind
     if cross is not None:  # cross-flow form: along each node's direction d_j, |V_perp| for |V_n|
         model = replace(model, load_directions=cross.directions)
         vn, vl, perp = cross.along[0], cross.rest[0], cross.perp[0]

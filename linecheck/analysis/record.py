@@ -12,14 +12,14 @@ from collections.abc import Callable
 import numpy as np
 
 from ..core.case import Case
-from ..core.crossflow import NodeWind, applies, node_wind
+from ..core.crossflow import NodeWind, node_wind
 from ..core.damping import aerodynamic_damping, node_tangents, stiffness_proportional
 from ..core.line_damping import reference_state_index, structural_omega1
 from ..core.loads import to_global_nodes
 from ..core.model import LinearModel, build_model
 from ..core.static import MeanStates
 from ..core.system import LineSystem
-from ..core.wind.mean import mean_vector_at_nodes, mean_wind
+from ..core.wind.mean import mean_wind
 from .step1 import StaticResult
 
 
@@ -68,25 +68,15 @@ def record_mean_wind(case: Case, st: StaticResult, t: np.ndarray) -> tuple[np.nd
     return to_global_nodes(system, mw.normal), to_global_nodes(system, mw.longitudinal)
 
 
-def states_cross_wind(case: Case, st: StaticResult) -> NodeWind | None:
-    """The cross-flow form's wind at the global nodes at the step-1 mean states, on each state's
-    deformed conductor axes (:class:`~linecheck.core.crossflow.NodeWind`, (n_k, n_nodes) each), its
-    load directions d_j at each node's largest |V_perp| among the states; None for the
-    horizontal-normal form (:func:`~linecheck.core.crossflow.applies`)."""
-    if not applies(case, st.system):
-        return None
-    return node_wind(st.system, mean_vector_at_nodes(case, st.system, st.mean.time), node_tangents(st.mean.nodes))
-
-
 def record_cross_wind(case: Case, st: StaticResult, t: np.ndarray, vn: np.ndarray,
                       vl: np.ndarray | None) -> NodeWind | None:
-    """:func:`states_cross_wind` over the record ``t`` [s], (n_steps, n_nodes) each, from the
+    """The mean states' cross-flow wind (:attr:`StaticResult.cross_wind`) over the record ``t`` [s], (n_steps, n_nodes) each, from the
     record's running-mean normal and along-line speeds ``vn``, ``vl`` [m/s] (:func:`record_wind`,
     (n_steps, n_nodes); the horizontal wind vn n + vl e at each node, n its normal and e its
     along-line direction): the mean wind at every step on the axes of its nearest mean state,
     with the states' load directions (one per node for the whole record; a synoptic record holds
     its mean, rows of stride 0)."""
-    states = states_cross_wind(case, st)
+    states = st.cross_wind
     if states is None:
         return None
     system, d = st.system, states.directions
@@ -158,7 +148,7 @@ def interpolated_models(case: Case, st: StaticResult, bracket: np.ndarray,
 
     mean, system = st.mean, st.system
     vn_all = to_global_nodes(system, st.wind.normal)
-    cross = states_cross_wind(case, st)
+    cross = st.cross_wind
     n_k = mean.time.size
     zs = case.analysis.structural_ratio
     w1 = 1.0

@@ -8,14 +8,17 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
 from ..core.case import Case
+from ..core.crossflow import NodeWind, applies, node_wind
+from ..core.damping import node_tangents
 from ..core.loads import mean_drag, mean_loads
 from ..core.static import MeanStates, solve_mean_states
 from ..core.system import LineSystem
-from ..core.wind.mean import MeanWind, mean_wind
+from ..core.wind.mean import MeanWind, mean_vector_at_nodes, mean_wind
 from .guard import Warn, check_budget, warn_case
 
 Progress = Callable[[str, int, int], None]
@@ -29,6 +32,18 @@ class StaticResult:
     system: LineSystem
     wind: MeanWind
     mean: MeanStates
+
+    @cached_property
+    def cross_wind(self) -> NodeWind | None:
+        """The cross-flow form's wind at the global nodes at the mean states, on each state's
+        deformed conductor axes (:class:`~linecheck.core.crossflow.NodeWind`, (n_k, n_nodes) each),
+        its load directions d_j at each node's largest |V_perp| among the states; None for the
+        horizontal-normal form (:func:`~linecheck.core.crossflow.applies`).  Computed once: the
+        damping, the record's loads and the frequency-domain check share it."""
+        if not applies(self.case, self.system):
+            return None
+        v = mean_vector_at_nodes(self.case, self.system, self.mean.time)
+        return node_wind(self.system, v, node_tangents(self.mean.nodes))
 
 
 def mean_state_times(case: Case) -> np.ndarray:

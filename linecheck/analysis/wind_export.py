@@ -18,7 +18,7 @@ from ..core.model import build_model
 from ..core.system import LineSystem
 from .burnin import synoptic_burn_in
 from .guard import Warn, check_budget
-from .record import record_mean_wind, record_time, states_cross_wind, with_burn_in
+from .record import record_mean_wind, record_time, with_burn_in
 from .step1 import StaticResult, static_analysis
 from .uplift import require_tension
 
@@ -158,7 +158,7 @@ def loads_from_field(case: Case, field: dict[str, np.ndarray]) -> tuple[np.ndarr
         n, e = st.system.node_normals, st.system.node_frames[:, :, 0]
         vn = u[..., 0] * n[None, :, 0] + u[..., 1] * n[None, :, 1]
         vl = u[..., 0] * e[None, :, 0] + u[..., 1] * e[None, :, 1]
-        states = states_cross_wind(case, st)  # inclined spans, cross-flow: along the run's directions
+        states = st.cross_wind  # inclined spans, cross-flow: along the run's directions
         cross = None if states is None else node_wind(st.system, u, node_tangents(st.mean.nodes[0]), states.directions)
         return fluctuating_loads(case, st.system, model, field["t"], field["v_along"][None], vn, vl, cross)
     vl = None if case.wind.type == "synoptic" else u[:, :, 0]

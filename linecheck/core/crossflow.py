@@ -29,12 +29,6 @@ from .case import Case
 from .system import LineSystem
 
 
-def span_axes(system: LineSystem) -> np.ndarray:
-    """[-] unit still-air chord c_i of every span, (n_spans, 3) (global frame, z up)."""
-    c = system.span_chords
-    return c / np.linalg.norm(c, axis=1)[:, None]
-
-
 def applies(case: Case, system: LineSystem) -> bool:
     """True when the cross-flow drag is used: ``drag_direction`` "cross-flow" on a section (the
     equal-span form is the paper's horizontal-normal idealisation)."""
@@ -54,13 +48,6 @@ def span_wind_vectors(system: LineSystem, normal: np.ndarray, longitudinal: np.n
     h = system.span_headings
     e = np.stack([np.cos(h), np.sin(h), np.zeros_like(h)], axis=1)
     return normal[..., None] * system.span_normals[:, None, :] + longitudinal[..., None] * e[:, None, :]
-
-
-def span_drag_vectors(system: LineSystem, normal: np.ndarray, longitudinal: np.ndarray) -> np.ndarray:
-    """[m/s] V_perp on every span's still-air chord (the first pass of step 1's follower
-    iteration), (..., n_spans, ne+1, 3): V_n n_i - V_x sin(theta_i) m_i, m_i the chord's normal in
-    the span's vertical plane."""
-    return normal_part(span_wind_vectors(system, normal, longitudinal), span_axes(system)[:, None, :])
 
 
 @dataclass(frozen=True)

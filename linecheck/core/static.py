@@ -453,8 +453,8 @@ def _section_states(system: LineSystem, gy: np.ndarray, labels: list[str], *, to
     Lu = system.unstretched_lengths
     clamps = system.clamp_points
     # first pass on the span chords (the still-air axes of a straight cable)
-    chord = system.span_chords / np.linalg.norm(system.span_chords, axis=1)[:, None]
-    dv = None if drag is None else drag(np.broadcast_to(chord[None, :, None, :], gy.shape + (3,)))
+    chord = system.span_directions[None, :, None, :]
+    dv = None if drag is None else drag(np.broadcast_to(chord, gy.shape + (3,)))
     p = section_loads(system, gy, dv)
     if initial is not None:
         pos = np.broadcast_to(clamps + initial.displacement, (n_s,) + clamps.shape).copy()
@@ -472,13 +472,10 @@ def _section_states(system: LineSystem, gy: np.ndarray, labels: list[str], *, to
             break
         new = drag(span_node_tangents(eq.spans, Lu, p))  # the drag on the deformed axes (follower)
         change = np.abs(new - dv).max() / max(float(np.abs(new).max()), 1e-300)
+        if change <= FOLLOWER_RTOL:  # this equilibrium's own drag: settled
+            break
         dv, p = new, section_loads(system, gy, new)
         pos, N0 = eq.p.copy(), eq.spans.N0.copy()  # warm start from the last equilibrium
-        if change <= FOLLOWER_RTOL:
-            eq = equilibrium(clamps, system.insulator_tops, system.insulator_lengths, system.suspension,
-                             system.tower_along, p, Lu, line.ea, pos, N0, labels=labels, tol=tol,
-                             max_iter=max_iter, cancel=cancel)
-            break
     else:
         raise ConvergenceError(f"{labels[0]}: the cross-flow drag on the deformed conductor did not settle in "
                                f"{FOLLOWER_MAX} passes (last change {change:.2g})")

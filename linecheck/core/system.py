@@ -239,6 +239,12 @@ class LineSystem:
         return np.diff(self.clamp_points, axis=0)
 
     @cached_property
+    def span_directions(self) -> np.ndarray:
+        """[-] unit still-air chord of every span, (n_spans, 3) (global frame, z up)."""
+        c = self.span_chords
+        return c / np.linalg.norm(c, axis=1)[:, None]
+
+    @cached_property
     def span_normals(self) -> np.ndarray:
         """[-] horizontal unit normal n_i = (-sin h_i, cos h_i, 0) of every span (the drag direction), (n_spans, 3)."""
         h = self.span_headings

@@ -16,7 +16,7 @@ import pytest
 from linecheck import service
 from linecheck.analysis.record import record_cross_wind
 from linecheck.core.case import case_from_dict
-from linecheck.core.crossflow import applies, span_drag_vectors
+from linecheck.core.crossflow import applies, normal_part, span_wind_vectors
 from linecheck.core.damping import node_tangents
 from linecheck.core.loads import fluctuating_loads
 
@@ -50,7 +50,9 @@ def test_normal_wind_on_an_inclined_chord_has_the_closed_form_vertical_part():
     case = _case(HILLY, direction=30.0)
     st = service.static_analysis(case)
     system = st.system
-    u = span_drag_vectors(system, st.wind.normal, st.wind.longitudinal)[0]  # (n_spans, ne+1, 3)
+    # V_perp on every span's still-air chord (step 1's first pass)
+    u = normal_part(span_wind_vectors(system, st.wind.normal, st.wind.longitudinal),
+                    system.span_directions[:, None, :])[0]  # (n_spans, ne+1, 3)
     v = 30.0
     vn, vx = v * math.cos(math.radians(30.0)), v * math.sin(math.radians(30.0))
     for i, (g0, g1, L) in enumerate(((0.0, 45.0, 300.0), (45.0, 80.0, 350.0), (80.0, 130.0, 330.0))):
@@ -176,7 +178,6 @@ def test_downburst_on_an_inclined_section_runs_with_frozen_directions():
     """A downburst: every node's load direction is V_perp's at its largest |V_perp| among the step-1
     states (checked against the mean wind of that state); the run completes, and the vertical
     wind-induced mean reaction differs from the horizontal-normal form's."""
-    from linecheck.analysis.record import states_cross_wind
     from linecheck.core.case import with_values
 
     case = with_values(_case(HILLY), {
@@ -184,7 +185,7 @@ def test_downburst_on_an_inclined_section_runs_with_frozen_directions():
         "wind.downburst": {"jet_diameter": 640.0, "distance": 500.0, "angle": 30.0},
         "analysis.realizations": 1, "analysis.mean_states": 20, "analysis.duration": None})
     st = service.static_analysis(case)
-    cross = states_cross_wind(case, st)
+    cross = st.cross_wind
     assert cross is not None
     size = np.linalg.norm(cross.perp_vectors, axis=-1)
     for node in (3, st.system.ne + 4):
@@ -204,7 +205,6 @@ def test_aerodynamic_damping_follows_the_normal_wind(damping):
     c d d^T with c = rho C_d D L |V_perp|; quasi-steady: c along the relative wind w = P V_perp/|P V_perp|
     (P normal to the deformed axis e), c/2 across it in the normal plane, 0 along e."""
     from linecheck.analysis.linear import damping_matrices
-    from linecheck.analysis.record import states_cross_wind
     from linecheck.core.case import with_values
     from linecheck.core.model import band_to_dense, build_model
 
@@ -212,7 +212,7 @@ def test_aerodynamic_damping_follows_the_normal_wind(damping):
     st = service.static_analysis(case)
     model = build_model(st.system, st.mean.state(0))
     C = band_to_dense(damping_matrices(case, st, [model])[0])
-    cross = states_cross_wind(case, st)
+    cross = st.cross_wind
     node = st.system.ne + 4
     i = model.dofs.node_dof[node]
     B = C[i:i + 3, i:i + 3]
